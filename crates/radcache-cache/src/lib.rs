@@ -1,0 +1,87 @@
+//! `radcache-cache`: the CPU reference ("Rust twin") of every irradiance-cache formula used by the
+//! GPU passes, plus the parameter set of the cache.
+//!
+//! Spec: `shared/docs/irradiance-caching.md` (cited below as §N). Each formula lives in one module:
+//!
+//! | Module | What | Spec |
+//! |---|---|---|
+//! | [`sampling`] | orthonormal basis, stratified cosine-weighted directions, per-stratum jitter | §3.1, §3.2, §16.3 |
+//! | [`record`] | irradiance, harmonic-mean / minimum distance, rotational and translational gradients | §3.1, §4, §6.1, §6.2, §7.1 |
+//! | [`radius`] | gradient limit, pixel footprint, screen-space clamp, gradient attenuation, neighbour clamping, `finalize_radius` | §7.2–§7.7 |
+//! | [`weight`] | Ward and Tabellion–Lamorlette weights with in-front and normal tests, weight cap, splat radius | §5.1–§5.5, §10.2, §16.1 |
+//! | [`extrapolate`] | gradient extrapolation with the negative/exploding guards | §5.6, §16.2 |
+//! | [`temporal`] | temporal gradient, lifespan, temporal extrapolation | §11.2 |
+//! | [`params`] | [`IcParams`] and its `draft`/`default`/`high` presets | §3.2, §19 |
+//!
+//! **GLSL twin.** `shaders/common/ircache_math.glsl` implements the same functions under the same
+//! (snake_case) names, argument order and guards, in f32. Every public function here takes plain
+//! `f32`, `u32`, `Vec3`, `[Vec3; 3]` or [`WeightKind`] (`uint` in GLSL) arguments so that a GPU
+//! test can evaluate both sides over a table of inputs; functions returning several values return
+//! a tuple or small struct here and use `out` parameters, in field order, in GLSL. RGB gradients
+//! are three world-space vectors, one per colour channel (`[Vec3; 3]` here, three `vec3` arguments
+//! in GLSL). Only [`compute_record`] (slices; the GPU pass reduces the per-stratum terms in shared
+//! memory) and the test helper `sampling::stratum_contains` have no twin. `tests/glsl.rs` checks
+//! names, arities and constants and compiles the GLSL when `glslangValidator` is installed.
+//!
+//! **Conventions.**
+//! * Local frames are right-handed: `t × b = n` (§1); directions in the local frame are
+//!   `(sinθ cosφ, sinθ sinφ, cosθ)`.
+//! * Stratum `(j, k)` of an `M × N` grid is stored at index `j * N + k` ([`sampling::stratum_index`]).
+//! * Hit distances: a miss is any distance `>= IC_FAR` (e.g. `f32::INFINITY`); a distance `<= r_eps`
+//!   (or NaN) marks an invalid sample (self-intersection). Raw distances returned by this crate use
+//!   [`IC_FAR`] for "no geometry", never `inf`, so that the GPU side never divides by infinity (Vulkan
+//!   only guarantees division precision for divisors below 2^126).
+//! * Guards never produce NaN or Inf from finite inputs, `+inf` distances, zero vectors, antiparallel
+//!   normals or zero radii (checked by the randomized sweep in `tests/sweep.rs`). NaN *inputs* are not
+//!   supported on the GPU side (Vulkan does not guarantee NaN semantics).
+
+pub mod extrapolate;
+pub mod params;
+pub mod radius;
+pub mod record;
+pub mod sampling;
+pub mod temporal;
+pub mod weight;
+
+pub use extrapolate::extrapolate_irradiance;
+pub use params::{IcParams, Preset};
+pub use radius::{finalize_radius, FinalRadius};
+pub use record::{compute_record, RecordEstimate};
+pub use weight::{record_weight, splat_radius, WeightKind};
+
+use glam::Vec3;
+
+/// Distances at or above this value are misses ("no geometry"); radii are capped to it.
+/// Chosen well below 2^126 so that `x / r` stays inside Vulkan's guaranteed division range.
+pub const IC_FAR: f32 = 1.0e30;
+
+/// Smallest radius any weight or clamp divides by (§16.1, `R = 0` guard).
+pub const R_FLOOR: f32 = 1.0e-20;
+
+/// Ward error floor: `w = 1 / max(ε, WARD_MIN_ERROR)` caps the weight at 1000 (RADIANCE's cap, §16.1).
+pub const WARD_MIN_ERROR: f32 = 1.0e-3;
+
+/// `sqrt(1 − cos 10°)`: the Tabellion–Lamorlette normal-error scale (§5.3).
+pub const TL_NORMAL_SCALE: f32 = 0.123_256_41;
+
+/// Smallest T&L κ accepted (κ = 0 would give an unbounded zone of influence).
+pub const KAPPA_MIN: f32 = 1.0e-3;
+
+/// `sin²(10°)`: rows lying entirely above 10° elevation (`cos²θ_j⁺ >= sin²10°`) take part in the
+/// restricted minimum distance (§7.1, Mitsuba's grazing-ray guard).
+pub const ELEVATION_MIN_SIN2: f32 = 0.030_153_69;
+
+/// Per-channel upper bound of the extrapolated irradiance relative to the record's value (§16.2).
+pub const EXTRAPOLATION_MAX_FACTOR: f32 = 4.0;
+
+/// `min(max(x, lo), hi)` in GLSL's order. Unlike `f32::clamp` it never panics (`lo > hi` gives `hi`)
+/// and maps a NaN `x` to `lo`.
+#[allow(clippy::manual_clamp)]
+pub(crate) fn clamp_lo_hi(x: f32, lo: f32, hi: f32) -> f32 {
+    x.max(lo).min(hi)
+}
+
+/// Rec. 709 luminance of an RGB triple (used by the temporal lifespan, §11.2).
+pub fn luminance_rec709(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}

@@ -1,0 +1,208 @@
+//! Irradiance-cache parameters and presets (spec §3.2, §5, §7.3, §9, §11.2, §19).
+//!
+//! | Field | draft | default | high | Source / reason |
+//! |---|---|---|---|---|
+//! | `weight_kind` | T&L | T&L | T&L | see [`crate::weight`] for why T&L is the default |
+//! | `accuracy` (Ward `a`) | 0.3 | 0.15 | 0.1 | §19 start value 0.15; RADIANCE `rvu` 0.3, `rtrace` 0.1 |
+//! | `kappa` (T&L `κ`) | 0.75 | 1.0 | 1.5 | §19 "T&L κ = 1"; larger κ = smaller zones |
+//! | `min_spacing_px` | 3 | 2 | 1.5 | validity radius floor in pixels, §19 "R⁻ = 2 px"; ≈1.5 px T&L (spec: recall, unverified) |
+//! | `max_spacing_px` | 32 | 20 | 15 | validity radius cap in pixels, §19 "R⁺ = 20 px"; pbrt-v2 15 |
+//! | `strata_m × strata_n` | 8×24 | 16×48 | 24×72 | §3.2: interactive 192 rays, offline 768; high ≈ 1.7k (`N = 3M`) |
+//! | `hole_threshold` | 0.25 | 0.5 | 0.75 | Σw, in units of [`weight_unit`], below which a pixel is a hole (pbrt-v2 minWeight 0.5) |
+//! | `levels` | 5 | 6 | 6 | coarse-to-fine spacings `2^(levels−1) … 1` px (§9: 32, 16, 8, 4, 2, 1) |
+//! | `creation_strictness` | 0.7 | 0.7 | 0.7 | §9: create at `a·0.7` (Ward) or `κ/0.7` (T&L) |
+//! | `front_tolerance_px` | 0.5 | 0.5 | 0.5 | §5.4 design: in-front tolerance `0.5·s(p)` |
+//! | `temporal_accuracy` (`a_t`) | 0.1 | 0.05 | 0.02 | §19 `a_t = 0.05` |
+//! | `max_age_frames` (`Δt_max`) | 60 | 30 | 15 | §19 `Δt_max = 30` |
+//!
+//! Draft trades accuracy for speed (4× fewer rays, bigger zones, fewer refreshes); high halves
+//! the ray noise (2.25× rays), shrinks zones and refreshes more often. On lavapipe (≈0.3 Mrays/s
+//! for incoherent gather rays, shared/docs/toolchain.md) the default's 768 rays per record is the
+//! dominant cost, so `draft` is the preset for tests and previews.
+
+use crate::radius::radius_bounds;
+use crate::weight::{coverage_threshold, validity_scale, weight_unit, WeightKind};
+
+/// Named parameter presets.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Preset {
+    /// Fast previews and tests.
+    Draft,
+    /// The §19 starting values.
+    #[default]
+    Default,
+    /// Offline quality.
+    High,
+}
+
+/// Parameters of the irradiance cache (see the module table for values and sources).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IcParams {
+    /// Interpolation weight (§5).
+    pub weight_kind: WeightKind,
+    /// Ward accuracy `a` (§5.1); used when `weight_kind` is Ward.
+    pub accuracy: f32,
+    /// Tabellion–Lamorlette `κ` (§5.3); used when `weight_kind` is T&L.
+    pub kappa: f32,
+    /// Smallest validity radius, in pixel footprints (§7.3, `R⁻`).
+    pub min_spacing_px: f32,
+    /// Largest validity radius, in pixel footprints (§7.3, `R⁺`).
+    pub max_spacing_px: f32,
+    /// Polar strata `M` (§3.2).
+    pub strata_m: u32,
+    /// Azimuthal strata `N` (§3.2).
+    pub strata_n: u32,
+    /// Σw, in units of [`weight_unit`], below which a pixel counts as a hole (§9, §10.4).
+    pub hole_threshold: f32,
+    /// Number of coarse-to-fine creation levels; the coarsest spacing is `2^(levels−1)` px (§9).
+    pub levels: u32,
+    /// Creation-pass strictness `s` (§9): records are created with `a·s` (Ward) or `κ/s` (T&L).
+    pub creation_strictness: f32,
+    /// In-front test tolerance in pixel footprints (§5.4).
+    pub front_tolerance_px: f32,
+    /// Temporal accuracy `a_t` (§11.2).
+    pub temporal_accuracy: f32,
+    /// Largest record lifespan `Δt_max`, in frames (§11.2).
+    pub max_age_frames: f32,
+}
+
+impl Default for IcParams {
+    fn default() -> Self {
+        Self::preset(Preset::Default)
+    }
+}
+
+impl IcParams {
+    /// Parameters of a named preset.
+    pub fn preset(preset: Preset) -> Self {
+        let base = Self {
+            weight_kind: WeightKind::default(),
+            accuracy: 0.15,
+            kappa: 1.0,
+            min_spacing_px: 2.0,
+            max_spacing_px: 20.0,
+            strata_m: 16,
+            strata_n: 48,
+            hole_threshold: 0.5,
+            levels: 6,
+            creation_strictness: 0.7,
+            front_tolerance_px: 0.5,
+            temporal_accuracy: 0.05,
+            max_age_frames: 30.0,
+        };
+        match preset {
+            Preset::Default => base,
+            Preset::Draft => Self {
+                accuracy: 0.3,
+                kappa: 0.75,
+                min_spacing_px: 3.0,
+                max_spacing_px: 32.0,
+                strata_m: 8,
+                strata_n: 24,
+                hole_threshold: 0.25,
+                levels: 5,
+                temporal_accuracy: 0.1,
+                max_age_frames: 60.0,
+                ..base
+            },
+            Preset::High => Self {
+                accuracy: 0.1,
+                kappa: 1.5,
+                min_spacing_px: 1.5,
+                max_spacing_px: 15.0,
+                strata_m: 24,
+                strata_n: 72,
+                hole_threshold: 0.75,
+                temporal_accuracy: 0.02,
+                max_age_frames: 15.0,
+                ..base
+            },
+        }
+    }
+
+    /// The `draft` preset.
+    pub fn draft() -> Self {
+        Self::preset(Preset::Draft)
+    }
+
+    /// The `high` preset.
+    pub fn high() -> Self {
+        Self::preset(Preset::High)
+    }
+
+    /// The weight parameter of the selected kind: `a` (Ward) or `κ` (T&L).
+    pub fn weight_param(&self) -> f32 {
+        match self.weight_kind {
+            WeightKind::Ward => self.accuracy,
+            WeightKind::TabellionLamorlette => self.kappa,
+        }
+    }
+
+    /// Validity radius / `R` for the selected kind (§10.2).
+    pub fn validity_scale(&self) -> f32 {
+        validity_scale(self.weight_kind, self.weight_param())
+    }
+
+    /// `(R⁻, R⁺)` for a record whose pixel footprint is `footprint` (§7.3).
+    pub fn radius_bounds(&self, footprint: f32) -> (f32, f32) {
+        radius_bounds(
+            footprint,
+            self.min_spacing_px,
+            self.max_spacing_px,
+            self.validity_scale(),
+        )
+    }
+
+    /// Σw below which a pixel is a hole (§10.4).
+    pub fn coverage_threshold(&self) -> f32 {
+        coverage_threshold(self.weight_kind, self.weight_param(), self.hole_threshold)
+    }
+
+    /// Weight of one full record for the selected kind ([`weight_unit`]).
+    pub fn weight_unit(&self) -> f32 {
+        weight_unit(self.weight_kind, self.weight_param())
+    }
+
+    /// In-front tolerance in world units at a point with pixel footprint `footprint` (§5.4).
+    pub fn front_tolerance(&self, footprint: f32) -> f32 {
+        self.front_tolerance_px * footprint.max(0.0)
+    }
+
+    /// The stricter parameters used while creating records (§9): `a·s` and `κ/s`.
+    pub fn for_creation(&self) -> Self {
+        let s = self.creation_strictness.clamp(0.05, 1.0);
+        Self {
+            accuracy: self.accuracy * s,
+            kappa: self.kappa / s,
+            ..*self
+        }
+    }
+
+    /// Rays per record, `M·N`.
+    pub fn sample_count(&self) -> u32 {
+        self.strata_m * self.strata_n
+    }
+
+    /// Candidate spacing in pixels of creation level `level` (0 = coarsest): `2^(levels−1−level)`.
+    pub fn level_spacing_px(&self, level: u32) -> u32 {
+        1u32 << self.levels.saturating_sub(1).saturating_sub(level).min(15)
+    }
+
+    /// True when every field is in its meaningful range (positive accuracies and strata,
+    /// `min_spacing_px <= max_spacing_px`, …).
+    pub fn is_valid(&self) -> bool {
+        self.accuracy > 0.0
+            && self.kappa >= crate::KAPPA_MIN
+            && self.min_spacing_px > 0.0
+            && self.min_spacing_px <= self.max_spacing_px
+            && self.strata_m >= 1
+            && self.strata_n >= 3
+            && self.hole_threshold >= 0.0
+            && self.levels >= 1
+            && self.creation_strictness > 0.0
+            && self.creation_strictness <= 1.0
+            && self.front_tolerance_px >= 0.0
+            && self.temporal_accuracy >= 0.0
+            && self.max_age_frames >= 0.0
+    }
+}

@@ -1,0 +1,209 @@
+//! Checks that `shaders/common/ircache_math.glsl` stays the twin of this crate
+//! (shared/docs/architecture.md, "Pair each GLSL function with a Rust reference"):
+//! * every top-level `pub fn` of `src/` has a GLSL function of the same name and vice versa, with
+//!   the same arity once Rust's `[Vec3; 3]` arguments count as three `vec3` and tuple/struct
+//!   results as `out` parameters (value comparison on the GPU is the lead's `radcache-tests`);
+//! * every `pub const` scalar of the crate has the same value in GLSL;
+//! * the file compiles with `glslangValidator` (Vulkan 1.2 target) when the tool is installed;
+//!   otherwise the test prints why that part was skipped.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// Rust functions with no GLSL twin (slices / test helpers) and their reason.
+const RUST_ONLY: [(&str, &str); 2] = [
+    (
+        "compute_record",
+        "takes slices; the GPU pass reduces the per-stratum terms",
+    ),
+    ("stratum_contains", "test helper"),
+];
+
+fn crate_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn glsl_path() -> PathBuf {
+    crate_dir().join("../../shaders/common/ircache_math.glsl")
+}
+
+/// Number of GLSL-side values a Rust signature maps to: arguments plus `out` results.
+fn rust_arity(args: &str, ret: &str) -> usize {
+    let args: Vec<&str> = args
+        .split(',')
+        .map(str::trim)
+        .filter(|a| !a.is_empty())
+        .collect();
+    let mut n = args
+        .iter()
+        .map(|a| if a.contains("[Vec3; 3]") { 3 } else { 1 })
+        .sum::<usize>();
+    let ret = ret.trim();
+    if ret.starts_with('(') {
+        n += ret.matches(',').count() + 1;
+    } else if ret == "FinalRadius" {
+        n += 5;
+    }
+    n
+}
+
+fn rust_functions() -> BTreeMap<String, usize> {
+    let mut out = BTreeMap::new();
+    for entry in std::fs::read_dir(crate_dir().join("src")).unwrap() {
+        let text = std::fs::read_to_string(entry.unwrap().path()).unwrap();
+        for (pos, _) in text.match_indices("\npub fn ") {
+            let sig = &text[pos + 8..];
+            let sig = &sig[..sig.find('{').unwrap()];
+            let open = sig.find('(').unwrap();
+            let name = &sig[..open];
+            // The ')' matching the argument list's '('.
+            let mut depth = 0;
+            let close = open
+                + sig[open..]
+                    .char_indices()
+                    .find(|&(_, c)| {
+                        depth += match c {
+                            '(' => 1,
+                            ')' => -1,
+                            _ => 0,
+                        };
+                        depth == 0
+                    })
+                    .unwrap()
+                    .0;
+            let ret = sig[close + 1..].trim().trim_start_matches("->");
+            out.insert(name.to_string(), rust_arity(&sig[open + 1..close], ret));
+        }
+    }
+    out
+}
+
+fn glsl_functions(text: &str) -> BTreeMap<String, usize> {
+    let mut out = BTreeMap::new();
+    for ty in ["float", "vec3", "vec4", "uint", "bool", "void"] {
+        for (pos, _) in text.match_indices(&format!("\n{ty} ")) {
+            let rest = &text[pos + ty.len() + 2..];
+            let Some(paren) = rest.find('(') else {
+                continue;
+            };
+            let name = &rest[..paren];
+            if name.contains(' ') || name.contains('=') {
+                continue; // a declaration, not a function
+            }
+            let args = &rest[paren + 1..paren + rest[paren..].find(')').unwrap()];
+            out.insert(
+                name.to_string(),
+                args.split(',').filter(|a| !a.trim().is_empty()).count(),
+            );
+        }
+    }
+    out
+}
+
+#[test]
+fn every_rust_function_has_a_glsl_twin() {
+    let text = std::fs::read_to_string(glsl_path()).expect("shaders/common/ircache_math.glsl");
+    let glsl = glsl_functions(&text);
+    let rust = rust_functions();
+    assert!(
+        rust.len() > 50 && glsl.len() > 50,
+        "parsers found too little: {} / {}",
+        rust.len(),
+        glsl.len()
+    );
+    for (name, arity) in &rust {
+        if RUST_ONLY.iter().any(|(n, _)| n == name) {
+            assert!(!glsl.contains_key(name));
+            continue;
+        }
+        let g = glsl
+            .get(name)
+            .unwrap_or_else(|| panic!("no GLSL twin for `{name}`"));
+        assert_eq!(
+            g, arity,
+            "`{name}`: GLSL takes {g} values, Rust maps to {arity}"
+        );
+    }
+    for name in glsl.keys() {
+        assert!(
+            rust.contains_key(name),
+            "GLSL `{name}` has no Rust reference"
+        );
+    }
+}
+
+#[test]
+fn constants_match() {
+    let text = std::fs::read_to_string(glsl_path()).unwrap();
+    let consts = [
+        ("IC_FAR", radcache_cache::IC_FAR),
+        ("R_FLOOR", radcache_cache::R_FLOOR),
+        ("WARD_MIN_ERROR", radcache_cache::WARD_MIN_ERROR),
+        ("TL_NORMAL_SCALE", radcache_cache::TL_NORMAL_SCALE),
+        ("KAPPA_MIN", radcache_cache::KAPPA_MIN),
+        ("ELEVATION_MIN_SIN2", radcache_cache::ELEVATION_MIN_SIN2),
+        (
+            "EXTRAPOLATION_MAX_FACTOR",
+            radcache_cache::EXTRAPOLATION_MAX_FACTOR,
+        ),
+        ("WEIGHT_WARD", radcache_cache::weight::WEIGHT_WARD as f32),
+        ("WEIGHT_TL", radcache_cache::weight::WEIGHT_TL as f32),
+    ];
+    for (name, value) in consts {
+        let key = format!(" {name} = ");
+        let pos = text
+            .find(&key)
+            .unwrap_or_else(|| panic!("GLSL lacks const {name}"));
+        let lit = text[pos + key.len()..]
+            .split(';')
+            .next()
+            .unwrap()
+            .trim()
+            .trim_end_matches('u');
+        let g: f32 = lit.parse().unwrap();
+        assert!(
+            (g - value).abs() <= 1e-7 * value.abs(),
+            "{name}: GLSL {g} vs Rust {value}"
+        );
+    }
+    // Derived constants hold what their names say.
+    assert!(
+        (radcache_cache::TL_NORMAL_SCALE - (1.0 - 10f32.to_radians().cos()).sqrt()).abs() < 1e-6
+    );
+    assert!((radcache_cache::ELEVATION_MIN_SIN2 - 10f32.to_radians().sin().powi(2)).abs() < 1e-7);
+}
+
+#[test]
+fn glsl_compiles_when_glslang_is_installed() {
+    let Ok(out) = std::process::Command::new("glslangValidator")
+        .arg("--version")
+        .output()
+    else {
+        eprintln!("SKIPPED: glslangValidator not found (apt-get install glslang-tools); GLSL compile check not run");
+        return;
+    };
+    assert!(out.status.success());
+    let dir = std::env::temp_dir().join(format!("radcache-cache-glsl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let wrapper = dir.join("wrap.comp");
+    std::fs::write(
+        &wrapper,
+        "#version 460\n#extension GL_GOOGLE_include_directive : require\n#include \"ircache_math.glsl\"\n\
+         #include \"ircache_math.glsl\"\nlayout(local_size_x = 1) in;\n\
+         layout(std430, binding = 0) buffer Out { vec4 v[]; } o;\n\
+         void main() { vec3 t, b; basis_from_normal(vec3(0.0, 0.0, -1.0), t, b); o.v[0] = vec4(t, stratum_tan_mean(3u, 16u)); }\n",
+    )
+    .unwrap();
+    let include = format!("-I{}", glsl_path().parent().unwrap().display());
+    let spv = dir.join("wrap.spv");
+    let res = std::process::Command::new("glslangValidator")
+        .args(["-V", "--target-env", "vulkan1.2", &include, "-o"])
+        .arg(&spv)
+        .arg(&wrapper)
+        .output()
+        .unwrap();
+    let log =
+        String::from_utf8_lossy(&res.stdout).to_string() + &String::from_utf8_lossy(&res.stderr);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(res.status.success(), "glslangValidator failed:\n{log}");
+}

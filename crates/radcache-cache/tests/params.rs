@@ -1,0 +1,75 @@
+//! Tests of `IcParams` and its presets (spec §3.2, §9, §19).
+
+use radcache_cache::weight::{splat_radius, WeightKind};
+use radcache_cache::{IcParams, Preset};
+
+#[test]
+fn presets_are_valid_and_ordered() {
+    let (d, n, h) = (IcParams::draft(), IcParams::default(), IcParams::high());
+    for p in [d, n, h] {
+        assert!(p.is_valid(), "{p:?}");
+        assert_eq!(p.weight_kind, WeightKind::TabellionLamorlette);
+        assert!(p.strata_n >= 3 * p.strata_m, "N ≈ πM (§3.2)");
+    }
+    assert_eq!(IcParams::preset(Preset::Default), n);
+    assert_eq!(
+        (n.strata_m, n.strata_n, n.accuracy, n.kappa),
+        (16, 48, 0.15, 1.0),
+        "§19 starting values"
+    );
+    assert_eq!(
+        (
+            n.min_spacing_px,
+            n.max_spacing_px,
+            n.temporal_accuracy,
+            n.max_age_frames
+        ),
+        (2.0, 20.0, 0.05, 30.0)
+    );
+    assert_eq!((d.strata_m, d.strata_n), (8, 24), "§3.2 interactive");
+    assert!(d.sample_count() < n.sample_count() && n.sample_count() < h.sample_count());
+    assert!(d.accuracy > n.accuracy && n.accuracy > h.accuracy);
+    assert!(d.kappa < n.kappa && n.kappa < h.kappa);
+    assert!(d.max_spacing_px > n.max_spacing_px && n.max_spacing_px > h.max_spacing_px);
+}
+
+#[test]
+fn derived_quantities() {
+    let p = IcParams::default();
+    assert_eq!(p.weight_param(), 1.0);
+    assert_eq!(p.validity_scale(), 0.5);
+    assert_eq!(p.coverage_threshold(), 0.5);
+    assert_eq!(
+        (
+            p.level_spacing_px(0),
+            p.level_spacing_px(5),
+            p.level_spacing_px(9)
+        ),
+        (32, 1, 1)
+    );
+    let s = 0.003;
+    let (lo, hi) = p.radius_bounds(s);
+    let vr = |r| splat_radius(p.weight_kind, r, p.weight_param(), 0.0);
+    assert!(
+        (vr(lo) - 2.0 * s).abs() < 1e-6 && (vr(hi) - 20.0 * s).abs() < 1e-6,
+        "validity radius in pixels"
+    );
+    assert!((p.front_tolerance(s) - 0.5 * s).abs() < 1e-9);
+    let c = p.for_creation();
+    assert!(
+        c.kappa > p.kappa && c.accuracy < p.accuracy,
+        "creation is stricter (§9)"
+    );
+    assert!((c.kappa - p.kappa / 0.7).abs() < 1e-6);
+    let ward = IcParams {
+        weight_kind: WeightKind::Ward,
+        ..p
+    };
+    assert_eq!(ward.weight_param(), 0.15);
+    assert!((ward.coverage_threshold() - 0.5 / 0.15).abs() < 1e-5);
+    assert!(!IcParams {
+        min_spacing_px: 30.0,
+        ..p
+    }
+    .is_valid());
+}

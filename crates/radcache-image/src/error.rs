@@ -1,0 +1,95 @@
+//! The crate's error type.
+//!
+//! Every variant that concerns a file names its path, so a failed frame of a long sequence can be
+//! found from the message alone. Bad input (missing, corrupt or unexpected files, mismatched
+//! image sizes, malformed path patterns) is always reported through [`Error`], never by a panic.
+
+use std::path::PathBuf;
+
+/// Errors of `radcache-image`.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// An operating-system I/O operation on `path` failed.
+    #[error("{op} '{path}': {source}")]
+    Io {
+        /// What was being done, e.g. "cannot create temporary file for".
+        op: &'static str,
+        /// The file concerned (the final path for atomic writes).
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+
+    /// The `exr` crate failed to encode `path`.
+    #[error("cannot write EXR '{path}': {source}")]
+    ExrWrite {
+        /// The destination file.
+        path: PathBuf,
+        /// The underlying error.
+        source: exr::error::Error,
+    },
+
+    /// The `exr` crate failed to decode `path` (missing, truncated or corrupt file).
+    #[error("cannot read EXR '{path}': {source}")]
+    ExrRead {
+        /// The source file.
+        path: PathBuf,
+        /// The underlying error.
+        source: exr::error::Error,
+    },
+
+    /// `path` is a valid EXR but not one this crate can interpret (e.g. no R, G, B channels).
+    #[error("unsupported EXR content in '{path}': {message}")]
+    ExrContent {
+        /// The source file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+
+    /// Metadata that cannot be stored as EXR header attributes.
+    #[error("invalid metadata for '{path}': {message}")]
+    Metadata {
+        /// The destination file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+
+    /// The `png` crate failed to encode `path`.
+    #[error("cannot write PNG '{path}': {source}")]
+    Png {
+        /// The destination file.
+        path: PathBuf,
+        /// The underlying error.
+        source: png::EncodingError,
+    },
+
+    /// An output path pattern could not be expanded.
+    #[error("invalid output path pattern '{pattern}': {message}")]
+    PathPattern {
+        /// The pattern as given.
+        pattern: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+
+    /// Two images that must have the same size do not.
+    #[error(
+        "image size mismatch: reference is {}x{}, candidate is {}x{}",
+        reference.0, reference.1, candidate.0, candidate.1
+    )]
+    SizeMismatch {
+        /// Reference (width, height).
+        reference: (u32, u32),
+        /// Candidate (width, height).
+        candidate: (u32, u32),
+    },
+
+    /// Pixel data or a layer does not fit the image it is given to.
+    #[error("invalid image data: {0}")]
+    InvalidImage(String),
+}
+
+/// `Result` with this crate's [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;

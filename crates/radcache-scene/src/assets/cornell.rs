@@ -1,0 +1,153 @@
+//! The Cornell box from the published Cornell Program of Computer Graphics data.
+//!
+//! Geometry: the published vertex lists (millimetres) converted to metres, kept in the published
+//! frame (box corner at the origin, +Y up, the open side towards −Z). The light quad is moved 3 mm
+//! below the ceiling (y = 545.8 mm instead of 548.8 mm) and faces down. Quads are re-oriented so
+//! that walls face the inside and blocks face outward (normals are flat per quad).
+//!
+//! Camera: published position (278, 273, −800) mm looking along +Z with +Y up (a glTF camera node
+//! rotated 180° about Y); focal length 0.035 m with a 0.025 m square film →
+//! yfov = 2·atan(0.0125 / 0.035) ≈ 39.3°, aspect 1. Looking along +Z with +Y up in this
+//! right-handed frame, image right is −X, so the red wall (x ≈ 0.55 m) is on the LEFT and the
+//! green wall (x = 0) on the right, as in the reference photographs.
+//!
+//! Materials (RGB approximations of the published spectral reflectances): white (0.73, 0.73, 0.73),
+//! red (0.63, 0.065, 0.05), green (0.14, 0.45, 0.091); the light has albedo 0.78 and emits
+//! (17, 12, 4) W/(sr·m²) (emissiveFactor (1, 12/17, 4/17) × emissiveStrength 17).
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use super::{write_named, yaw, QuadSoup};
+use crate::error::Result;
+use crate::writer::{GltfBuilder, MaterialDesc, NodeDesc};
+
+/// Vertical field of view of the published camera: 2·atan(0.0125 / 0.035).
+pub const CORNELL_YFOV: f32 = 0.686_047_9;
+
+/// Published camera position in metres.
+pub(crate) const CAMERA_POSITION: [f32; 3] = [0.278, 0.273, -0.8];
+
+type Quad = [[f32; 3]; 4];
+
+const FLOOR: Quad = [[552.8, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 559.2], [549.6, 0.0, 559.2]];
+const CEILING: Quad = [[556.0, 548.8, 0.0], [556.0, 548.8, 559.2], [0.0, 548.8, 559.2], [0.0, 548.8, 0.0]];
+const BACK_WALL: Quad = [[549.6, 0.0, 559.2], [0.0, 0.0, 559.2], [0.0, 548.8, 559.2], [556.0, 548.8, 559.2]];
+const GREEN_WALL: Quad = [[0.0, 0.0, 559.2], [0.0, 0.0, 0.0], [0.0, 548.8, 0.0], [0.0, 548.8, 559.2]];
+const RED_WALL: Quad = [[552.8, 0.0, 0.0], [549.6, 0.0, 559.2], [556.0, 548.8, 559.2], [556.0, 548.8, 0.0]];
+const LIGHT_Y: f32 = 545.8;
+const LIGHT: Quad = [[343.0, LIGHT_Y, 227.0], [343.0, LIGHT_Y, 332.0], [213.0, LIGHT_Y, 332.0], [213.0, LIGHT_Y, 227.0]];
+
+const SHORT_BLOCK: [Quad; 5] = [
+    [[130.0, 165.0, 65.0], [82.0, 165.0, 225.0], [240.0, 165.0, 272.0], [290.0, 165.0, 114.0]],
+    [[290.0, 0.0, 114.0], [290.0, 165.0, 114.0], [240.0, 165.0, 272.0], [240.0, 0.0, 272.0]],
+    [[130.0, 0.0, 65.0], [130.0, 165.0, 65.0], [290.0, 165.0, 114.0], [290.0, 0.0, 114.0]],
+    [[82.0, 0.0, 225.0], [82.0, 165.0, 225.0], [130.0, 165.0, 65.0], [130.0, 0.0, 65.0]],
+    [[240.0, 0.0, 272.0], [240.0, 165.0, 272.0], [82.0, 165.0, 225.0], [82.0, 0.0, 225.0]],
+];
+
+const TALL_BLOCK: [Quad; 5] = [
+    [[423.0, 330.0, 247.0], [265.0, 330.0, 296.0], [314.0, 330.0, 456.0], [472.0, 330.0, 406.0]],
+    [[423.0, 0.0, 247.0], [423.0, 330.0, 247.0], [472.0, 330.0, 406.0], [472.0, 0.0, 406.0]],
+    [[472.0, 0.0, 406.0], [472.0, 330.0, 406.0], [314.0, 330.0, 456.0], [314.0, 0.0, 456.0]],
+    [[314.0, 0.0, 456.0], [314.0, 330.0, 456.0], [265.0, 330.0, 296.0], [265.0, 0.0, 296.0]],
+    [[265.0, 0.0, 296.0], [265.0, 330.0, 296.0], [423.0, 330.0, 247.0], [423.0, 0.0, 247.0]],
+];
+
+/// Millimetres → metres.
+fn metres(q: &Quad) -> [Vec3; 4] {
+    q.map(|p| Vec3::from(p) * 0.001)
+}
+
+fn centroid(q: &[Vec3; 4]) -> Vec3 {
+    (q[0] + q[1] + q[2] + q[3]) * 0.25
+}
+
+/// Material indices of the Cornell box.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CornellMaterials {
+    pub(crate) white: usize,
+    pub(crate) red: usize,
+    pub(crate) green: usize,
+    pub(crate) light: usize,
+}
+
+pub(crate) fn add_materials(b: &mut GltfBuilder) -> CornellMaterials {
+    CornellMaterials {
+        white: b.add_material(&MaterialDesc::diffuse("white", [0.73, 0.73, 0.73])),
+        red: b.add_material(&MaterialDesc::diffuse("red", [0.63, 0.065, 0.05])),
+        green: b.add_material(&MaterialDesc::diffuse("green", [0.14, 0.45, 0.091])),
+        light: b.add_material(&MaterialDesc::emitter("light", [0.78, 0.78, 0.78], [17.0, 12.0, 4.0])),
+    }
+}
+
+fn node(b: &mut GltfBuilder, name: &str, mesh: usize) -> usize {
+    b.add_node(&NodeDesc {
+        name: Some(name.into()),
+        mesh: Some(mesh),
+        ..NodeDesc::default()
+    })
+}
+
+/// Adds the room (white floor/ceiling/back, red left wall, green right wall), the tall block and
+/// the light, each as a mesh with its node; returns the node indices.
+pub(crate) fn add_room(b: &mut GltfBuilder, m: CornellMaterials) -> Vec<usize> {
+    let inside = Vec3::new(0.278, 0.274, 0.280);
+    let wall = |soup: &mut QuadSoup, q: &Quad| {
+        let q = metres(q);
+        soup.quad(q, inside - centroid(&q));
+    };
+    let (mut white, mut red, mut green) = (QuadSoup::default(), QuadSoup::default(), QuadSoup::default());
+    for q in [&FLOOR, &CEILING, &BACK_WALL] {
+        wall(&mut white, q);
+    }
+    wall(&mut red, &RED_WALL);
+    wall(&mut green, &GREEN_WALL);
+    let room = b.add_mesh("room", &[white.primitive(m.white), red.primitive(m.red), green.primitive(m.green)]);
+    let tall = add_block(b, "tall_block", &TALL_BLOCK, m.white);
+    let mut light = QuadSoup::default();
+    light.quad(metres(&LIGHT), -Vec3::Y);
+    let light = b.add_mesh("light", &[light.primitive(m.light)]);
+    vec![node(b, "room", room), node(b, "tall_block", tall), node(b, "light", light)]
+}
+
+fn add_block(b: &mut GltfBuilder, name: &str, quads: &[Quad; 5], material: usize) -> usize {
+    let qs: Vec<[Vec3; 4]> = quads.iter().map(metres).collect();
+    let top = &qs[0];
+    let center = Vec3::new(centroid(top).x, top[0].y * 0.5, centroid(top).z);
+    let mut soup = QuadSoup::default();
+    for q in &qs {
+        soup.quad(*q, centroid(q) - center);
+    }
+    b.add_mesh(name, &[soup.primitive(material)])
+}
+
+/// Adds the published camera (looking along +Z) and returns its node.
+pub(crate) fn add_camera(b: &mut GltfBuilder, name: &str) -> usize {
+    let cam = b.add_perspective_camera(name, CORNELL_YFOV, Some(1.0), 0.01, Some(100.0));
+    b.add_node(&NodeDesc {
+        name: Some(name.into()),
+        translation: Some(CAMERA_POSITION),
+        rotation: Some(yaw(180.0)),
+        camera: Some(cam),
+        ..NodeDesc::default()
+    })
+}
+
+/// The Cornell box document.
+pub fn cornell_builder() -> GltfBuilder {
+    let mut b = GltfBuilder::new();
+    let m = add_materials(&mut b);
+    let mut roots = add_room(&mut b, m);
+    let short = add_block(&mut b, "short_block", &SHORT_BLOCK, m.white);
+    roots.push(node(&mut b, "short_block", short));
+    roots.push(add_camera(&mut b, "camera"));
+    b.add_scene("cornell_box", &roots, None);
+    b
+}
+
+/// Writes `dir/cornell/cornell.gltf` (+ `.bin`).
+pub fn write_cornell(dir: &Path) -> Result<PathBuf> {
+    write_named(&cornell_builder(), dir, "cornell")
+}

@@ -1,0 +1,218 @@
+//! `Scene::load`: glTF file → [`Scene`] plus warnings.
+//!
+//! Order of work: parse and validate (gltf crate) → load buffers → animations (to know which nodes
+//! move) → nodes and hierarchy of the chosen scene (`scene`, else `scenes[0]`, else every parentless
+//! node) → materials and textures → meshes → lights → instances → camera → environment.
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use crate::animation::load_animations;
+use crate::camera::{camera_defs, Camera, CameraDef};
+use crate::environment::{scene_radiance, EnvOverride, Environment};
+use crate::error::{label, Error, Result, Warning, WarningKind, Warnings};
+use crate::light::{load_lights, LightInstance};
+use crate::material::{load_materials, Material};
+use crate::mesh::load_mesh;
+use crate::node::{load_nodes, traversal_order, Node};
+use crate::resources::Source;
+use crate::scene::{Instance, Scene};
+use crate::texture::TextureLoader;
+
+/// Options of [`Scene::load`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LoadOptions {
+    /// Use the camera whose node (or camera) has this name instead of the first camera.
+    pub camera_name: Option<String>,
+    /// Environment overrides (command line).
+    pub env: EnvOverride,
+}
+
+impl Scene {
+    /// Loads a `.gltf` or `.glb` file. Warnings are logged with `log::warn!` and returned.
+    pub fn load(path: &Path, opts: &LoadOptions) -> Result<(Scene, Vec<Warning>)> {
+        let src = Source::open(path)?;
+        let mut w = Warnings::default();
+        let animations = load_animations(&src, &mut w)?;
+        let node_count = src.doc.nodes().len();
+        let mut targeted = vec![false; node_count];
+        let mut animated = vec![false; node_count];
+        for ch in animations.iter().flat_map(|a| &a.channels) {
+            targeted[ch.node] = true;
+            animated[ch.node] |= !ch.sampler.is_constant();
+        }
+        let mut nodes = load_nodes(&src, &targeted, &mut w)?;
+        let roots = scene_roots(&src, &nodes, &mut w);
+        let order = traversal_order(&src, &mut nodes, &roots)?;
+
+        let mut textures = TextureLoader::default();
+        let mut materials = load_materials(&src, &mut textures, &mut w)?;
+        let default_index = materials.len() as u32;
+        let mut default_used = false;
+        let mut material_of = |m: Option<usize>| match m {
+            Some(i) => i as u32,
+            None => {
+                default_used = true;
+                default_index
+            }
+        };
+        let mut meshes = Vec::new();
+        for m in src.doc.meshes() {
+            meshes.push(load_mesh(&src, &m, &mut material_of, &mut w)?);
+        }
+        if default_used {
+            materials.push(Material::default_material());
+        }
+
+        let mut dynamic = vec![false; node_count];
+        for &n in &order {
+            dynamic[n] = animated[n] || nodes[n].parent.is_some_and(|p| dynamic[p]);
+        }
+        let lights = load_lights(&src.doc);
+        let light_instances = order
+            .iter()
+            .filter_map(|&n| nodes[n].light.map(|light| (n, light)))
+            .map(|(node, light)| LightInstance {
+                light,
+                node,
+                dynamic: dynamic[node],
+            })
+            .collect();
+        let instances = order
+            .iter()
+            .filter_map(|&n| nodes[n].mesh.map(|mesh| (n, mesh)))
+            .filter(|&(_, mesh)| meshes.get(mesh).is_some_and(|m| m.triangle_count() > 0))
+            .map(|(node, mesh)| Instance {
+                mesh,
+                node,
+                dynamic: dynamic[node],
+            })
+            .collect();
+        let material_emission = materials
+            .iter()
+            .map(|m| {
+                let tex = m.emissive_texture.map_or(Vec3::ONE, |t| {
+                    textures.images[textures.textures[t.texture].image].mean_linear().truncate()
+                });
+                m.emissive * tex
+            })
+            .collect();
+        let environment = resolve_environment(&src, opts, &mut w);
+        let camera_count = order.iter().filter(|&&n| nodes[n].camera.is_some()).count();
+        let mut scene = Scene {
+            path: path.to_path_buf(),
+            nodes,
+            roots,
+            order,
+            meshes,
+            materials,
+            material_emission,
+            textures: textures.textures,
+            images: textures.images,
+            lights,
+            light_instances,
+            instances,
+            camera: Camera::framing(&crate::math::Aabb::EMPTY),
+            camera_count,
+            animations,
+            environment,
+            animated,
+            dynamic,
+        };
+        scene.camera = select_camera(&src, &scene, opts, &mut w)?;
+        Ok((scene, w.list))
+    }
+}
+
+fn scene_roots(src: &Source, nodes: &[Node], w: &mut Warnings) -> Vec<usize> {
+    let chosen = src.doc.default_scene().or_else(|| src.doc.scenes().next());
+    match chosen {
+        Some(s) => s.nodes().map(|n| n.index()).collect(),
+        None => {
+            if !nodes.is_empty() {
+                let msg = format!("{}: no scene defined; using every parentless node as a root", src.path.display());
+                w.push(WarningKind::Other, 1, msg);
+            }
+            (0..nodes.len()).filter(|&i| nodes[i].parent.is_none()).collect()
+        }
+    }
+}
+
+fn resolve_environment(src: &Source, opts: &LoadOptions, w: &mut Warnings) -> Environment {
+    let chosen = src.doc.default_scene().or_else(|| src.doc.scenes().next());
+    let radiance = match chosen {
+        Some(s) => match scene_radiance(s.extras()) {
+            Ok(r) => r,
+            Err(e) => {
+                let msg = format!("{}: {}: extras.environment ignored: {e}", src.path.display(), label("scene", s.index(), s.name()));
+                w.push(WarningKind::Other, 1, msg);
+                None
+            }
+        },
+        None => None,
+    };
+    Environment::resolve(&opts.env, radiance)
+}
+
+/// Display name of a camera node: node name, else camera name, else `#<node>`.
+fn camera_name(node: &Node, index: usize, cam_name: Option<&str>) -> String {
+    node.name
+        .clone()
+        .or_else(|| cam_name.map(str::to_string))
+        .unwrap_or_else(|| format!("#{index}"))
+}
+
+fn select_camera(src: &Source, scene: &Scene, opts: &LoadOptions, w: &mut Warnings) -> Result<Camera> {
+    let defs = camera_defs(&src.doc);
+    let candidates: Vec<(usize, usize)> = scene
+        .order
+        .iter()
+        .filter_map(|&n| scene.nodes[n].camera.map(|c| (n, c)))
+        .filter(|&(_, c)| c < defs.len())
+        .collect();
+    let chosen = match &opts.camera_name {
+        Some(want) => {
+            let found = candidates.iter().find(|&&(n, c)| {
+                scene.nodes[n].name.as_deref() == Some(want.as_str()) || defs[c].0.as_deref() == Some(want.as_str())
+            });
+            match found {
+                Some(&f) => Some(f),
+                None => {
+                    return Err(Error::CameraNotFound {
+                        path: src.path(),
+                        name: want.clone(),
+                        available: candidates
+                            .iter()
+                            .map(|&(n, c)| camera_name(&scene.nodes[n], n, defs[c].0.as_deref()))
+                            .collect(),
+                    })
+                }
+            }
+        }
+        None => candidates.first().copied(),
+    };
+    let Some((node, cam)) = chosen else {
+        let msg = format!("{}: the scene has no camera; using a default camera framing the scene bounds", src.path.display());
+        w.push(WarningKind::DefaultCamera, 1, msg);
+        return Ok(Camera::framing(&scene.bounds_at(0.0)));
+    };
+    let element = format!("{} {}", scene.nodes[node].label(node), label("camera", cam, defs[cam].0.as_deref()));
+    match &defs[cam].1 {
+        CameraDef::Perspective(p) => Ok(Camera {
+            name: camera_name(&scene.nodes[node], node, defs[cam].0.as_deref()),
+            node: Some(node),
+            perspective: *p,
+            fixed_world_from_camera: glam::Mat4::IDENTITY,
+        }),
+        CameraDef::Orthographic => Err(Error::OrthographicCamera {
+            path: src.path(),
+            element,
+        }),
+        CameraDef::Invalid(reason) => Err(Error::Invalid {
+            path: src.path(),
+            element,
+            reason: reason.clone(),
+        }),
+    }
+}

@@ -1,0 +1,190 @@
+//! [`ScenePlan`]: what a scene needs from the renderer, derived once after loading.
+//!
+//! Later passes consult it instead of re-inspecting the scene: whether to build the emitter
+//! sampling table, which punctual light kinds exist, which environment is used, whether textures
+//! must be bound, and how the scene animates (nothing, camera only, lights only, or geometry —
+//! the latter needing TLAS refits) over which time range.
+
+use std::fmt;
+
+use crate::environment::Environment;
+use crate::light::LightKind;
+use crate::scene::Scene;
+
+/// Counts of punctual light instances by kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LightCounts {
+    /// Point lights.
+    pub point: usize,
+    /// Spot lights.
+    pub spot: usize,
+    /// Directional lights.
+    pub directional: usize,
+}
+
+impl LightCounts {
+    /// Total number of punctual light instances.
+    pub fn total(&self) -> usize {
+        self.point + self.spot + self.directional
+    }
+}
+
+/// Which environment the scene uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnvironmentKind {
+    /// No environment light.
+    None,
+    /// Uniform radiance.
+    Constant,
+    /// Equirectangular map.
+    Map,
+}
+
+/// How the scene changes over time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AnimationKind {
+    /// Nothing moves.
+    None,
+    /// Only the camera moves: geometry, lights and emitters are static.
+    CameraOnly,
+    /// Punctual lights move but no geometry does (the camera may move too).
+    LightsOnly,
+    /// At least one mesh instance moves (TLAS refit; emitters may move); others may move too.
+    Geometry,
+}
+
+/// The animation part of the plan.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AnimationPlan {
+    /// Classification.
+    pub kind: AnimationKind,
+    /// The selected camera moves.
+    pub camera: bool,
+    /// Some punctual light moves.
+    pub lights: bool,
+    /// Some mesh instance moves.
+    pub geometry: bool,
+    /// Key range `[t0, t1]` in seconds, when the file has animation channels.
+    pub time_range: Option<(f32, f32)>,
+}
+
+/// Rendering plan of a scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScenePlan {
+    /// Number of emissive triangles (world space at the start time).
+    pub emissive_triangles: usize,
+    /// Their total luminance-weighted power (W).
+    pub emissive_power: f32,
+    /// Punctual light instances by kind.
+    pub lights: LightCounts,
+    /// Environment kind.
+    pub environment: EnvironmentKind,
+    /// Number of textures used by materials.
+    pub textures: usize,
+    /// Animation summary.
+    pub animation: AnimationPlan,
+}
+
+impl ScenePlan {
+    /// Derives the plan of `scene`.
+    pub fn new(scene: &Scene) -> ScenePlan {
+        let time_range = scene.time_range();
+        let t0 = time_range.map_or(0.0, |r| r.0);
+        let emitters = scene.emitters_at(t0);
+        let mut lights = LightCounts::default();
+        for li in &scene.light_instances {
+            match scene.lights[li.light].kind {
+                LightKind::Point => lights.point += 1,
+                LightKind::Spot { .. } => lights.spot += 1,
+                LightKind::Directional => lights.directional += 1,
+            }
+        }
+        let camera = scene.camera.node.is_some_and(|n| scene.dynamic[n]);
+        let lights_moving = scene.light_instances.iter().any(|l| l.dynamic);
+        let geometry = scene.instances.iter().any(|i| i.dynamic);
+        let kind = if geometry {
+            AnimationKind::Geometry
+        } else if lights_moving {
+            AnimationKind::LightsOnly
+        } else if camera {
+            AnimationKind::CameraOnly
+        } else {
+            AnimationKind::None
+        };
+        ScenePlan {
+            emissive_triangles: emitters.triangles.len(),
+            emissive_power: emitters.total_power,
+            lights,
+            environment: match scene.environment {
+                Environment::None => EnvironmentKind::None,
+                Environment::Constant(_) => EnvironmentKind::Constant,
+                Environment::Map { .. } => EnvironmentKind::Map,
+            },
+            textures: scene.textures.len(),
+            animation: AnimationPlan {
+                kind,
+                camera,
+                lights: lights_moving,
+                geometry,
+                time_range,
+            },
+        }
+    }
+
+    /// The scene has emissive triangles.
+    pub fn has_emissive(&self) -> bool {
+        self.emissive_triangles > 0
+    }
+
+    /// The scene has punctual lights.
+    pub fn has_punctual_lights(&self) -> bool {
+        self.lights.total() > 0
+    }
+}
+
+impl Scene {
+    /// The scene's rendering plan.
+    pub fn plan(&self) -> ScenePlan {
+        ScenePlan::new(self)
+    }
+}
+
+impl fmt::Display for ScenePlan {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "plan:")?;
+        if self.has_emissive() {
+            writeln!(f, "  emissive triangles: {} (power {:.4} W)", self.emissive_triangles, self.emissive_power)?;
+        } else {
+            writeln!(f, "  emissive triangles: none")?;
+        }
+        let l = &self.lights;
+        if self.has_punctual_lights() {
+            writeln!(f, "  punctual lights: {} point, {} spot, {} directional", l.point, l.spot, l.directional)?;
+        } else {
+            writeln!(f, "  punctual lights: none")?;
+        }
+        let env = match self.environment {
+            EnvironmentKind::None => "none",
+            EnvironmentKind::Constant => "constant",
+            EnvironmentKind::Map => "map",
+        };
+        writeln!(f, "  environment: {env}")?;
+        writeln!(f, "  textures: {}", if self.textures > 0 { "yes" } else { "no" })?;
+        let a = &self.animation;
+        let kind = match a.kind {
+            AnimationKind::None => "none",
+            AnimationKind::CameraOnly => "camera only",
+            AnimationKind::LightsOnly => "lights only",
+            AnimationKind::Geometry => "geometry",
+        };
+        write!(f, "  animation: {kind}")?;
+        if a.kind != AnimationKind::None {
+            let yn = |b: bool| if b { "yes" } else { "no" };
+            write!(f, " (camera {}, lights {}, geometry {})", yn(a.camera), yn(a.lights), yn(a.geometry))?;
+        }
+        if let Some((t0, t1)) = a.time_range {
+            write!(f, ", time range [{t0:.3}, {t1:.3}] s")?;
+        }
+        writeln!(f)
+    }
+}

@@ -1,0 +1,261 @@
+//! Reading a glTF file and its external resources (buffers, images) without panicking.
+//!
+//! The gltf crate's `import` is not used: it indexes buffers with unchecked slices and unwraps
+//! percent-decoding, so a hostile file could panic it. Instead the JSON (or GLB) is parsed and
+//! validated by the gltf crate, then each buffer is resolved here (data URI, relative path, or the
+//! GLB `BIN` chunk) and checked against its `byteLength`. Images are decoded by the gltf crate only
+//! after their source has been checked.
+
+use std::path::{Path, PathBuf};
+
+use crate::base64;
+use crate::error::{label, Error, Result};
+
+/// A parsed and validated glTF document with its buffers loaded.
+#[derive(Debug)]
+pub(crate) struct Source {
+    /// The glTF file (used in every error message).
+    pub(crate) path: PathBuf,
+    /// Directory that relative URIs resolve against.
+    pub(crate) base: PathBuf,
+    /// The validated document.
+    pub(crate) doc: gltf::Document,
+    /// Buffer contents, index-aligned with `doc.buffers()`; each is at least `byteLength` long.
+    pub(crate) buffers: Vec<gltf::buffer::Data>,
+}
+
+impl Source {
+    /// Reads, parses and validates `path`, then loads all buffers.
+    pub(crate) fn open(path: &Path) -> Result<Self> {
+        let bytes = std::fs::read(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let parse_err = |e: gltf::Error| Error::Parse {
+            path: path.to_path_buf(),
+            message: describe_gltf_error(&e),
+        };
+        let gltf::Gltf { document, blob } =
+            gltf::Gltf::from_slice_without_validation(&bytes).map_err(parse_err)?;
+        let root = document.into_json();
+        for name in &root.extensions_required {
+            if !SUPPORTED_REQUIRED.contains(&name.as_str()) {
+                return Err(Error::UnsupportedExtension {
+                    path: path.to_path_buf(),
+                    name: name.clone(),
+                });
+            }
+        }
+        precheck(path, &root)?;
+        let doc = gltf::Document::from_json(root).map_err(parse_err)?;
+        let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let mut source = Source {
+            path: path.to_path_buf(),
+            base,
+            doc,
+            buffers: Vec::new(),
+        };
+        source.buffers = source.load_buffers(blob)?;
+        Ok(source)
+    }
+
+    fn load_buffers(&self, mut blob: Option<Vec<u8>>) -> Result<Vec<gltf::buffer::Data>> {
+        let mut out = Vec::new();
+        for buffer in self.doc.buffers() {
+            let element = label("buffer", buffer.index(), buffer.name());
+            let (uri, data) = match buffer.source() {
+                gltf::buffer::Source::Bin => ("<GLB BIN chunk>".to_string(), blob.take()),
+                gltf::buffer::Source::Uri(uri) => {
+                    let data = self.read_uri(uri).map_err(|reason| Error::MissingBuffer {
+                        path: self.path.clone(),
+                        element: element.clone(),
+                        uri: short_uri(uri),
+                        reason,
+                    })?;
+                    (short_uri(uri), Some(data))
+                }
+            };
+            let data = data.ok_or_else(|| Error::MissingBuffer {
+                path: self.path.clone(),
+                element: element.clone(),
+                uri,
+                reason: "no GLB BIN chunk (or it is used by an earlier buffer)".into(),
+            })?;
+            if data.len() < buffer.length() {
+                return Err(Error::ShortBuffer {
+                    path: self.path.clone(),
+                    element,
+                    expected: buffer.length(),
+                    actual: data.len(),
+                });
+            }
+            out.push(gltf::buffer::Data(data));
+        }
+        Ok(out)
+    }
+
+    /// Reads a buffer URI: `data:...;base64,...` or a relative (percent-encoded) file path.
+    fn read_uri(&self, uri: &str) -> std::result::Result<Vec<u8>, String> {
+        if let Some(rest) = uri.strip_prefix("data:") {
+            let (_, payload) = rest
+                .split_once(";base64,")
+                .ok_or_else(|| "data URI is not base64-encoded".to_string())?;
+            return base64::decode(payload).map_err(|e| format!("bad base64 data: {e}"));
+        }
+        let rel = relative_path(uri)?;
+        let file = self.base.join(rel);
+        std::fs::read(&file).map_err(|e| format!("{}: {e}", file.display()))
+    }
+
+    /// Decodes image `index` to pixels, checking its source first.
+    pub(crate) fn decode_image(&self, image: &gltf::Image<'_>) -> Result<gltf::image::Data> {
+        let element = label("image", image.index(), image.name());
+        let invalid = |reason: String| Error::Invalid {
+            path: self.path.clone(),
+            element: element.clone(),
+            reason,
+        };
+        // `Image::source` unwraps these two; check them on the JSON first.
+        let json = self.doc.as_json().images.get(image.index());
+        match json {
+            Some(j) if j.buffer_view.is_some() && j.mime_type.is_none() => {
+                return Err(invalid("an image in a buffer view needs a mimeType".into()));
+            }
+            Some(j) if j.buffer_view.is_none() && j.uri.is_none() => {
+                return Err(invalid("image has neither uri nor bufferView".into()));
+            }
+            Some(_) => {}
+            None => return Err(invalid("image does not exist".into())),
+        }
+        match image.source() {
+            gltf::image::Source::View { view, .. } => {
+                let len = self.buffers.get(view.buffer().index()).map_or(0, |b| b.0.len());
+                let end = view.offset().checked_add(view.length());
+                if end.is_none_or(|end| end > len) {
+                    return Err(invalid(format!(
+                        "buffer view {} (offset {}, length {}) exceeds buffer {} ({len} bytes)",
+                        view.index(),
+                        view.offset(),
+                        view.length(),
+                        view.buffer().index()
+                    )));
+                }
+            }
+            gltf::image::Source::Uri { uri, .. } => {
+                if !uri.starts_with("data:") {
+                    relative_path(uri).map_err(invalid)?;
+                }
+            }
+        }
+        gltf::image::Data::from_source(image.source(), Some(&self.base), &self.buffers)
+            .map_err(|e| invalid(format!("cannot decode: {}", describe_gltf_error(&e))))
+    }
+
+    /// The glTF file path as an owned value (for error construction).
+    pub(crate) fn path(&self) -> PathBuf {
+        self.path.clone()
+    }
+}
+
+/// Checks what the gltf crate's validation indexes without bounds checks (gltf-json 1.4's
+/// primitive hook reads `accessors[POSITION]` directly and would panic on a bad index).
+fn precheck(path: &Path, root: &gltf::json::Root) -> Result<()> {
+    use gltf::json::mesh::Semantic;
+    use gltf::json::validation::Checked;
+    for (mi, mesh) in root.meshes.iter().enumerate() {
+        for (pi, prim) in mesh.primitives.iter().enumerate() {
+            if let Some(index) = prim.attributes.get(&Checked::Valid(Semantic::Positions)) {
+                if index.value() >= root.accessors.len() {
+                    let element = label("mesh", mi, mesh.name.as_deref());
+                    return Err(Error::Parse {
+                        path: path.to_path_buf(),
+                        message: format!(
+                            "{element} primitive {pi}: POSITION accessor {} does not exist ({} accessors)",
+                            index.value(),
+                            root.accessors.len()
+                        ),
+                    });
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Required extensions this loader implements.
+const SUPPORTED_REQUIRED: &[&str] = &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+
+/// Turns a relative, percent-encoded URI into a path; rejects other URI schemes.
+fn relative_path(uri: &str) -> std::result::Result<PathBuf, String> {
+    if uri.contains(':') {
+        return Err("only data: and relative URIs are supported".into());
+    }
+    let bytes = percent_decode(uri);
+    let s = String::from_utf8(bytes).map_err(|_| "URI is not valid UTF-8".to_string())?;
+    Ok(PathBuf::from(s))
+}
+
+/// Decodes `%XX` escapes; malformed escapes are kept literally.
+fn percent_decode(s: &str) -> Vec<u8> {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%' && i + 2 < b.len() {
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    out
+}
+
+/// Shortens data URIs for messages.
+fn short_uri(uri: &str) -> String {
+    if uri.len() > 64 {
+        let cut = (0..=48).rev().find(|&i| uri.is_char_boundary(i)).unwrap_or(0);
+        format!("{}...", &uri[..cut])
+    } else {
+        uri.to_string()
+    }
+}
+
+/// A readable message for a gltf crate error (validation errors list each JSON path).
+pub(crate) fn describe_gltf_error(e: &gltf::Error) -> String {
+    match e {
+        gltf::Error::Validation(list) => {
+            let items: Vec<String> = list
+                .iter()
+                .take(8)
+                .map(|(p, err)| format!("{p}: {err}"))
+                .collect();
+            let more = list.len().saturating_sub(8);
+            let suffix = if more > 0 {
+                format!(" (and {more} more)")
+            } else {
+                String::new()
+            };
+            format!("validation failed: {}{suffix}", items.join("; "))
+        }
+        other => other.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percent_decoding() {
+        assert_eq!(percent_decode("a%20b.bin"), b"a b.bin");
+        assert_eq!(percent_decode("100%"), b"100%");
+        assert_eq!(percent_decode("%zz%4"), b"%zz%4");
+        assert!(relative_path("%FF").is_err());
+        assert!(relative_path("http://x/y.bin").is_err());
+    }
+}

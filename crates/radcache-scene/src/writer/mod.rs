@@ -1,0 +1,485 @@
+//! A small builder that writes valid glTF 2.0 (checked with the Khronos validator).
+//!
+//! Add materials, meshes, cameras, punctual lights, nodes, animations, textures and scenes (each
+//! `add_*` returns the glTF index), then [`GltfBuilder::write`] a `.gltf` with either an external
+//! `.bin` next to it or an embedded base64 data URI ([`BufferLayout`]). Every accessor gets its own
+//! 4-byte-aligned buffer view; float accessors carry `min`/`max`. Emission is given as radiance and
+//! split into `emissiveFactor` × `KHR_materials_emissive_strength` when it exceeds 1. The JSON is
+//! written with serde_json; [`GltfBuilder::to_json`] exposes it so tests can mutate it.
+
+mod png;
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+use serde_json::{json, Map, Value};
+
+use crate::animation::{Interpolation, Property};
+use crate::error::{Error, Result};
+use crate::light::LightKind;
+
+/// Where the binary buffer goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BufferLayout {
+    /// `<stem>.bin` next to the `.gltf`.
+    External,
+    /// A `data:application/octet-stream;base64,` URI inside the JSON.
+    Embedded,
+}
+
+/// Index component type of a primitive.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum IndexFormat {
+    /// The smallest of u16/u32 that fits (u8 is allowed by glTF but discouraged by the validator).
+    #[default]
+    Auto,
+    /// Unsigned byte.
+    U8,
+    /// Unsigned short.
+    U16,
+    /// Unsigned int.
+    U32,
+}
+
+/// A metallic-roughness material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialDesc {
+    /// Name.
+    pub name: String,
+    /// Linear base colour factor.
+    pub base_color: [f32; 4],
+    /// Metallic factor.
+    pub metallic: f32,
+    /// Roughness factor.
+    pub roughness: f32,
+    /// Emitted radiance W/(sr·m²) (split into factor × strength on write).
+    pub emissive: [f32; 3],
+    /// Double-sided flag.
+    pub double_sided: bool,
+    /// Base colour texture index (from [`GltfBuilder::add_texture_rgba8`]).
+    pub base_color_texture: Option<usize>,
+    /// Emissive texture index.
+    pub emissive_texture: Option<usize>,
+    /// `alphaMode` other than OPAQUE (e.g. `"BLEND"`), for tests.
+    pub alpha_mode: Option<String>,
+}
+
+impl MaterialDesc {
+    /// A diffuse (metallic 0, roughness 1) material of linear albedo `rgb`.
+    pub fn diffuse(name: &str, rgb: [f32; 3]) -> MaterialDesc {
+        MaterialDesc {
+            name: name.into(),
+            base_color: [rgb[0], rgb[1], rgb[2], 1.0],
+            metallic: 0.0,
+            roughness: 1.0,
+            emissive: [0.0; 3],
+            double_sided: false,
+            base_color_texture: None,
+            emissive_texture: None,
+            alpha_mode: None,
+        }
+    }
+
+    /// A diffuse material that also emits `radiance`.
+    pub fn emitter(name: &str, rgb: [f32; 3], radiance: [f32; 3]) -> MaterialDesc {
+        MaterialDesc {
+            emissive: radiance,
+            ..MaterialDesc::diffuse(name, rgb)
+        }
+    }
+}
+
+/// One primitive of a mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrimitiveDesc {
+    /// Vertex positions.
+    pub positions: Vec<[f32; 3]>,
+    /// Unit normals (optional).
+    pub normals: Option<Vec<[f32; 3]>>,
+    /// TEXCOORD_0 (optional).
+    pub texcoords: Option<Vec<[f32; 2]>>,
+    /// Indices (optional: non-indexed).
+    pub indices: Option<Vec<u32>>,
+    /// Index component type.
+    pub index_format: IndexFormat,
+    /// Material index.
+    pub material: Option<usize>,
+    /// Primitive mode (4 = TRIANGLES).
+    pub mode: u32,
+}
+
+impl PrimitiveDesc {
+    /// An indexed triangle primitive.
+    pub fn triangles(positions: Vec<[f32; 3]>, normals: Option<Vec<[f32; 3]>>, indices: Vec<u32>, material: Option<usize>) -> PrimitiveDesc {
+        PrimitiveDesc {
+            positions,
+            normals,
+            texcoords: None,
+            indices: Some(indices),
+            index_format: IndexFormat::Auto,
+            material,
+            mode: 4,
+        }
+    }
+}
+
+/// A node.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NodeDesc {
+    /// Name.
+    pub name: Option<String>,
+    /// Translation.
+    pub translation: Option<[f32; 3]>,
+    /// Rotation quaternion (x, y, z, w).
+    pub rotation: Option<[f32; 4]>,
+    /// Scale.
+    pub scale: Option<[f32; 3]>,
+    /// Column-major matrix (instead of TRS).
+    pub matrix: Option<[f32; 16]>,
+    /// Mesh index.
+    pub mesh: Option<usize>,
+    /// Camera index.
+    pub camera: Option<usize>,
+    /// Punctual light index.
+    pub light: Option<usize>,
+    /// Child node indices.
+    pub children: Vec<usize>,
+}
+
+/// A punctual light.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightDesc {
+    /// Name.
+    pub name: Option<String>,
+    /// Kind (and spot cone angles).
+    pub kind: LightKind,
+    /// Linear colour.
+    pub color: [f32; 3],
+    /// Candela (point/spot) or lux (directional).
+    pub intensity: f32,
+    /// Range (m).
+    pub range: Option<f32>,
+}
+
+/// One animation channel (its sampler is written alongside).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChannelDesc {
+    /// Target node.
+    pub node: usize,
+    /// Target property.
+    pub property: Property,
+    /// Interpolation.
+    pub interpolation: Interpolation,
+    /// Key times (s).
+    pub times: Vec<f32>,
+    /// Flat output values: 3 or 4 per element; CUBICSPLINE has 3 elements per key (in, value, out).
+    pub values: Vec<f32>,
+}
+
+/// Builds a glTF document; see the module docs.
+#[derive(Clone, Debug, Default)]
+pub struct GltfBuilder {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+    materials: Vec<Value>,
+    meshes: Vec<Value>,
+    nodes: Vec<Value>,
+    cameras: Vec<Value>,
+    lights: Vec<Value>,
+    animations: Vec<Value>,
+    scenes: Vec<Value>,
+    images: Vec<Value>,
+    textures: Vec<Value>,
+    samplers: Vec<Value>,
+    extensions_used: BTreeSet<String>,
+}
+
+/// A JSON number from an f32, written in its shortest round-tripping decimal form.
+fn num(x: f32) -> Value {
+    let shortest: f64 = format!("{x}").parse().unwrap_or(f64::from(x));
+    serde_json::Number::from_f64(shortest).map_or(Value::Null, Value::Number)
+}
+
+fn nums(xs: &[f32]) -> Value {
+    Value::Array(xs.iter().map(|&x| num(x)).collect())
+}
+
+fn push(list: &mut Vec<Value>, v: Value) -> usize {
+    list.push(v);
+    list.len() - 1
+}
+
+impl GltfBuilder {
+    /// An empty document.
+    pub fn new() -> GltfBuilder {
+        GltfBuilder::default()
+    }
+
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
+        if let Some(t) = target {
+            v["target"] = json!(t);
+        }
+        self.bin.extend_from_slice(bytes);
+        push(&mut self.views, v)
+    }
+
+    /// Adds a float accessor of `comps` components (with min/max); returns its index.
+    pub fn add_float_accessor(&mut self, data: &[f32], comps: usize, target: Option<u32>) -> usize {
+        let bytes: Vec<u8> = data.iter().flat_map(|x| x.to_le_bytes()).collect();
+        let view = self.view(&bytes, target);
+        let count = data.len() / comps.max(1);
+        let mut min = vec![f32::INFINITY; comps];
+        let mut max = vec![f32::NEG_INFINITY; comps];
+        for e in data.chunks_exact(comps) {
+            for c in 0..comps {
+                min[c] = min[c].min(e[c]);
+                max[c] = max[c].max(e[c]);
+            }
+        }
+        let ty = ["SCALAR", "VEC2", "VEC3", "VEC4"][comps.clamp(1, 4) - 1];
+        let mut a = json!({"bufferView": view, "componentType": 5126, "count": count, "type": ty});
+        if count > 0 && min.iter().chain(&max).all(|x| x.is_finite()) {
+            a["min"] = nums(&min);
+            a["max"] = nums(&max);
+        }
+        push(&mut self.accessors, a)
+    }
+
+    fn add_index_accessor(&mut self, indices: &[u32], format: IndexFormat) -> usize {
+        let max = indices.iter().copied().max().unwrap_or(0);
+        let format = match format {
+            IndexFormat::Auto if max < 65_535 => IndexFormat::U16,
+            IndexFormat::Auto => IndexFormat::U32,
+            f => f,
+        };
+        let (bytes, ct): (Vec<u8>, u32) = match format {
+            IndexFormat::U8 => (indices.iter().map(|&i| i as u8).collect(), 5121),
+            IndexFormat::U16 => (indices.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect(), 5123),
+            _ => (indices.iter().flat_map(|&i| i.to_le_bytes()).collect(), 5125),
+        };
+        let view = self.view(&bytes, Some(34963));
+        push(&mut self.accessors, json!({"bufferView": view, "componentType": ct, "count": indices.len(), "type": "SCALAR"}))
+    }
+
+    /// Adds a material; returns its index.
+    pub fn add_material(&mut self, m: &MaterialDesc) -> usize {
+        let mut pbr = json!({"baseColorFactor": nums(&m.base_color), "metallicFactor": num(m.metallic), "roughnessFactor": num(m.roughness)});
+        if let Some(t) = m.base_color_texture {
+            pbr["baseColorTexture"] = json!({"index": t});
+        }
+        let mut v = json!({"name": m.name, "pbrMetallicRoughness": pbr});
+        let peak = m.emissive.iter().copied().fold(0.0f32, f32::max);
+        if peak > 0.0 {
+            let strength = peak.max(1.0);
+            v["emissiveFactor"] = nums(&m.emissive.map(|e| e / strength));
+            if strength > 1.0 {
+                v["extensions"] = json!({"KHR_materials_emissive_strength": {"emissiveStrength": num(strength)}});
+                self.extensions_used.insert("KHR_materials_emissive_strength".into());
+            }
+        }
+        if let Some(t) = m.emissive_texture {
+            v["emissiveTexture"] = json!({"index": t});
+        }
+        if m.double_sided {
+            v["doubleSided"] = json!(true);
+        }
+        if let Some(mode) = &m.alpha_mode {
+            v["alphaMode"] = json!(mode);
+        }
+        push(&mut self.materials, v)
+    }
+
+    /// Adds a mesh with the given primitives; returns its index.
+    pub fn add_mesh(&mut self, name: &str, prims: &[PrimitiveDesc]) -> usize {
+        let mut out = Vec::new();
+        for p in prims {
+            let flat: Vec<f32> = p.positions.iter().flatten().copied().collect();
+            let mut attrs = Map::new();
+            attrs.insert("POSITION".into(), json!(self.add_float_accessor(&flat, 3, Some(34962))));
+            if let Some(n) = &p.normals {
+                let flat: Vec<f32> = n.iter().flatten().copied().collect();
+                attrs.insert("NORMAL".into(), json!(self.add_float_accessor(&flat, 3, Some(34962))));
+            }
+            if let Some(t) = &p.texcoords {
+                let flat: Vec<f32> = t.iter().flatten().copied().collect();
+                attrs.insert("TEXCOORD_0".into(), json!(self.add_float_accessor(&flat, 2, Some(34962))));
+            }
+            let mut prim = json!({"attributes": attrs});
+            if let Some(i) = &p.indices {
+                prim["indices"] = json!(self.add_index_accessor(i, p.index_format));
+            }
+            if let Some(m) = p.material {
+                prim["material"] = json!(m);
+            }
+            if p.mode != 4 {
+                prim["mode"] = json!(p.mode);
+            }
+            out.push(prim);
+        }
+        push(&mut self.meshes, json!({"name": name, "primitives": out}))
+    }
+
+    /// Adds a perspective camera; returns its index.
+    pub fn add_perspective_camera(&mut self, name: &str, yfov: f32, aspect: Option<f32>, znear: f32, zfar: Option<f32>) -> usize {
+        let mut p = json!({"yfov": num(yfov), "znear": num(znear)});
+        if let Some(a) = aspect {
+            p["aspectRatio"] = num(a);
+        }
+        if let Some(f) = zfar {
+            p["zfar"] = num(f);
+        }
+        push(&mut self.cameras, json!({"name": name, "type": "perspective", "perspective": p}))
+    }
+
+    /// Adds an orthographic camera (for tests; the loader rejects it); returns its index.
+    pub fn add_orthographic_camera(&mut self, name: &str, xmag: f32, ymag: f32) -> usize {
+        let o = json!({"xmag": num(xmag), "ymag": num(ymag), "znear": 0.01, "zfar": 100.0});
+        push(&mut self.cameras, json!({"name": name, "type": "orthographic", "orthographic": o}))
+    }
+
+    /// Adds a KHR_lights_punctual light; returns its index.
+    pub fn add_light(&mut self, l: &LightDesc) -> usize {
+        self.extensions_used.insert("KHR_lights_punctual".into());
+        let mut v = json!({"color": nums(&l.color), "intensity": num(l.intensity)});
+        v["type"] = json!(match l.kind {
+            LightKind::Point => "point",
+            LightKind::Spot { .. } => "spot",
+            LightKind::Directional => "directional",
+        });
+        if let LightKind::Spot { inner_cone_angle, outer_cone_angle } = l.kind {
+            v["spot"] = json!({"innerConeAngle": num(inner_cone_angle), "outerConeAngle": num(outer_cone_angle)});
+        }
+        if let Some(r) = l.range {
+            v["range"] = num(r);
+        }
+        if let Some(n) = &l.name {
+            v["name"] = json!(n);
+        }
+        push(&mut self.lights, v)
+    }
+
+    /// Adds a node; returns its index.
+    pub fn add_node(&mut self, n: &NodeDesc) -> usize {
+        let mut v = json!({});
+        if let Some(s) = &n.name {
+            v["name"] = json!(s);
+        }
+        for (key, val) in [("translation", n.translation.map(|x| nums(&x))), ("rotation", n.rotation.map(|x| nums(&x))), ("scale", n.scale.map(|x| nums(&x))), ("matrix", n.matrix.map(|x| nums(&x)))] {
+            if let Some(val) = val {
+                v[key] = val;
+            }
+        }
+        for (key, val) in [("mesh", n.mesh), ("camera", n.camera)] {
+            if let Some(val) = val {
+                v[key] = json!(val);
+            }
+        }
+        if let Some(l) = n.light {
+            v["extensions"] = json!({"KHR_lights_punctual": {"light": l}});
+        }
+        if !n.children.is_empty() {
+            v["children"] = json!(n.children);
+        }
+        push(&mut self.nodes, v)
+    }
+
+    /// Adds an animation, one sampler per channel; returns its index.
+    pub fn add_animation(&mut self, name: &str, channels: &[ChannelDesc]) -> usize {
+        let (mut chans, mut samplers) = (Vec::new(), Vec::new());
+        for (i, c) in channels.iter().enumerate() {
+            let comps = if c.property == Property::Rotation { 4 } else { 3 };
+            let input = self.add_float_accessor(&c.times, 1, None);
+            let output = self.add_float_accessor(&c.values, comps, None);
+            let interp = match c.interpolation {
+                Interpolation::Linear => "LINEAR",
+                Interpolation::Step => "STEP",
+                Interpolation::CubicSpline => "CUBICSPLINE",
+            };
+            let path = match c.property {
+                Property::Translation => "translation",
+                Property::Rotation => "rotation",
+                Property::Scale => "scale",
+            };
+            samplers.push(json!({"input": input, "output": output, "interpolation": interp}));
+            chans.push(json!({"sampler": i, "target": {"node": c.node, "path": path}}));
+        }
+        push(&mut self.animations, json!({"name": name, "channels": chans, "samplers": samplers}))
+    }
+
+    /// Adds an RGBA8 image (embedded PNG) and a texture using it; returns the texture index.
+    /// `wrap` is the glTF wrap mode for both axes (10497 REPEAT, 33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT).
+    pub fn add_texture_rgba8(&mut self, width: u32, height: u32, rgba: &[u8], wrap: u32) -> Option<usize> {
+        let png = png::encode_rgba8(width, height, rgba)?;
+        let view = self.view(&png, None);
+        let image = push(&mut self.images, json!({"bufferView": view, "mimeType": "image/png"}));
+        let sampler = push(&mut self.samplers, json!({"wrapS": wrap, "wrapT": wrap}));
+        Some(push(&mut self.textures, json!({"source": image, "sampler": sampler})))
+    }
+
+    /// Adds a scene with `roots` and optional `extras`; the first scene is the default one.
+    pub fn add_scene(&mut self, name: &str, roots: &[usize], extras: Option<Value>) -> usize {
+        let mut v = json!({"name": name, "nodes": roots});
+        if let Some(e) = extras {
+            v["extras"] = e;
+        }
+        push(&mut self.scenes, v)
+    }
+
+    /// The glTF JSON and the binary buffer. `bin_uri` is the buffer's URI, or `None` to embed it.
+    pub fn to_json(&self, bin_uri: Option<&str>) -> (Value, Vec<u8>) {
+        let mut root = json!({"asset": {"version": "2.0", "generator": "radcache-scene writer"}});
+        if !self.bin.is_empty() {
+            let uri = match bin_uri {
+                Some(u) => u.to_string(),
+                None => format!("data:application/octet-stream;base64,{}", crate::base64::encode(&self.bin)),
+            };
+            root["buffers"] = json!([{"byteLength": self.bin.len(), "uri": uri}]);
+        }
+        let lists = [("bufferViews", &self.views), ("accessors", &self.accessors), ("materials", &self.materials), ("meshes", &self.meshes), ("nodes", &self.nodes), ("cameras", &self.cameras), ("animations", &self.animations), ("scenes", &self.scenes), ("images", &self.images), ("textures", &self.textures), ("samplers", &self.samplers)];
+        for (key, list) in lists {
+            if !list.is_empty() {
+                root[key] = Value::Array(list.clone());
+            }
+        }
+        if !self.scenes.is_empty() {
+            root["scene"] = json!(0);
+        }
+        if !self.lights.is_empty() {
+            root["extensions"] = json!({"KHR_lights_punctual": {"lights": self.lights}});
+        }
+        if !self.extensions_used.is_empty() {
+            root["extensionsUsed"] = json!(self.extensions_used);
+        }
+        (root, self.bin.clone())
+    }
+
+    /// Writes `path` (a `.gltf`), plus `<stem>.bin` next to it for [`BufferLayout::External`].
+    pub fn write(&self, path: &Path, layout: BufferLayout) -> Result<()> {
+        let bin_name = format!("{}.bin", path.file_stem().and_then(|s| s.to_str()).unwrap_or("buffer"));
+        let (root, bin) = self.to_json((layout == BufferLayout::External).then_some(bin_name.as_str()));
+        write_files(path, &root, (layout == BufferLayout::External).then_some((&bin_name, &bin)))
+    }
+}
+
+/// Writes a glTF JSON value (pretty-printed) and optionally a binary file next to it.
+pub fn write_files(path: &Path, root: &Value, bin: Option<(&str, &[u8])>) -> Result<()> {
+    let io = |p: &Path| {
+        let p = p.to_path_buf();
+        move |source| Error::Write { path: p, source }
+    };
+    let text = serde_json::to_string_pretty(root).map_err(|e| Error::Write {
+        path: path.to_path_buf(),
+        source: std::io::Error::other(e),
+    })?;
+    std::fs::write(path, text + "\n").map_err(io(path))?;
+    if let Some((name, data)) = bin {
+        let bin_path = path.with_file_name(name);
+        std::fs::write(&bin_path, data).map_err(io(&bin_path))?;
+    }
+    Ok(())
+}

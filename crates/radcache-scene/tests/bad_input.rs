@@ -1,0 +1,219 @@
+//! Each class of bad input gives its specific error (or warning), naming file and element.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{temp_dir, triangle_scene, warnings_of, write};
+use radcache_scene::writer::{write_files, GltfBuilder, IndexFormat, NodeDesc};
+use radcache_scene::{Error, LoadOptions, Scene, WarningKind};
+use serde_json::{json, Value};
+
+/// Writes the triangle scene, lets `f` edit its JSON, and returns the `.gltf` path.
+fn mutated(tag: &str, f: impl FnOnce(&mut Value)) -> PathBuf {
+    let dir = temp_dir(tag);
+    let b = triangle_scene(None, |_| {});
+    let (mut root, bin) = b.to_json(Some("t.bin"));
+    f(&mut root);
+    let path = dir.join("t.gltf");
+    write_files(&path, &root, Some(("t.bin", &bin))).unwrap();
+    path
+}
+
+fn load_err(path: &Path) -> Error {
+    match Scene::load(path, &LoadOptions::default()) {
+        Ok(_) => panic!("{} loaded but should fail", path.display()),
+        Err(e) => e,
+    }
+}
+
+#[track_caller]
+fn assert_mentions(e: &Error, needles: &[&str]) {
+    let text = e.to_string();
+    for n in needles {
+        assert!(text.contains(n), "error {text:?} lacks {n:?}");
+    }
+}
+
+#[test]
+fn missing_file() {
+    let path = temp_dir("missing").join("nope.gltf");
+    let e = load_err(&path);
+    assert!(matches!(e, Error::Io { .. }), "{e:?}");
+    assert_mentions(&e, &["nope.gltf"]);
+}
+
+#[test]
+fn invalid_json() {
+    let path = temp_dir("json").join("bad.gltf");
+    std::fs::write(&path, "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [").unwrap();
+    let e = load_err(&path);
+    assert!(matches!(e, Error::Parse { .. }), "{e:?}");
+    assert_mentions(&e, &["bad.gltf", "invalid glTF"]);
+    // Valid JSON that fails schema validation (bad index).
+    let path = mutated("schema", |r| r["scenes"][0]["nodes"] = json!([7]));
+    assert!(matches!(load_err(&path), Error::Parse { .. }));
+}
+
+#[test]
+fn missing_buffer_file() {
+    let path = mutated("nobin", |_| {});
+    std::fs::remove_file(path.with_file_name("t.bin")).unwrap();
+    let e = load_err(&path);
+    assert!(matches!(e, Error::MissingBuffer { .. }), "{e:?}");
+    assert_mentions(&e, &["t.gltf", "buffer 0", "t.bin"]);
+}
+
+#[test]
+fn short_buffer() {
+    let path = mutated("short", |_| {});
+    let bin = path.with_file_name("t.bin");
+    let data = std::fs::read(&bin).unwrap();
+    std::fs::write(&bin, &data[..data.len() / 2]).unwrap();
+    let e = load_err(&path);
+    assert!(matches!(e, Error::ShortBuffer { .. }), "{e:?}");
+    assert_mentions(&e, &["buffer 0", "byteLength"]);
+}
+
+#[test]
+fn accessor_out_of_range() {
+    let path = mutated("acc", |r| r["accessors"][0]["count"] = json!(1000));
+    let e = load_err(&path);
+    assert!(matches!(e, Error::Accessor { .. }), "{e:?}");
+    assert_mentions(&e, &["mesh 0 \"tri\" primitive 0 POSITION accessor 0", "exceed"]);
+    let path = mutated("acc-offset", |r| r["accessors"][1]["byteOffset"] = json!(4));
+    assert_mentions(&load_err(&path), &["NORMAL accessor 1"]);
+    let path = mutated("view", |r| r["bufferViews"][0]["byteLength"] = json!(100_000));
+    let e = load_err(&path);
+    assert!(matches!(e, Error::Accessor { .. }), "{e:?}");
+    assert_mentions(&e, &["buffer view 0", "exceeds buffer 0"]);
+    let path = mutated("type", |r| r["accessors"][0]["type"] = json!("VEC2"));
+    assert_mentions(&load_err(&path), &["POSITION accessor 0", "expected 3 components"]);
+}
+
+#[test]
+fn index_out_of_range() {
+    let b = triangle_scene(None, |p| p.indices = Some(vec![0, 1, 5]));
+    let e = load_err(&write(&b, &temp_dir("idx"), "i"));
+    assert!(matches!(e, Error::IndexOutOfRange { index: 5, vertex_count: 3, .. }), "{e:?}");
+    assert_mentions(&e, &["mesh 0 \"tri\" primitive 0 indices accessor"]);
+}
+
+#[test]
+fn non_finite_positions() {
+    for (tag, bad) in [("nan", f32::NAN), ("inf", f32::INFINITY)] {
+        // POSITION is the first buffer view; vertex 1's z is at byte 20. (min/max stay valid.)
+        let path = mutated(tag, |_| {});
+        let bin_path = path.with_file_name("t.bin");
+        let mut bin = std::fs::read(&bin_path).unwrap();
+        bin[20..24].copy_from_slice(&bad.to_le_bytes());
+        std::fs::write(&bin_path, bin).unwrap();
+        let e = load_err(&path);
+        assert!(matches!(e, Error::NonFinite { position: 1, .. }), "{e:?}");
+        assert_mentions(&e, &["mesh 0 \"tri\" primitive 0 POSITION accessor 0"]);
+    }
+}
+
+#[test]
+fn degenerate_triangles_warn_with_count() {
+    let b = triangle_scene(None, |p| {
+        p.positions.push([2.0, 0.0, 0.0]);
+        p.normals = None;
+        // good, repeated index, collinear (0, 1, 3 on the x axis)
+        p.indices = Some(vec![0, 1, 2, 0, 0, 1, 0, 1, 3]);
+    });
+    let (s, w) = common::load(&write(&b, &temp_dir("degen"), "d"));
+    assert_eq!(warnings_of(&w, WarningKind::DegenerateTriangles), (1, 2));
+    assert!(w.iter().any(|w| w.message.contains("dropped 2 degenerate") && w.message.contains("mesh 0 \"tri\" primitive 0")));
+    assert_eq!(s.triangle_count(), 1);
+}
+
+#[test]
+fn unsupported_required_extension() {
+    let path = mutated("ext", |r| {
+        r["extensionsUsed"] = json!(["EXT_made_up"]);
+        r["extensionsRequired"] = json!(["EXT_made_up"]);
+    });
+    let e = load_err(&path);
+    assert!(matches!(&e, Error::UnsupportedExtension { name, .. } if name == "EXT_made_up"), "{e:?}");
+    // Supported required extensions are fine.
+    let path = mutated("ext-ok", |r| {
+        r["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+        r["extensionsRequired"] = json!(["KHR_lights_punctual"]);
+    });
+    assert!(Scene::load(&path, &LoadOptions::default()).is_ok());
+}
+
+#[test]
+fn orthographic_camera() {
+    let mut b = GltfBuilder::new();
+    let cam = b.add_orthographic_camera("ortho", 1.0, 1.0);
+    let node = b.add_node(&NodeDesc {
+        camera: Some(cam),
+        ..NodeDesc::default()
+    });
+    b.add_scene("s", &[node], None);
+    let e = load_err(&write(&b, &temp_dir("ortho"), "o"));
+    assert!(matches!(e, Error::OrthographicCamera { .. }), "{e:?}");
+    assert_mentions(&e, &["orthographic cameras are not supported yet", "camera 0 \"ortho\""]);
+}
+
+#[test]
+fn unknown_camera_name_lists_the_available_ones() {
+    let path = mutated("camname", |_| {});
+    let opts = LoadOptions {
+        camera_name: Some("nope".into()),
+        ..LoadOptions::default()
+    };
+    let e = Scene::load(&path, &opts).unwrap_err();
+    assert!(matches!(&e, Error::CameraNotFound { available, .. } if available == &["cam".to_string()]), "{e:?}");
+    assert_mentions(&e, &["\"nope\"", "\"cam\""]);
+}
+
+#[test]
+fn hierarchy_errors() {
+    let path = mutated("twoparents", |r| {
+        r["nodes"][1]["children"] = json!([0]);
+        r["nodes"].as_array_mut().unwrap().push(json!({"children": [0]}));
+    });
+    assert_mentions(&load_err(&path), &["node 0 \"tri\"", "two parents"]);
+    let path = mutated("selfchild", |r| r["nodes"][0]["children"] = json!([0]));
+    assert_mentions(&load_err(&path), &["node 0 \"tri\"", "its own child"]);
+    let path = mutated("rootchild", |r| r["nodes"][1]["children"] = json!([0]));
+    assert_mentions(&load_err(&path), &["scene root but also a child"]);
+}
+
+#[test]
+fn bad_animation_data() {
+    let dir = temp_dir("anim-bad");
+    let mut b = triangle_scene(None, |_| {});
+    b.add_animation(
+        "a",
+        &[radcache_scene::writer::ChannelDesc {
+            node: 0,
+            property: radcache_scene::Property::Translation,
+            interpolation: radcache_scene::Interpolation::Linear,
+            times: vec![0.0, 1.0, 1.0],
+            values: vec![0.0; 9],
+        }],
+    );
+    let e = load_err(&write(&b, &dir, "a"));
+    assert_mentions(&e, &["animation 0 \"a\" channel 0 sampler 0 input", "strictly increasing"]);
+    let (mut root, bin) = b.to_json(Some("a.bin"));
+    root["animations"][0]["samplers"][0]["interpolation"] = json!("CUBICSPLINE");
+    let path = dir.join("c.gltf");
+    write_files(&path, &root, Some(("a.bin", &bin))).unwrap();
+    assert!(matches!(load_err(&path), Error::Invalid { .. }));
+}
+
+#[test]
+fn index_formats_and_non_indexed_primitives_load() {
+    for format in [IndexFormat::U8, IndexFormat::U16, IndexFormat::U32] {
+        let b = triangle_scene(None, |p| p.index_format = format);
+        let (s, _) = common::load(&write(&b, &temp_dir("fmt"), "f"));
+        assert_eq!(s.meshes[0].indices, vec![0, 1, 2]);
+    }
+    let b = triangle_scene(None, |p| p.indices = None);
+    let (s, _) = common::load(&write(&b, &temp_dir("noidx"), "f"));
+    assert_eq!(s.triangle_count(), 1);
+}

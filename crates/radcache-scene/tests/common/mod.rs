@@ -1,0 +1,81 @@
+//! Shared helpers of the integration tests: temporary directories, loading, small scenes.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use radcache_scene::writer::{BufferLayout, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
+use radcache_scene::{LoadOptions, Scene, Warning, WarningKind};
+
+static COUNTER: AtomicUsize = AtomicUsize::new(0);
+
+/// A fresh, empty directory under the system temp dir.
+pub fn temp_dir(tag: &str) -> PathBuf {
+    let n = COUNTER.fetch_add(1, Ordering::SeqCst);
+    let dir = std::env::temp_dir().join(format!("radcache-scene-{tag}-{}-{n}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Loads with default options, panicking with the error message on failure.
+pub fn load(path: &Path) -> (Scene, Vec<Warning>) {
+    match Scene::load(path, &LoadOptions::default()) {
+        Ok(r) => r,
+        Err(e) => panic!("loading {} failed: {e}", path.display()),
+    }
+}
+
+/// Number of warnings of `kind`, and the sum of their counts.
+pub fn warnings_of(warnings: &[Warning], kind: WarningKind) -> (usize, usize) {
+    let w: Vec<&Warning> = warnings.iter().filter(|w| w.kind == kind).collect();
+    (w.len(), w.iter().map(|w| w.count).sum())
+}
+
+/// Writes `b` as `dir/name.gltf` (+ `.bin`) and returns the path.
+pub fn write(b: &GltfBuilder, dir: &Path, name: &str) -> PathBuf {
+    let path = dir.join(format!("{name}.gltf"));
+    b.write(&path, BufferLayout::External).unwrap();
+    path
+}
+
+/// A unit right triangle in the XY plane (normal +Z) and a camera at z = 2, as a builder
+/// whose single primitive can be customised by `f`.
+pub fn triangle_scene(material: Option<MaterialDesc>, f: impl FnOnce(&mut PrimitiveDesc)) -> GltfBuilder {
+    let mut b = GltfBuilder::new();
+    let mat = material.map(|m| b.add_material(&m));
+    let mut prim = PrimitiveDesc::triangles(
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        Some(vec![[0.0, 0.0, 1.0]; 3]),
+        vec![0, 1, 2],
+        mat,
+    );
+    f(&mut prim);
+    let mesh = b.add_mesh("tri", &[prim]);
+    let node = b.add_node(&NodeDesc {
+        name: Some("tri".into()),
+        mesh: Some(mesh),
+        ..NodeDesc::default()
+    });
+    let cam = b.add_perspective_camera("cam", 1.0, None, 0.1, None);
+    let cam_node = b.add_node(&NodeDesc {
+        name: Some("cam".into()),
+        translation: Some([0.0, 0.0, 2.0]),
+        camera: Some(cam),
+        ..NodeDesc::default()
+    });
+    b.add_scene("s", &[node, cam_node], None);
+    b
+}
+
+/// Asserts two floats are within `tol`.
+#[track_caller]
+pub fn close(a: f32, b: f32, tol: f32) {
+    assert!((a - b).abs() <= tol, "{a} != {b} (tol {tol})");
+}
+
+/// Asserts two vectors are within `tol` (Euclidean).
+#[track_caller]
+pub fn close3(a: glam::Vec3, b: glam::Vec3, tol: f32) {
+    assert!((a - b).length() <= tol, "{a} != {b} (tol {tol})");
+}

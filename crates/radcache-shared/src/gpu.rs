@@ -1,0 +1,194 @@
+//! The plain-data structs that cross into GLSL. Rust is the source of truth; the GLSL side is
+//! generated into `shaders/shared/layouts.glsl` by `cargo xtask codegen`.
+
+use crate::gpu_struct;
+
+gpu_struct! {
+    /// One vertex (32 bytes). Positions come first so the vertex buffer is also the BLAS input
+    /// (`R32G32B32_SFLOAT`, stride 32).
+    pub struct GpuVertex {
+        /// Object-space position (xyz) and texture coordinate u (w).
+        pub position_u: [f32; 4] => "vec4",
+        /// Object-space shading normal (xyz) and texture coordinate v (w).
+        pub normal_v: [f32; 4] => "vec4",
+    }
+}
+
+gpu_struct! {
+    /// Where a mesh lives in the shared vertex, index and triangle-material buffers.
+    pub struct GpuMesh {
+        /// First vertex, first index, first triangle, triangle count.
+        pub ranges: [u32; 4] => "uvec4",
+    }
+}
+
+gpu_struct! {
+    /// One TLAS instance (indexed by the instance custom index).
+    pub struct GpuInstance {
+        /// Object-to-world transform.
+        pub world_from_object: [[f32; 4]; 4] => "mat4",
+        /// Inverse transpose of the upper 3×3, for normals.
+        pub normal_to_world: [[f32; 4]; 4] => "mat4",
+        /// Mesh index, first vertex, first index, first triangle of the mesh.
+        pub mesh: [u32; 4] => "uvec4",
+    }
+}
+
+gpu_struct! {
+    /// A material (metallic-roughness; rendered as diffuse for now).
+    pub struct GpuMaterial {
+        /// Base colour factor (linear RGBA).
+        pub base_color: [f32; 4] => "vec4",
+        /// Emitted radiance (rgb, factor × strength) and double-sidedness (w: 1 or 0).
+        pub emission: [f32; 4] => "vec4",
+        /// Texture indices: base colour, emissive (−1 for none), unused, unused.
+        pub textures: [i32; 4] => "ivec4",
+        /// Metallic, roughness, unused, unused.
+        pub params: [f32; 4] => "vec4",
+    }
+}
+
+gpu_struct! {
+    /// A texture in the shared texel buffer (RGBA8 texels).
+    pub struct GpuTexture {
+        /// First texel, width, height, flags (bits 0–3 wrap S, 4–7 wrap T, bit 8 sRGB).
+        pub info: [u32; 4] => "uvec4",
+    }
+}
+
+gpu_struct! {
+    /// An emissive triangle in world space at the frame's time.
+    pub struct GpuEmitter {
+        /// Corner 0 (xyz) and area (w).
+        pub p0: [f32; 4] => "vec4",
+        /// Corner 1 (xyz).
+        pub p1: [f32; 4] => "vec4",
+        /// Corner 2 (xyz).
+        pub p2: [f32; 4] => "vec4",
+        /// Radiance factor (rgb, before textures) and two-sidedness (w: 1 or 0).
+        pub radiance: [f32; 4] => "vec4",
+        /// Texture coordinates of corners 0 (xy) and 1 (zw).
+        pub uvs: [f32; 4] => "vec4",
+        /// Texture coordinates of corner 2 (xy), material index (z, exact in f32), unused (w).
+        pub uv2_material: [f32; 4] => "vec4",
+    }
+}
+
+gpu_struct! {
+    /// One entry of an alias table (Walker/Vose).
+    pub struct GpuAlias {
+        /// Probability of keeping this entry.
+        pub prob: f32 => "float",
+        /// The entry taken otherwise.
+        pub alias: u32 => "uint",
+        /// Probability mass of this entry.
+        pub pmf: f32 => "float",
+        /// Unused.
+        pub pad: u32 => "uint",
+    }
+}
+
+gpu_struct! {
+    /// A punctual light (KHR_lights_punctual units).
+    pub struct GpuLight {
+        /// World position (xyz) and type (w: 0 point, 1 spot, 2 directional).
+        pub position: [f32; 4] => "vec4",
+        /// World direction the light points to (xyz) and range (w; 0 = infinite).
+        pub direction: [f32; 4] => "vec4",
+        /// Colour × intensity (candela for point/spot, lux for directional).
+        pub intensity: [f32; 4] => "vec4",
+        /// Spot cone: angle scale, angle offset (glTF's falloff), unused, unused.
+        pub spot: [f32; 4] => "vec4",
+    }
+}
+
+gpu_struct! {
+    /// Per-frame constants.
+    pub struct FrameConstants {
+        /// World to clip (Vulkan clip space: y down; reversed depth, 1 at the near plane).
+        pub clip_from_world: [[f32; 4]; 4] => "mat4",
+        /// Clip to world.
+        pub world_from_clip: [[f32; 4]; 4] => "mat4",
+        /// Camera position (xyz), scene scale (w: bounding-box diagonal, for epsilons).
+        pub camera_position: [f32; 4] => "vec4",
+        /// Constant environment radiance (rgb) and scale of the environment map (w).
+        pub environment: [f32; 4] => "vec4",
+        /// Width, height, frame index, random seed.
+        pub resolution: [u32; 4] => "uvec4",
+        /// Emitter count, light count, instance count, environment map width (0 = none).
+        pub counts: [u32; 4] => "uvec4",
+        /// Total emitted power of the emitters, env map height, unused, unused.
+        pub totals: [f32; 4] => "vec4",
+    }
+}
+
+/// Every shared struct's GLSL, in dependency order, with the generated-file header.
+pub fn generated_glsl() -> String {
+    use crate::layout::glsl_struct;
+    let mut s = String::from(
+        "// Generated by `cargo xtask codegen` from crates/radcache-shared/src/gpu.rs. Do not edit.\n\
+         #ifndef RADCACHE_SHARED_LAYOUTS_GLSL\n#define RADCACHE_SHARED_LAYOUTS_GLSL\n\n",
+    );
+    for text in [
+        glsl_struct::<GpuVertex>(),
+        glsl_struct::<GpuMesh>(),
+        glsl_struct::<GpuInstance>(),
+        glsl_struct::<GpuMaterial>(),
+        glsl_struct::<GpuTexture>(),
+        glsl_struct::<GpuEmitter>(),
+        glsl_struct::<GpuAlias>(),
+        glsl_struct::<GpuLight>(),
+        glsl_struct::<FrameConstants>(),
+    ] {
+        s.push_str(&text);
+        s.push('\n');
+    }
+    s.push_str("#endif\n");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::layout::std430_violations;
+
+    #[test]
+    fn every_struct_matches_std430() {
+        let mut errors = Vec::new();
+        errors.extend(std430_violations::<GpuVertex>());
+        errors.extend(std430_violations::<GpuMesh>());
+        errors.extend(std430_violations::<GpuInstance>());
+        errors.extend(std430_violations::<GpuMaterial>());
+        errors.extend(std430_violations::<GpuTexture>());
+        errors.extend(std430_violations::<GpuEmitter>());
+        errors.extend(std430_violations::<GpuAlias>());
+        errors.extend(std430_violations::<GpuLight>());
+        errors.extend(std430_violations::<FrameConstants>());
+        assert!(errors.is_empty(), "{}", errors.join("\n"));
+    }
+
+    #[test]
+    fn a_misaligned_struct_is_caught() {
+        gpu_struct! {
+            /// A float followed by a vec4: std430 puts the vec4 at 16, Rust at 4.
+            pub struct Bad {
+                /// A scalar.
+                pub a: f32 => "float",
+                /// A vector.
+                pub b: [f32; 4] => "vec4",
+            }
+        }
+        let errors = std430_violations::<Bad>();
+        assert!(errors.iter().any(|e| e.contains("Bad.b")), "{errors:?}");
+    }
+
+    #[test]
+    fn generated_glsl_is_up_to_date() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shaders/shared/layouts.glsl");
+        let on_disk = std::fs::read_to_string(path).unwrap_or_default();
+        assert!(
+            on_disk == generated_glsl(),
+            "shaders/shared/layouts.glsl is stale: run `cargo xtask codegen`"
+        );
+    }
+}

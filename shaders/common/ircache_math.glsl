@@ -1,0 +1,334 @@
+// ircache_math.glsl: GLSL twin of the `radcache-cache` crate (crates/radcache-cache/src/*.rs).
+//
+// Irradiance-cache formulas of shared/docs/irradiance-caching.md: hemisphere sampling (§3.1, §3.2),
+// record sums and gradients (§6.1, §6.2, §7.1), radius post-processing (§7.2-§7.7), weights and
+// splat radius (§5.1-§5.5, §10.2, §16.1), extrapolation (§5.6, §16.2), temporal formulas (§11.2).
+// Each function has the same name, arguments (in order) and guards as its Rust reference; Rust
+// tuples/structs become `out` parameters, `[Vec3; 3]` RGB gradients become three vec3 (R, G, B).
+// The Rust docs hold the formulas; comments here only name the section. GLSL 4.60 core, no
+// extension; include once (guarded). Conventions: right-handed frames t x b = n; stratum (j, k) at
+// index j*N + k; distances >= IC_FAR are misses, <= r_eps invalid; outputs never divide by inf.
+// Test: crates/radcache-cache/tests/glsl.rs checks that every Rust function has a twin here and
+// compiles this file with glslangValidator when it is installed.
+
+#ifndef IRCACHE_MATH_GLSL
+#define IRCACHE_MATH_GLSL
+
+const float IC_FAR = 1.0e30;
+const float R_FLOOR = 1.0e-20;
+const float WARD_MIN_ERROR = 1.0e-3;
+const float TL_NORMAL_SCALE = 0.12325641;
+const float KAPPA_MIN = 1.0e-3;
+const float ELEVATION_MIN_SIN2 = 0.03015369;
+const float EXTRAPOLATION_MAX_FACTOR = 4.0;
+const uint WEIGHT_WARD = 0u;
+const uint WEIGHT_TL = 1u;
+const float IC_PI = 3.14159265358979;
+const float IC_TAU = 6.28318530717959;
+
+float luminance_rec709(vec3 c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
+// ---- sampling (§3.1, §3.2, §11.4, §16.3) ----
+
+uint stratum_index(uint j, uint k, uint n) { return j * n + k; }
+
+vec3 normalize_or_z(vec3 n) {
+    float len2 = dot(n, n);
+    if (len2 > 1.0e-30 && len2 < 1.0e30) {
+        return n / sqrt(len2);
+    }
+    return vec3(0.0, 0.0, 1.0);
+}
+
+// Duff et al. 2017, sign(0) = +1.
+void basis_from_normal(vec3 n_in, out vec3 t, out vec3 b) {
+    vec3 n = normalize_or_z(n_in);
+    float s = n.z >= 0.0 ? 1.0 : -1.0;
+    float a = -1.0 / (s + n.z);
+    float c = n.x * n.y * a;
+    t = vec3(1.0 + s * n.x * n.x * a, s * c, -s * n.x);
+    b = vec3(c, s + n.y * n.y * a, -n.y);
+}
+
+vec3 frame_to_world(vec3 v, vec3 t, vec3 b, vec3 n) { return t * v.x + b * v.y + n * v.z; }
+
+vec3 world_to_frame(vec3 w, vec3 t, vec3 b, vec3 n) { return vec3(dot(w, t), dot(w, b), dot(w, n)); }
+
+float azimuth_from_unit(float u) { return u > 0.5 ? IC_TAU * (u - 1.0) : IC_TAU * u; }
+
+float stratum_phi_centre(uint k, uint n) { return azimuth_from_unit((float(k) + 0.5) / float(max(n, 1u))); }
+
+float stratum_phi_start(uint k, uint n) { return azimuth_from_unit(float(k) / float(max(n, 1u))); }
+
+vec3 horizontal_u(float phi) { return vec3(cos(phi), sin(phi), 0.0); }
+
+vec3 horizontal_v(float phi) { return vec3(-sin(phi), cos(phi), 0.0); }
+
+float stratum_tan_centre(uint j, uint m) {
+    uint mm = max(m, 1u);
+    float s2 = (float(min(j, mm - 1u)) + 0.5) / float(mm);
+    return sqrt(s2 / max(1.0 - s2, 0.5 / float(mm)));
+}
+
+float stratum_tan_mean(uint j, uint m) {
+    uint mm = max(m, 1u);
+    uint jj = min(j, mm - 1u);
+    float mf = float(mm);
+    float ua = float(jj) / mf;
+    float ub = float(jj + 1u) / mf;
+    float sa = sqrt(ua);
+    float ca = sqrt(max(1.0 - ua, 0.0));
+    float sb = sqrt(min(ub, 1.0));
+    float cb = sqrt(max(1.0 - ub, 0.0));
+    float dtheta = atan(sb * ca - sa * cb, cb * ca + sb * sa);
+    return max(mf * (dtheta - (sb * cb - sa * ca)), 0.0);
+}
+
+vec3 stratum_direction_local(uint j, uint k, uint m, uint n, float xi, float psi) {
+    float x = clamp(xi, 0.0, 1.0);
+    float y = clamp(psi, 0.0, 1.0);
+    float s2 = clamp((float(j) + x) / float(max(m, 1u)), 0.0, 1.0);
+    float sin_t = sqrt(s2);
+    float cos_t = sqrt(max(1.0 - s2, 0.0));
+    float phi = azimuth_from_unit((float(k) + y) / float(max(n, 1u)));
+    return vec3(sin_t * cos(phi), sin_t * sin(phi), cos_t);
+}
+
+uint ircache_hash(uint v) {
+    uint state = v * 747796405u + 2891336453u;
+    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+float unit_float_from_bits(uint h) { return float(h >> 8u) * (1.0 / 16777216.0); }
+
+void stratum_jitter(uint seed, uint index, out float xi, out float psi) {
+    uint h1 = ircache_hash(index + ircache_hash(seed));
+    uint h2 = ircache_hash(h1);
+    xi = unit_float_from_bits(h1);
+    psi = unit_float_from_bits(h2);
+}
+
+float stratum_projected_solid_angle(uint m, uint n) { return IC_PI / (float(max(m, 1u)) * float(max(n, 1u))); }
+
+// ---- record sums and gradients (§3.1, §6.1, §6.2, §7.1) ----
+
+bool is_valid_sample(float r, float r_eps) { return r > max(r_eps, 0.0); }
+
+float inverse_distance(float r, float r_eps) {
+    if (is_valid_sample(r, r_eps) && r < IC_FAR) {
+        return 1.0 / r;
+    }
+    return 0.0;
+}
+
+float harmonic_mean_distance(float sum_inv_r, float valid_count) {
+    if (sum_inv_r > 0.0 && valid_count > 0.0) {
+        return sum_inv_r < IC_FAR ? min(valid_count / sum_inv_r, IC_FAR) : 0.0;
+    }
+    return IC_FAR;
+}
+
+bool stratum_elevation_ok(uint j, uint m) { return 1.0 - (float(j) + 1.0) / float(max(m, 1u)) >= ELEVATION_MIN_SIN2; }
+
+vec3 rotational_gradient_coeff(uint j, uint k, uint m, uint n) {
+    return horizontal_v(stratum_phi_centre(k, n)) * (stratum_projected_solid_angle(m, n) * stratum_tan_mean(j, m));
+}
+
+vec3 polar_wall_coeff(uint j, uint k, uint m, uint n) {
+    uint mm = max(m, 1u);
+    if (j == 0u || j >= mm) {
+        return vec3(0.0);
+    }
+    float s2 = float(j) / float(mm);
+    float c = (IC_TAU / float(max(n, 1u))) * sqrt(s2) * (1.0 - s2);
+    return horizontal_u(stratum_phi_centre(k, n)) * c;
+}
+
+vec3 azimuthal_wall_coeff(uint j, uint k, uint m, uint n) {
+    uint mm = max(m, 1u);
+    float jf = float(min(j, mm - 1u));
+    float mf = float(mm);
+    float s2c = (jf + 0.5) / mf;
+    float cos_lo = sqrt(max(1.0 - jf / mf, 0.0));
+    float cos_hi = sqrt(max(1.0 - (jf + 1.0) / mf, 0.0));
+    float c = sqrt(1.0 - s2c) * (cos_lo - cos_hi) / sqrt(s2c);
+    return horizontal_v(stratum_phi_start(k, n)) * c;
+}
+
+vec3 wall_term(vec3 l_cur, vec3 l_prev, float r_cur, float r_prev, float r_eps) {
+    if (!is_valid_sample(r_cur, r_eps) || !is_valid_sample(r_prev, r_eps)) {
+        return vec3(0.0);
+    }
+    float r = max(min(r_cur, r_prev), R_FLOOR);
+    if (r < IC_FAR) {
+        return (l_cur - l_prev) / r;
+    }
+    return vec3(0.0);
+}
+
+// NaN fails every comparison, so it is rejected too (where the driver keeps NaN).
+bool irradiance_is_valid(vec3 e) { return all(greaterThanEqual(e, vec3(0.0))) && all(lessThan(e, vec3(3.0e38))); }
+
+// ---- radius (§7.2-§7.7) ----
+
+float sanitize_radius(float r) { return min(max(r, 0.0), IC_FAR); }
+
+float gradient_limit_radius(float r, vec3 e, vec3 gt_r, vec3 gt_g, vec3 gt_b) {
+    float out_r = sanitize_radius(r);
+    float g = length(gt_r);
+    if (g > 0.0) { out_r = min(out_r, max(e.x, 0.0) / g); }
+    g = length(gt_g);
+    if (g > 0.0) { out_r = min(out_r, max(e.y, 0.0) / g); }
+    g = length(gt_b);
+    if (g > 0.0) { out_r = min(out_r, max(e.z, 0.0) / g); }
+    return out_r;
+}
+
+float neighbour_clamp(float r_i, float r_j, float d_ij) { return min(sanitize_radius(r_i), sanitize_radius(r_j) + max(d_ij, 0.0)); }
+
+void neighbour_clamp_pair(float r_i, vec3 p_i, float r_j, vec3 p_j, out float new_r_i, out float new_r_j) {
+    float d = length(p_i - p_j);
+    new_r_i = neighbour_clamp(r_i, r_j, d);
+    new_r_j = neighbour_clamp(r_j, r_i, d);
+}
+
+float pixel_footprint_from_differentials(vec3 dpdx, vec3 dpdy) { return sqrt(length(cross(dpdx, dpdy))); }
+
+float pixel_footprint(float depth, float tan_half_fov_y, float image_height, float cos_view) {
+    float s = 2.0 * abs(depth) * abs(tan_half_fov_y) / max(image_height, 1.0);
+    return s / sqrt(max(abs(cos_view), 0.1));
+}
+
+void radius_bounds(float footprint, float min_px, float max_px, float v_scale, out float r_lo, out float r_hi) {
+    float scale = max(v_scale, 1.0e-6);
+    float s = max(footprint, 0.0);
+    r_lo = min(max(max(min_px, 0.0) * s / scale, R_FLOOR), IC_FAR);
+    r_hi = min(max(max(max_px, 0.0) * s / scale, r_lo), IC_FAR);
+}
+
+float clamp_radius(float r, float r_lo, float r_hi) {
+    float lo = min(max(r_lo, R_FLOOR), IC_FAR);
+    float hi = min(max(r_hi, lo), IC_FAR);
+    return min(max(sanitize_radius(r), lo), hi);
+}
+
+float gradient_attenuation(float r_unclamped, float r_lo) {
+    return min(sanitize_radius(r_unclamped) / min(max(r_lo, R_FLOOR), IC_FAR), 1.0);
+}
+
+// §7.7 steps 3-7; outputs in the order of the Rust `FinalRadius` fields.
+void finalize_radius(float r, vec3 e, vec3 gt_r, vec3 gt_g, vec3 gt_b, float r_neighbour, float r_lo, float r_hi,
+                     out float r_orig, out float r_used, out float r_lo_out, out float r_hi_out, out float grad_t_scale) {
+    float limited = gradient_limit_radius(r, e, gt_r, gt_g, gt_b);
+    r_orig = min(limited, sanitize_radius(r_neighbour));
+    r_lo_out = min(max(r_lo, R_FLOOR), IC_FAR);
+    r_hi_out = min(max(r_hi, r_lo_out), IC_FAR);
+    r_used = clamp_radius(r_orig, r_lo_out, r_hi_out);
+    grad_t_scale = gradient_attenuation(r_orig, r_lo_out);
+}
+
+// ---- weights (§5.1-§5.5, §10.2, §16.1) ----
+
+bool normal_test(vec3 n, vec3 n_i) { return dot(n, n_i) > 0.0; }
+
+bool in_front_test(vec3 p, vec3 p_i, vec3 n_i, float tol) { return dot(p - p_i, n_i) >= -max(tol, 0.0); }
+
+float normal_error(vec3 n, vec3 n_i) { return length(n - n_i) * 0.70710678; }
+
+float position_error(vec3 p, vec3 p_i, vec3 n_i, float r_i) {
+    vec3 d = p - p_i;
+    return (length(d) + abs(dot(d, n_i))) / min(max(r_i, R_FLOOR), IC_FAR);
+}
+
+float ward_weight(vec3 p, vec3 n, vec3 p_i, vec3 n_i, float r_i, float a, float front_tol) {
+    if (!normal_test(n, n_i) || !in_front_test(p, p_i, n_i, front_tol)) {
+        return 0.0;
+    }
+    float eps = position_error(p, p_i, n_i, r_i) + normal_error(n, n_i);
+    if (eps < a) {
+        return 1.0 / max(eps, WARD_MIN_ERROR);
+    }
+    return 0.0;
+}
+
+float tl_weight(vec3 p, vec3 n, vec3 p_i, vec3 n_i, float r_i, float kappa, float front_tol) {
+    if (!normal_test(n, n_i) || !in_front_test(p, p_i, n_i, front_tol)) {
+        return 0.0;
+    }
+    float e_p = 2.0 * position_error(p, p_i, n_i, r_i);
+    float e_n = normal_error(n, n_i) / TL_NORMAL_SCALE;
+    float w = 1.0 - max(kappa, KAPPA_MIN) * max(e_p, e_n);
+    return w > 0.0 ? w : 0.0;
+}
+
+// Unknown kinds behave as T&L (Rust `WeightKind::from_u32`).
+float record_weight(uint kind, vec3 p, vec3 n, vec3 p_i, vec3 n_i, float r_i, float param, float front_tol) {
+    if (kind == WEIGHT_WARD) {
+        return ward_weight(p, n, p_i, n_i, r_i, param, front_tol);
+    }
+    return tl_weight(p, n, p_i, n_i, r_i, param, front_tol);
+}
+
+float validity_scale(uint kind, float param) {
+    if (kind == WEIGHT_WARD) {
+        return max(param, 0.0);
+    }
+    return 0.5 / max(param, KAPPA_MIN);
+}
+
+float splat_radius(uint kind, float r_i, float param, float w_min) {
+    float r = min(max(r_i, R_FLOOR), IC_FAR);
+    if (kind == WEIGHT_WARD) {
+        return min(r / max(1.0 / max(param, 1.0e-6), w_min), IC_FAR);
+    }
+    return (1.0 - clamp(w_min, 0.0, 1.0)) * r * (0.5 / max(param, KAPPA_MIN));
+}
+
+float weight_unit(uint kind, float param) {
+    if (kind == WEIGHT_WARD) {
+        return 1.0 / max(param, 1.0e-6);
+    }
+    return 1.0;
+}
+
+float coverage_threshold(uint kind, float param, float hole_threshold) {
+    return max(hole_threshold, 0.0) * weight_unit(kind, param);
+}
+
+// ---- extrapolation (§5.6, §16.2) ----
+
+vec3 clamp_extrapolation(vec3 x, vec3 e) {
+    vec3 hi = max(e, vec3(0.0)) * EXTRAPOLATION_MAX_FACTOR;
+    return min(max(x, vec3(0.0)), hi);
+}
+
+vec3 extrapolate_irradiance(vec3 e_i, vec3 gr_r, vec3 gr_g, vec3 gr_b, vec3 gt_r, vec3 gt_g, vec3 gt_b,
+                            vec3 p, vec3 n, vec3 p_i, vec3 n_i) {
+    vec3 rot = cross(n_i, n);
+    vec3 dp = p - p_i;
+    vec3 raw = e_i + vec3(dot(rot, gr_r) + dot(dp, gt_r), dot(rot, gr_g) + dot(dp, gt_g), dot(rot, gr_b) + dot(dp, gt_b));
+    return clamp_extrapolation(raw, e_i);
+}
+
+// ---- temporal (§11.2) ----
+
+vec3 temporal_gradient(vec3 e_t0, vec3 e_t1) { return e_t1 - e_t0; }
+
+float temporal_lifespan(vec3 e_t0, vec3 e_t1, float a_t, float max_age) {
+    float max_a = max(max_age, 0.0);
+    float y0 = max(luminance_rec709(e_t0), 0.0);
+    float y1 = max(luminance_rec709(e_t1), 0.0);
+    float dy = abs(y1 - y0);
+    float num = max(a_t, 0.0) * y0;
+    if (num >= max_a * dy) {
+        return max_a;
+    }
+    return num / dy;
+}
+
+bool temporal_is_valid(float age, float lifespan) { return age <= lifespan; }
+
+vec3 temporal_extrapolate(vec3 e_t0, vec3 de_dt, float age) { return max(e_t0 + de_dt * max(age, 0.0), vec3(0.0)); }
+
+#endif // IRCACHE_MATH_GLSL

@@ -1,0 +1,159 @@
+// The scene as every scene-reading pass sees it: bindings 0-15 (see shared/bindings.glsl),
+// surface reconstruction at a ray-query hit, materials, textures and emission.
+#ifndef RADCACHE_SCENE_GLSL
+#define RADCACHE_SCENE_GLSL
+
+#extension GL_EXT_ray_query : require
+#extension GL_EXT_nonuniform_qualifier : enable
+
+#include "../shared/layouts.glsl"
+#include "../shared/bindings.glsl"
+#include "sampling.glsl"
+
+layout(binding = B_FRAME) uniform Frame { FrameConstants frame; };
+layout(binding = B_TLAS) uniform accelerationStructureEXT tlas;
+layout(binding = B_VERTICES, std430) readonly buffer Vertices { GpuVertex vertices[]; };
+layout(binding = B_INDICES, std430) readonly buffer Indices { uint indices[]; };
+layout(binding = B_INSTANCES, std430) readonly buffer Instances { GpuInstance instances[]; };
+layout(binding = B_TRI_MATERIALS, std430) readonly buffer TriMaterials { uint tri_materials[]; };
+layout(binding = B_MATERIALS, std430) readonly buffer Materials { GpuMaterial materials[]; };
+layout(binding = B_TEXTURES, std430) readonly buffer Textures { GpuTexture textures[]; };
+layout(binding = B_TEXELS, std430) readonly buffer Texels { uint texels[]; };
+layout(binding = B_EMITTERS, std430) readonly buffer Emitters { GpuEmitter emitters[]; };
+layout(binding = B_EMITTER_ALIAS, std430) readonly buffer EmitterAlias { GpuAlias emitter_alias[]; };
+layout(binding = B_LIGHTS, std430) readonly buffer Lights { GpuLight lights[]; };
+layout(binding = B_ENV_TEXELS, std430) readonly buffer EnvTexels { vec4 env_texels[]; };
+layout(binding = B_ENV_ALIAS, std430) readonly buffer EnvAlias { GpuAlias env_alias[]; };
+
+// A reconstructed surface point.
+struct Surface {
+    vec3 position;
+    vec3 geometric_normal;  // unit, facing the incoming ray
+    vec3 shading_normal;    // unit, on the same side as geometric_normal
+    vec2 uv;
+    uint material;
+    bool front_face;        // the ray hit the counter-clockwise (front) side
+};
+
+// Offsets a ray origin off a surface along its geometric normal by a few ulps of the position's
+// magnitude, independent of scene scale (Wächter & Binder, "A Fast and Robust Method for Avoiding
+// Self-Intersection", Ray Tracing Gems, 2019).
+vec3 offset_ray_origin(vec3 p, vec3 n) {
+    const float ORIGIN = 1.0 / 32.0;
+    const float FLOAT_SCALE = 1.0 / 65536.0;
+    const float INT_SCALE = 256.0;
+    ivec3 of_i = ivec3(INT_SCALE * n);
+    vec3 p_i = vec3(intBitsToFloat(floatBitsToInt(p.x) + (p.x < 0.0 ? -of_i.x : of_i.x)),
+                    intBitsToFloat(floatBitsToInt(p.y) + (p.y < 0.0 ? -of_i.y : of_i.y)),
+                    intBitsToFloat(floatBitsToInt(p.z) + (p.z < 0.0 ? -of_i.z : of_i.z)));
+    return vec3(abs(p.x) < ORIGIN ? p.x + FLOAT_SCALE * n.x : p_i.x,
+                abs(p.y) < ORIGIN ? p.y + FLOAT_SCALE * n.y : p_i.y,
+                abs(p.z) < ORIGIN ? p.z + FLOAT_SCALE * n.z : p_i.z);
+}
+
+// Surface at a committed triangle hit of instance `instance` (custom index), primitive `prim`,
+// barycentrics `bary`, for a ray travelling along `dir`.
+Surface surface_at(uint instance, uint prim, vec2 bary, vec3 dir) {
+    GpuInstance inst = instances[instance];
+    uint first_vertex = inst.mesh.y;
+    uint first_index = inst.mesh.z + 3u * prim;
+    uint i0 = indices[first_index] + first_vertex;
+    uint i1 = indices[first_index + 1u] + first_vertex;
+    uint i2 = indices[first_index + 2u] + first_vertex;
+    GpuVertex v0 = vertices[i0];
+    GpuVertex v1 = vertices[i1];
+    GpuVertex v2 = vertices[i2];
+    vec3 w = vec3(1.0 - bary.x - bary.y, bary.x, bary.y);
+    vec3 p_obj = w.x * v0.position_u.xyz + w.y * v1.position_u.xyz + w.z * v2.position_u.xyz;
+    vec3 n_obj = w.x * v0.normal_v.xyz + w.y * v1.normal_v.xyz + w.z * v2.normal_v.xyz;
+    vec3 e1 = (inst.world_from_object * vec4(v1.position_u.xyz - v0.position_u.xyz, 0.0)).xyz;
+    vec3 e2 = (inst.world_from_object * vec4(v2.position_u.xyz - v0.position_u.xyz, 0.0)).xyz;
+
+    Surface s;
+    s.position = (inst.world_from_object * vec4(p_obj, 1.0)).xyz;
+    vec3 ng = cross(e1, e2);
+    float len = length(ng);
+    ng = len > 0.0 ? ng / len : vec3(0.0, 0.0, 1.0);
+    s.front_face = dot(ng, dir) < 0.0;
+    s.geometric_normal = s.front_face ? ng : -ng;
+    vec3 ns = (inst.normal_to_world * vec4(n_obj, 0.0)).xyz;
+    float ns_len = length(ns);
+    ns = (ns_len > 0.0 && !isnan(ns_len)) ? ns / ns_len : ng;
+    if (!s.front_face) {
+        ns = -ns;
+    }
+    // A shading normal on the far side of the geometric one (inward-facing vertex normals, or
+    // interpolation across a crease) would send rays into the surface: fall back.
+    s.shading_normal = dot(ns, s.geometric_normal) > 0.0 ? ns : s.geometric_normal;
+    s.uv = w.x * vec2(v0.position_u.w, v0.normal_v.w) + w.y * vec2(v1.position_u.w, v1.normal_v.w) +
+           w.z * vec2(v2.position_u.w, v2.normal_v.w);
+    s.material = tri_materials[inst.mesh.w + prim];
+    return s;
+}
+
+// One texel of texture `tex` (integer coordinates already wrapped), linear RGBA.
+vec4 texel_fetch(GpuTexture tex, int x, int y) {
+    uint v = texels[tex.info.x + uint(y) * tex.info.y + uint(x)];
+    vec4 c = unpackUnorm4x8(v);
+    if ((tex.info.w & 0x100u) != 0u) {
+        // sRGB EOTF (IEC 61966-2-1).
+        bvec3 lo = lessThanEqual(c.rgb, vec3(0.04045));
+        c.rgb = mix(pow((c.rgb + 0.055) / 1.055, vec3(2.4)), c.rgb / 12.92, lo);
+    }
+    return c;
+}
+
+// Wraps integer coordinate i into [0, n) with glTF wrap mode (0 repeat, 1 clamp, 2 mirror).
+int wrap_coord(int i, int n, uint mode) {
+    if (mode == 1u) {
+        return clamp(i, 0, n - 1);
+    }
+    if (mode == 2u) {
+        int period = 2 * n;
+        int m = ((i % period) + period) % period;
+        return m < n ? m : period - 1 - m;
+    }
+    return ((i % n) + n) % n;
+}
+
+// Bilinear texture lookup with the texture's wrap modes.
+vec4 texture_sample(int index, vec2 uv) {
+    GpuTexture tex = textures[index];
+    int w = int(tex.info.y);
+    int h = int(tex.info.z);
+    vec2 p = uv * vec2(w, h) - 0.5;
+    ivec2 i = ivec2(floor(p));
+    vec2 f = p - vec2(i);
+    uint ws = tex.info.w & 0xFu;
+    uint wt = (tex.info.w >> 4u) & 0xFu;
+    int x0 = wrap_coord(i.x, w, ws), x1 = wrap_coord(i.x + 1, w, ws);
+    int y0 = wrap_coord(i.y, h, wt), y1 = wrap_coord(i.y + 1, h, wt);
+    vec4 a = mix(texel_fetch(tex, x0, y0), texel_fetch(tex, x1, y0), f.x);
+    vec4 b = mix(texel_fetch(tex, x0, y1), texel_fetch(tex, x1, y1), f.x);
+    return mix(a, b, f.y);
+}
+
+// Diffuse albedo: base colour × (1 − metallic).
+vec3 material_albedo(uint m, vec2 uv) {
+    GpuMaterial mat = materials[m];
+    vec3 base = mat.base_color.rgb;
+    if (mat.textures.x >= 0) {
+        base *= texture_sample(mat.textures.x, uv).rgb;
+    }
+    return clamp(base * (1.0 - mat.params.x), 0.0, 1.0);
+}
+
+// Emitted radiance toward the viewer: front face only, or both when double-sided.
+vec3 material_emission(uint m, vec2 uv, bool front_face) {
+    GpuMaterial mat = materials[m];
+    if (!front_face && mat.emission.w == 0.0) {
+        return vec3(0.0);
+    }
+    vec3 e = mat.emission.rgb;
+    if (mat.textures.y >= 0 && any(greaterThan(e, vec3(0.0)))) {
+        e *= texture_sample(mat.textures.y, uv).rgb;
+    }
+    return e;
+}
+
+#endif

@@ -1,0 +1,104 @@
+//! Harness for radcache's GPU tests: a validated lavapipe context, the shader compiler, and the
+//! end-of-test check (no validation error, no leaked allocation).
+//!
+//! Tests run with the Khronos validation layer on (unless `RADCACHE_VALIDATION=0` is set by
+//! hand); a missing layer fails the test instead of silently running unvalidated.
+
+pub mod geometry;
+pub mod shader_check;
+
+use std::path::PathBuf;
+use std::sync::Once;
+
+use radcache_vk::{Context, ContextOptions, ShaderCompiler};
+
+static LOG: Once = Once::new();
+
+/// Initialises logging once (`RUST_LOG` controls the level; warnings by default).
+pub fn init_log() {
+    LOG.call_once(|| {
+        let _ = env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
+            .is_test(true)
+            .try_init();
+    });
+}
+
+/// The repository's `shaders/` folder.
+pub fn shader_root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shaders")
+}
+
+/// Whether validation was explicitly turned off for this run.
+fn validation_disabled_by_user() -> bool {
+    matches!(
+        std::env::var("RADCACHE_VALIDATION").as_deref(),
+        Ok("0") | Ok("false") | Ok("off") | Ok("no")
+    )
+}
+
+/// A context with validation on; panics with a clear message if the layer is missing.
+pub fn context() -> Context {
+    init_log();
+    let mut opts = ContextOptions::from_env();
+    opts.validation = !validation_disabled_by_user();
+    let ctx = Context::with_options(&opts).unwrap_or_else(|e| panic!("creating the Vulkan context: {e}"));
+    if opts.validation {
+        assert!(
+            ctx.info().validation,
+            "the Khronos validation layer is not installed (apt-get install vulkan-validationlayers)"
+        );
+    }
+    ctx
+}
+
+/// A shader compiler over the repository's shaders.
+pub fn shaders() -> ShaderCompiler {
+    ShaderCompiler::new(shader_root()).unwrap_or_else(|e| panic!("shader compiler: {e}"))
+}
+
+/// Shuts the context down and asserts no validation error occurred and nothing leaked.
+pub fn finish(ctx: Context) {
+    let first = ctx.first_validation_error();
+    let report = ctx.shutdown();
+    assert_eq!(
+        report.validation_errors, 0,
+        "validation errors occurred; first: {}",
+        first.unwrap_or_default()
+    );
+    assert!(report.leaked.is_empty(), "leaked GPU allocations: {:?}", report.leaked);
+}
+
+/// A small deterministic PRNG (splitmix64) for test inputs.
+#[derive(Debug, Clone)]
+pub struct Rng(u64);
+
+impl Rng {
+    /// A generator from a seed.
+    pub fn new(seed: u64) -> Self {
+        Rng(seed)
+    }
+
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// A uniform float in [0, 1).
+    pub fn f32(&mut self) -> f32 {
+        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// A uniform float in [lo, hi).
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.f32()
+    }
+
+    /// A uniform integer in [0, n).
+    pub fn below(&mut self, n: u32) -> u32 {
+        (self.next_u64() % u64::from(n.max(1))) as u32
+    }
+}

@@ -1,0 +1,18 @@
+//! `cargo xtask bench <what>`: benchmarks whose figures go to `bench/results.csv`.
+//!
+//! Benchmarks run with validation off (it costs CPU time per call) unless `RADCACHE_VALIDATION` is
+//! set, and on the device `RADCACHE_DEVICE` names (the preferred one otherwise).
+
+mod rays;
+
+use anyhow::{bail, Result};
+
+pub fn run(args: &[&str]) -> Result<()> {
+    if std::env::var_os("RADCACHE_VALIDATION").is_none() {
+        std::env::set_var("RADCACHE_VALIDATION", "0");
+    }
+    match args {
+        ["rays", rest @ ..] => rays::run(rest),
+        _ => bail!("usage: cargo xtask bench rays [--rays N]"),
+    }
+}

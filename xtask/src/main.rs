@@ -1,0 +1,57 @@
+//! radcache's project tasks: `cargo xtask <task>`.
+
+mod bench;
+mod codegen;
+mod results;
+mod shaders;
+mod test;
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+
+const HELP: &str = "\
+cargo xtask <task>
+
+Tasks:
+  test              run the whole test suite on lavapipe with validation (the README's command)
+  shaders           compile every shader in shaders/ and run spirv-val on the output
+  codegen [--check] write shaders/shared/*.glsl from radcache-shared (--check: fail if stale)
+  bench rays        raw ray-query throughput and BLAS/TLAS build times on the chosen device
+  help              this text
+
+Benchmarks append their figures to bench/results.csv.
+Environment: RADCACHE_DEVICE=<name substring> picks the device; VK_DRIVER_FILES as usual.
+";
+
+/// The repository root (the parent of xtask/).
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(PathBuf::from)
+        .unwrap_or_default()
+}
+
+fn main() {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("info")).init();
+    if let Err(e) = try_main() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn try_main() -> Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    match args.as_slice() {
+        ["test", rest @ ..] => test::run(rest),
+        ["shaders"] => shaders::run(),
+        ["codegen", rest @ ..] => codegen::run(rest),
+        ["bench", rest @ ..] => bench::run(rest),
+        [] | ["help"] | ["--help"] | ["-h"] => {
+            print!("{HELP}");
+            Ok(())
+        }
+        other => bail!("unknown task {other:?}\n\n{HELP}"),
+    }
+}
