@@ -33,7 +33,9 @@ struct GpuEmitter {
     vec4 p1;
     vec4 p2;
     vec4 radiance;
-};  // 64 bytes
+    vec4 uvs;
+    vec4 uv2_material;
+};  // 96 bytes
 
 struct GpuAlias {
     float prob;

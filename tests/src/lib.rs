@@ -41,7 +41,8 @@ pub fn context() -> Context {
     init_log();
     let mut opts = ContextOptions::from_env();
     opts.validation = !validation_disabled_by_user();
-    let ctx = Context::with_options(&opts).unwrap_or_else(|e| panic!("creating the Vulkan context: {e}"));
+    let ctx =
+        Context::with_options(&opts).unwrap_or_else(|e| panic!("creating the Vulkan context: {e}"));
     if opts.validation {
         assert!(
             ctx.info().validation,
@@ -61,11 +62,16 @@ pub fn finish(ctx: Context) {
     let first = ctx.first_validation_error();
     let report = ctx.shutdown();
     assert_eq!(
-        report.validation_errors, 0,
+        report.validation_errors,
+        0,
         "validation errors occurred; first: {}",
         first.unwrap_or_default()
     );
-    assert!(report.leaked.is_empty(), "leaked GPU allocations: {:?}", report.leaked);
+    assert!(
+        report.leaked.is_empty(),
+        "leaked GPU allocations: {:?}",
+        report.leaked
+    );
 }
 
 /// A small deterministic PRNG (splitmix64) for test inputs.

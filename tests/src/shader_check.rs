@@ -48,7 +48,11 @@ pub fn check_all(root: &Path, out_dir: &Path, validate: bool) -> std::io::Result
     let compiler = ShaderCompiler::new(root).map_err(std::io::Error::other)?;
     let mut results = Vec::new();
     for path in paths {
-        let mut check = ShaderCheck { path: path.clone(), error: None, words: 0 };
+        let mut check = ShaderCheck {
+            path: path.clone(),
+            error: None,
+            words: 0,
+        };
         match compiler.compile(&path, &[]) {
             Err(e) => check.error = Some(e.to_string()),
             Ok(spirv) => {
@@ -56,7 +60,10 @@ pub fn check_all(root: &Path, out_dir: &Path, validate: bool) -> std::io::Result
                 let spv = out_dir.join(format!("{}.spv", path.replace('/', "_")));
                 std::fs::write(&spv, bytemuck::cast_slice::<u32, u8>(&spirv))?;
                 if validate {
-                    let out = Command::new("spirv-val").args(["--target-env", "vulkan1.3"]).arg(&spv).output()?;
+                    let out = Command::new("spirv-val")
+                        .args(["--target-env", "vulkan1.3"])
+                        .arg(&spv)
+                        .output()?;
                     if !out.status.success() {
                         check.error = Some(format!(
                             "spirv-val: {}{}",

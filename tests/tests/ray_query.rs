@@ -63,17 +63,31 @@ struct CpuHit {
 fn world_triangles(mesh: &Mesh, transforms: &[Mat4]) -> Vec<Vec<[Vec3; 3]>> {
     transforms
         .iter()
-        .map(|m| (0..mesh.triangle_count()).map(|t| mesh.triangle(t).map(|p| m.transform_point3(p))).collect())
+        .map(|m| {
+            (0..mesh.triangle_count())
+                .map(|t| mesh.triangle(t).map(|p| m.transform_point3(p)))
+                .collect()
+        })
         .collect()
 }
 
-fn cpu_closest(world: &[Vec<[Vec3; 3]>], o: Vec3, d: Vec3, tmax: f64, slack: f64) -> Option<CpuHit> {
+fn cpu_closest(
+    world: &[Vec<[Vec3; 3]>],
+    o: Vec3,
+    d: Vec3,
+    tmax: f64,
+    slack: f64,
+) -> Option<CpuHit> {
     let mut best: Option<CpuHit> = None;
     for (instance, tris) in world.iter().enumerate() {
         for (primitive, tri) in tris.iter().enumerate() {
             if let Some(hit) = intersect(o.as_dvec3(), d.as_dvec3(), *tri, slack) {
                 if hit.t >= 0.0 && hit.t <= tmax && best.as_ref().is_none_or(|b| hit.t < b.hit.t) {
-                    best = Some(CpuHit { hit, instance, primitive });
+                    best = Some(CpuHit {
+                        hit,
+                        instance,
+                        primitive,
+                    });
                 }
             }
         }
@@ -88,14 +102,26 @@ fn ray_queries_match_cpu_reference() {
     let mesh = uv_sphere(1.0, 40, 64); // 2·64·39 = 4992 triangles
     assert!(mesh.triangle_count() > 4000);
     let transforms = [
-        Mat4::from_scale_rotation_translation(Vec3::splat(1.0), Quat::from_rotation_y(0.3), Vec3::new(-1.5, 0.0, 0.0)),
-        Mat4::from_scale_rotation_translation(Vec3::new(0.7, 1.2, 0.9), Quat::from_rotation_x(0.8), Vec3::new(1.4, 0.3, -0.2)),
+        Mat4::from_scale_rotation_translation(
+            Vec3::splat(1.0),
+            Quat::from_rotation_y(0.3),
+            Vec3::new(-1.5, 0.0, 0.0),
+        ),
+        Mat4::from_scale_rotation_translation(
+            Vec3::new(0.7, 1.2, 0.9),
+            Quat::from_rotation_x(0.8),
+            Vec3::new(1.4, 0.3, -0.2),
+        ),
     ];
     let input = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
         | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
     let positions: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
-    let vbuf = ctx.create_buffer_init("test.vertices", input, &positions).unwrap();
-    let ibuf = ctx.create_buffer_init("test.indices", input, &mesh.indices).unwrap();
+    let vbuf = ctx
+        .create_buffer_init("test.vertices", input, &positions)
+        .unwrap();
+    let ibuf = ctx
+        .create_buffer_init("test.indices", input, &mesh.indices)
+        .unwrap();
     let (blases, stats) = ctx
         .build_blases(&[BlasGeometry {
             name: "test.sphere_blas",
@@ -108,7 +134,10 @@ fn ray_queries_match_cpu_reference() {
             triangle_count: mesh.triangle_count() as u32,
         }])
         .unwrap();
-    assert!(stats.bytes_compacted > 0 && stats.bytes_compacted <= stats.bytes_built, "{stats:?}");
+    assert!(
+        stats.bytes_compacted > 0 && stats.bytes_compacted <= stats.bytes_built,
+        "{stats:?}"
+    );
     let mut tlas = Tlas::new(&ctx, "test.tlas", 4).unwrap();
     let instances: Vec<TlasInstance<'_>> = transforms
         .iter()
@@ -127,21 +156,43 @@ fn ray_queries_match_cpu_reference() {
     let n = 10_000usize;
     let rays: Vec<GpuRay> = (0..n)
         .map(|i| {
-            let o = Vec3::new(rng.range(-4.0, 4.0), rng.range(-3.0, 3.0), rng.range(3.0, 5.0)) * if i % 2 == 0 { 1.0 } else { -1.0 };
-            let target = Vec3::new(rng.range(-3.0, 3.0), rng.range(-1.6, 1.6), rng.range(-1.2, 1.2));
+            let o = Vec3::new(
+                rng.range(-4.0, 4.0),
+                rng.range(-3.0, 3.0),
+                rng.range(3.0, 5.0),
+            ) * if i % 2 == 0 { 1.0 } else { -1.0 };
+            let target = Vec3::new(
+                rng.range(-3.0, 3.0),
+                rng.range(-1.6, 1.6),
+                rng.range(-1.2, 1.2),
+            );
             let d = (target - o).normalize();
-            let tmax = if i % 10 == 0 { rng.range(0.5, 6.0) } else { 1.0e30 };
-            GpuRay { origin: o.to_array(), tmin: 0.0, dir: d.to_array(), tmax }
+            let tmax = if i % 10 == 0 {
+                rng.range(0.5, 6.0)
+            } else {
+                1.0e30
+            };
+            GpuRay {
+                origin: o.to_array(),
+                tmin: 0.0,
+                dir: d.to_array(),
+                tmax,
+            }
         })
         .collect();
-    let ray_buf = ctx.create_buffer_init("test.rays", vk::BufferUsageFlags::STORAGE_BUFFER, &rays).unwrap();
-    let hit_buf = Buffer::new(&ctx, &BufferDesc {
-        name: "test.hits",
-        size: (n * std::mem::size_of::<GpuHit>()) as u64,
-        usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-        location: MemoryLocation::GpuOnly,
-        alignment: 0,
-    })
+    let ray_buf = ctx
+        .create_buffer_init("test.rays", vk::BufferUsageFlags::STORAGE_BUFFER, &rays)
+        .unwrap();
+    let hit_buf = Buffer::new(
+        &ctx,
+        &BufferDesc {
+            name: "test.hits",
+            size: (n * std::mem::size_of::<GpuHit>()) as u64,
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+            location: MemoryLocation::GpuOnly,
+            alignment: 0,
+        },
+    )
     .unwrap();
     let spirv = compiler.compile("tests/ray_query.comp", &[]).unwrap();
     let bindings = [
@@ -152,11 +203,21 @@ fn ray_queries_match_cpu_reference() {
     let pipeline = Pipeline::compute(&ctx, "test.ray_query", &spirv, &bindings, 16).unwrap();
 
     let mut rec = ctx.begin("test").unwrap();
-    rec.build_tlas(&ctx, &mut tlas, &instances, TlasUpdate::Rebuild).unwrap();
+    rec.build_tlas(&ctx, &mut tlas, &instances, TlasUpdate::Rebuild)
+        .unwrap();
     rec.pass("test.trace", |rec| {
         rec.bind_pipeline(&pipeline);
-        rec.push_bindings(&[(0, Resource::Tlas(&tlas)), (1, Resource::Buffer(&ray_buf)), (2, Resource::Buffer(&hit_buf))]);
-        rec.push_constants(&Push { count: n as u32, flags: 0, row_width: n as u32, pad: 0 });
+        rec.push_bindings(&[
+            (0, Resource::Tlas(&tlas)),
+            (1, Resource::Buffer(&ray_buf)),
+            (2, Resource::Buffer(&hit_buf)),
+        ]);
+        rec.push_constants(&Push {
+            count: n as u32,
+            flags: 0,
+            row_width: n as u32,
+            pad: 0,
+        });
         rec.dispatch((n as u32).div_ceil(64), 1, 1).unwrap();
     });
     rec.barrier(Access::COMPUTE_WRITE, Access::TRANSFER_READ);
@@ -194,16 +255,24 @@ fn ray_queries_match_cpu_reference() {
             (1, Some(s)) => {
                 let tri = world[gpu.instance as usize][gpu.primitive as usize];
                 let own = intersect(o.as_dvec3(), d.as_dvec3(), tri, 1e-5);
-                own.is_some_and(|h| (h.t - s.hit.t).abs() <= 1e-4 * s.hit.t && h.edge_distance() < 1e-5)
-                    || s.hit.edge_distance() < 1e-5
+                own.is_some_and(|h| {
+                    (h.t - s.hit.t).abs() <= 1e-4 * s.hit.t && h.edge_distance() < 1e-5
+                }) || s.hit.edge_distance() < 1e-5
             }
             (0, Some(s)) => s.hit.edge_distance() < 1e-5 || (s.hit.t - tmax).abs() <= 1e-4 * tmax,
             _ => false,
         };
-        assert!(explained, "ray {i}: GPU {gpu:?} vs CPU {:?}", cpu.map(|c| (c.hit, c.instance, c.primitive)));
+        assert!(
+            explained,
+            "ray {i}: GPU {gpu:?} vs CPU {:?}",
+            cpu.map(|c| (c.hit, c.instance, c.primitive))
+        );
         edge_cases += 1;
     }
-    assert!(hit_count > n / 3, "only {hit_count} hits: the test rays mostly miss");
+    assert!(
+        hit_count > n / 3,
+        "only {hit_count} hits: the test rays mostly miss"
+    );
     assert!(edge_cases <= n / 1000, "{edge_cases} edge cases");
     drop(instances);
     drop((pipeline, hit_buf, ray_buf, tlas, blases, vbuf, ibuf));

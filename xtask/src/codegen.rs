@@ -8,7 +8,9 @@ pub fn run(args: &[&str]) -> Result<()> {
     let text = radcache_shared::gpu::generated_glsl();
     let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
     match args {
-        ["--check"] if on_disk != text => bail!("{} is stale: run `cargo xtask codegen`", path.display()),
+        ["--check"] if on_disk != text => {
+            bail!("{} is stale: run `cargo xtask codegen`", path.display())
+        }
         ["--check"] => println!("{} is up to date", path.display()),
         [] if on_disk == text => println!("{} unchanged", path.display()),
         [] => {

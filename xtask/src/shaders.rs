@@ -24,7 +24,11 @@ pub fn run() -> Result<()> {
             }
         }
     }
-    println!("{} shaders, {failed} failed; SPIR-V in {}", results.len(), out.display());
+    println!(
+        "{} shaders, {failed} failed; SPIR-V in {}",
+        results.len(),
+        out.display()
+    );
     if failed > 0 {
         bail!("{failed} shader(s) failed");
     }

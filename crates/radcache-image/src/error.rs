@@ -47,6 +47,28 @@ pub enum Error {
         message: String,
     },
 
+    /// A sample that would put NaN or ±inf into `path`: non-finite, or (for `f16` output)
+    /// beyond ±65504. Only the first such sample is reported; set
+    /// [`crate::ExrOptions::sanitize`] to replace these values instead.
+    #[error(
+        "refusing to write '{path}': channel '{channel}' at pixel ({x}, {y}) is {value}, {problem} \
+         (set ExrOptions::sanitize to replace such values)"
+    )]
+    NonFinite {
+        /// The destination file.
+        path: PathBuf,
+        /// Full EXR channel name, e.g. `R` or `albedo.G`.
+        channel: String,
+        /// Column of the pixel (0 = left).
+        x: u32,
+        /// Row of the pixel (0 = top).
+        y: u32,
+        /// The offending value.
+        value: f32,
+        /// Why it cannot be written, e.g. "which is not finite".
+        problem: &'static str,
+    },
+
     /// Metadata that cannot be stored as EXR header attributes.
     #[error("invalid metadata for '{path}': {message}")]
     Metadata {

@@ -1,8 +1,11 @@
 //! EXR input: the RGB beauty, AOV layers and [`Metadata`] of a file written by
 //! [`crate::write_exr`] (or any scan-line/tiled, non-deep EXR with `R`, `G`, `B` channels).
 //!
-//! All parts ("layers" in the `exr` crate) and channels are gathered under their full names
-//! (`<part name>.<channel>` for named parts). Channels without a `.` form the beauty: `R`, `G`,
+//! Plain RGB or RGBA files written by other tools (e.g. environment maps), in `f16`, `f32` or
+//! `u32`, read the same way. All parts ("layers" in the `exr` crate) and channels are gathered
+//! under their full names: in a multi-part file a channel of a named part is prefixed with
+//! `<part name>.` unless its name already starts so; in a single-part file the part name (if
+//! any) is only a label and channel names are used as they are. Channels without a `.` form the beauty: `R`, `G`,
 //! `B` are required, `A` and other unprefixed channels are ignored. Channels named
 //! `<layer>.<channel>` become a [`Layer`] named after the text before the last `.`; a layer's
 //! channels are ordered `R, G, B, A, X, Y, Z`, then others alphabetically (EXR itself stores
@@ -53,16 +56,27 @@ pub fn read_exr(path: impl AsRef<Path>) -> Result<(Image, Metadata)> {
                 layer.size.y()
             )));
         }
-        let prefix = layer.attributes.layer_name.as_ref().map(string);
+        let prefix = match &layer.attributes.layer_name {
+            Some(name) if exr_image.layer_data.len() > 1 && !name.as_slice().is_empty() => {
+                Some(format!("{}.", string(name)))
+            }
+            _ => None,
+        };
         for channel in &layer.channel_data.list {
+            let name = string(&channel.name);
             let name = match &prefix {
-                Some(prefix) if !prefix.is_empty() => format!("{prefix}.{}", string(&channel.name)),
-                _ => string(&channel.name),
+                Some(prefix) if !name.starts_with(prefix.as_str()) => format!("{prefix}{name}"),
+                _ => name,
             };
             let samples = to_f32(&channel.sample_data);
             if samples.len() != width * height {
                 return Err(content_error(format!(
                     "channel '{name}' is subsampled, which is not supported"
+                )));
+            }
+            if channels.contains_key(&name) {
+                return Err(content_error(format!(
+                    "channel '{name}' appears in more than one part"
                 )));
             }
             channels.insert(name, samples);

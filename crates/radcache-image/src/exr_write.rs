@@ -4,15 +4,25 @@
 //! the beauty in channels `R`, `G`, `B` and each AOV layer as prefixed channels in the same part
 //! (`albedo.R`, `normal.X`, `depth.Z`, ...), which is the OpenEXR naming convention for layers and
 //! what Nuke, Blender and `exrheader` show as layers. Samples are `f32`, or `f16` for every
-//! channel when [`ExrOptions::half`] is set (values beyond ±65504 become ±inf, as in any f16
-//! conversion). Chromaticities are the Rec.709/sRGB primaries with a D65 white point, since the
+//! channel when [`ExrOptions::half`] is set. Chromaticities are the Rec.709/sRGB primaries with a D65 white point, since the
 //! renderer works in linear sRGB. The write is atomic (see [`crate::atomic`]).
+//!
+//! # No NaN or infinity in the output
+//!
+//! The renderer guards against non-finite radiance at its source; the writer is the last line of
+//! defence. By default a sample that would be stored as NaN or ±inf — a non-finite value in the
+//! beauty or any written AOV, or with `half` a finite value beyond ±65504 (f16's largest finite
+//! value) — makes [`write_exr`] fail with [`Error::NonFinite`], naming the file, the channel and
+//! the first such pixel (in channel order, then row-major), and nothing is written. With
+//! [`ExrOptions::sanitize`] such values are replaced instead: NaN and ±inf by 0, and (for `f16`)
+//! finite values beyond the range by ±65504; the number of replaced samples is logged as a
+//! warning. The caller's [`Image`] is never modified.
 
 use std::path::Path;
 
 use exr::image::{AnyChannel, AnyChannels, Encoding, FlatSamples, Layer as ExrLayer};
 use exr::math::Vec2;
-use exr::meta::attribute::{Chromaticities, Text};
+use exr::meta::attribute::Chromaticities;
 use exr::meta::header::{ImageAttributes, LayerAttributes};
 use exr::prelude::{f16, IntegerBounds, SmallVec, WritableImage};
 
@@ -28,19 +38,25 @@ pub struct ExrOptions {
     pub half: bool,
     /// Write the image's AOV layers; `false` writes the beauty only.
     pub aovs: bool,
+    /// Replace values that cannot be stored finitely instead of failing (see the module docs).
+    pub sanitize: bool,
 }
 
 impl Default for ExrOptions {
-    /// `f32` samples, AOV layers included.
+    /// `f32` samples, AOV layers included, non-finite values refused.
     fn default() -> Self {
         Self {
             half: false,
             aovs: true,
+            sanitize: false,
         }
     }
 }
 
 /// Writes `image` and `metadata` to `path` atomically.
+///
+/// Fails, writing nothing, on an empty image, unwritable metadata, or (unless
+/// [`ExrOptions::sanitize`]) a value that cannot be stored finitely ([`Error::NonFinite`]).
 pub fn write_exr(
     path: impl AsRef<Path>,
     image: &Image,
@@ -57,18 +73,31 @@ pub fn write_exr(
         )));
     }
 
+    let mut converter = Converter {
+        path,
+        width: image.width() as usize,
+        options,
+        replaced: 0,
+    };
     let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
     for (index, name) in ["R", "G", "B"].into_iter().enumerate() {
-        channels.push(channel(text(name), image.rgb(), 3, index, options.half));
+        channels.push(converter.channel(name.to_owned(), image.rgb(), 3, index)?);
     }
     if options.aovs {
         for layer in image.layers() {
             let stride = layer.channels().len();
             for (index, name) in layer.channels().iter().enumerate() {
-                let full = text(&format!("{}.{name}", layer.name()));
-                channels.push(channel(full, layer.data(), stride, index, options.half));
+                let full = format!("{}.{name}", layer.name());
+                channels.push(converter.channel(full, layer.data(), stride, index)?);
             }
         }
+    }
+    if converter.replaced > 0 {
+        log::warn!(
+            "'{}': replaced {} sample(s) that cannot be stored finitely",
+            path.display(),
+            converter.replaced
+        );
     }
 
     let mut layer_attributes = LayerAttributes::default();
@@ -106,21 +135,63 @@ pub fn write_exr(
     Ok(())
 }
 
-/// One channel de-interleaved from `data` (`stride` values per pixel, this one at `index`).
-fn channel(
-    name: Text,
-    data: &[f32],
-    stride: usize,
-    index: usize,
-    half: bool,
-) -> AnyChannel<FlatSamples> {
-    let values = data.iter().skip(index).step_by(stride).copied();
-    let samples = if half {
-        FlatSamples::F16(values.map(f16::from_f32).collect())
-    } else {
-        FlatSamples::F32(values.collect())
-    };
-    AnyChannel::new(name, samples)
+/// Largest finite `f16` value.
+const F16_MAX: f32 = 65504.0;
+
+/// De-interleaves channels and applies the non-finite policy (see the module docs).
+struct Converter<'a> {
+    path: &'a Path,
+    width: usize,
+    options: &'a ExrOptions,
+    /// Samples replaced so far (with `sanitize`).
+    replaced: u64,
+}
+
+impl Converter<'_> {
+    /// Channel `name`, de-interleaved from `data` (`stride` values per pixel, this one at
+    /// `index`).
+    fn channel(
+        &mut self,
+        name: String,
+        data: &[f32],
+        stride: usize,
+        index: usize,
+    ) -> Result<AnyChannel<FlatSamples>> {
+        let limit = if self.options.half { F16_MAX } else { f32::MAX };
+        let mut values = Vec::with_capacity(data.len() / stride);
+        for (pixel, &value) in data.iter().skip(index).step_by(stride).enumerate() {
+            let problem = if !value.is_finite() {
+                "which is not finite"
+            } else if value.abs() > limit {
+                "which overflows f16 (largest finite value 65504)"
+            } else {
+                values.push(value);
+                continue;
+            };
+            if !self.options.sanitize {
+                return Err(Error::NonFinite {
+                    path: self.path.to_owned(),
+                    channel: name,
+                    x: (pixel % self.width) as u32,
+                    y: (pixel / self.width) as u32,
+                    value,
+                    problem,
+                });
+            }
+            self.replaced += 1;
+            values.push(if value.is_finite() {
+                limit.copysign(value)
+            } else {
+                0.0
+            });
+        }
+        let samples = if self.options.half {
+            FlatSamples::F16(values.into_iter().map(f16::from_f32).collect())
+        } else {
+            FlatSamples::F32(values)
+        };
+        Ok(AnyChannel::new(text(&name), samples))
+    }
 }
 
 /// Rec.709 / sRGB primaries with D65 white (ITU-R BT.709).

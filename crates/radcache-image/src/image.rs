@@ -158,6 +158,32 @@ impl Image {
         })
     }
 
+    /// An image from RGB pixels (`width * height` of them), row-major, top row first.
+    pub fn from_pixels(width: u32, height: u32, pixels: Vec<[f32; 3]>) -> Result<Self> {
+        let expected = pixel_count(width, height);
+        if pixels.len() != expected {
+            return Err(Error::InvalidImage(format!(
+                "{width}x{height} image needs {expected} pixels, got {}",
+                pixels.len()
+            )));
+        }
+        Self::from_rgb(width, height, pixels.into_iter().flatten().collect())
+    }
+
+    /// An image from interleaved RGBA data (`4 * width * height` values, e.g. a GPU read-back
+    /// of an `R32G32B32A32_SFLOAT` target); the fourth channel is dropped.
+    pub fn from_rgba(width: u32, height: u32, rgba: &[f32]) -> Result<Self> {
+        let expected = pixel_count(width, height) * 4;
+        if rgba.len() != expected {
+            return Err(Error::InvalidImage(format!(
+                "{width}x{height} RGBA image needs {expected} values, got {}",
+                rgba.len()
+            )));
+        }
+        let rgb = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]);
+        Self::from_rgb(width, height, rgb.collect())
+    }
+
     /// Width in pixels.
     pub fn width(&self) -> u32 {
         self.width
@@ -181,6 +207,11 @@ impl Image {
     /// Mutable interleaved linear RGB.
     pub fn rgb_mut(&mut self) -> &mut [f32] {
         &mut self.rgb
+    }
+
+    /// The RGB pixels in order (row-major, top row first).
+    pub fn pixels(&self) -> impl ExactSizeIterator<Item = [f32; 3]> + '_ {
+        self.rgb.chunks_exact(3).map(|p| [p[0], p[1], p[2]])
     }
 
     /// The RGB value at (`x`, `y`), `y = 0` being the top row. Panics when out of bounds.
@@ -270,6 +301,18 @@ mod tests {
         image.set_pixel(2, 1, [1.0, 2.0, 3.0]);
         assert_eq!(&image.rgb()[15..18], &[1.0, 2.0, 3.0]);
         assert_eq!(image.pixel(2, 1), [1.0, 2.0, 3.0]);
+    }
+
+    #[test]
+    fn pixel_and_rgba_constructors() {
+        let pixels = vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]];
+        let image = Image::from_pixels(2, 1, pixels.clone()).unwrap();
+        assert_eq!(image.rgb(), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert_eq!(image.pixels().collect::<Vec<_>>(), pixels);
+        let rgba = [1.0, 2.0, 3.0, 9.0, 4.0, 5.0, 6.0, 9.0];
+        assert_eq!(Image::from_rgba(2, 1, &rgba).unwrap(), image);
+        assert!(Image::from_pixels(2, 2, pixels).is_err());
+        assert!(Image::from_rgba(2, 1, &rgba[..7]).is_err());
     }
 
     #[test]

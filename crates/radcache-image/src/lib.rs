@@ -2,7 +2,9 @@
 //!
 //! - [`Image`]: linear RGB `f32` beauty (row-major, top row first) plus named AOV [`Layer`]s.
 //! - [`write_exr`] / [`read_exr`]: OpenEXR with render [`Metadata`] in header attributes; `f32`
-//!   or `f16` samples; AOVs as `<layer>.<channel>` channels.
+//!   or `f16` samples; AOVs as `<layer>.<channel>` channels. The writer never stores NaN or
+//!   ±inf: it fails with [`Error::NonFinite`] unless [`ExrOptions::sanitize`] is set. The reader
+//!   also reads plain RGB(A) EXRs from other tools (e.g. environment maps).
 //! - [`write_png`]: 8-bit sRGB preview with exposure and an optional filmic curve ([`ToneMap`]).
 //! - [`frame_path`], [`output_path`], [`png_beside`]: output path patterns (`frame_####.exr`).
 //! - [`compare`] → [`Metrics`] (RMSE, relMSE, MAE, 8×8 block RMSE, mean ratios, FLIP,

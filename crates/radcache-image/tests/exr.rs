@@ -11,7 +11,7 @@ use radcache_image::{
     read_exr, write_atomic, write_exr, Error, ExrOptions, Image, Layer, Metadata,
 };
 
-/// A 5×3 image with awkward values and all three standard AOVs.
+/// A 5×3 image with awkward (finite) values and all three standard AOVs.
 fn test_image() -> Image {
     let (w, h) = (5, 3);
     let special = [
@@ -21,9 +21,9 @@ fn test_image() -> Image {
         -2.5,
         1.0e-40, // subnormal
         3.0e38,
-        f32::INFINITY,
-        f32::NEG_INFINITY,
-        f32::NAN,
+        f32::MAX,
+        -f32::MAX,
+        f32::MIN_POSITIVE,
         0.1,
     ];
     let rgb = (0..w * h * 3)

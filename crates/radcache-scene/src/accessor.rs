@@ -5,14 +5,15 @@
 //! [`Error::Accessor`] naming the accessor, its user (mesh/primitive/attribute or animation) and
 //! the buffer view, instead of a panic.
 
-use gltf::accessor::{DataType, Dimensions};
 use glam::{Vec2, Vec3, Vec4};
+use gltf::accessor::{DataType, Dimensions};
 
 use crate::error::{label, Error, Result};
 use crate::resources::Source;
 
-/// Accessors without a buffer view are zero-filled; refuse absurd sizes for them.
-const MAX_ZERO_FILL_BYTES: usize = 1 << 28;
+/// Accessors without a buffer view are zero-filled; refuse absurd sizes for them (in components,
+/// each held as an f64 while reading: 2^24 components = 128 MiB).
+const MAX_ZERO_FILL_COMPONENTS: usize = 1 << 24;
 
 fn component_size(t: DataType) -> usize {
     match t {
@@ -80,7 +81,15 @@ impl Reader<'_> {
     }
 
     /// Checks that `count` elements of `elem` bytes at `offset` with `stride` fit in `len` bytes.
-    fn check_range(&self, what: &str, offset: usize, stride: usize, elem: usize, count: usize, len: usize) -> Result<()> {
+    fn check_range(
+        &self,
+        what: &str,
+        offset: usize,
+        stride: usize,
+        elem: usize,
+        count: usize,
+        len: usize,
+    ) -> Result<()> {
         if count == 0 {
             return Ok(());
         }
@@ -114,7 +123,9 @@ impl Reader<'_> {
             let bytes = self.view_bytes(&view)?;
             let stride = view.stride().unwrap_or(elem);
             if stride < elem {
-                return Err(self.err(format!("byteStride {stride} is smaller than the element size {elem}")));
+                return Err(self.err(format!(
+                    "byteStride {stride} is smaller than the element size {elem}"
+                )));
             }
             self.check_range("accessor", acc.offset(), stride, elem, count, bytes.len())?;
             out = Vec::with_capacity(count * comps);
@@ -126,8 +137,13 @@ impl Reader<'_> {
                 }
             }
         } else {
-            if count.checked_mul(elem).is_none_or(|n| n > MAX_ZERO_FILL_BYTES) {
-                return Err(self.err(format!("count {count} is too large for an accessor without bufferView")));
+            if count
+                .checked_mul(comps)
+                .is_none_or(|n| n > MAX_ZERO_FILL_COMPONENTS)
+            {
+                return Err(self.err(format!(
+                    "count {count} is too large for an accessor without bufferView"
+                )));
             }
             out = vec![0.0; count * comps];
         }
@@ -162,7 +178,14 @@ impl Reader<'_> {
             IndexType::U32 => DataType::U32,
         };
         let ibytes = self.view_bytes(&ind.view())?;
-        self.check_range("sparse indices", ind.offset(), isize, isize, n, ibytes.len())?;
+        self.check_range(
+            "sparse indices",
+            ind.offset(),
+            isize,
+            isize,
+            n,
+            ibytes.len(),
+        )?;
         let vals = sparse.values();
         let csize = component_size(t);
         let elem = comps * csize;
@@ -195,11 +218,18 @@ pub(crate) fn element_label(acc: &gltf::Accessor<'_>, user: &str) -> String {
 
 /// Reads a float-valued accessor with `comps` components per element, normalizing integer
 /// components where the accessor says `normalized` (glTF spec, "Animations"/"Meshes").
-pub(crate) fn read_floats(src: &Source, acc: &gltf::Accessor<'_>, user: &str, comps: usize) -> Result<Vec<f32>> {
+pub(crate) fn read_floats(
+    src: &Source,
+    acc: &gltf::Accessor<'_>,
+    user: &str,
+    comps: usize,
+) -> Result<Vec<f32>> {
     let r = reader(src, acc, user);
     let (have, raw) = r.raw(acc)?;
     if have != comps {
-        return Err(r.err(format!("expected {comps} components per element, found {have}")));
+        return Err(r.err(format!(
+            "expected {comps} components per element, found {have}"
+        )));
     }
     let t = acc.data_type();
     let norm = acc.normalized() || t == DataType::F32;
@@ -208,7 +238,13 @@ pub(crate) fn read_floats(src: &Source, acc: &gltf::Accessor<'_>, user: &str, co
     }
     Ok(raw
         .into_iter()
-        .map(|v| if norm { normalize(t, v) as f32 } else { v as f32 })
+        .map(|v| {
+            if norm {
+                normalize(t, v) as f32
+            } else {
+                v as f32
+            }
+        })
         .collect())
 }
 
@@ -229,7 +265,12 @@ pub(crate) fn read_vec2(src: &Source, acc: &gltf::Accessor<'_>, user: &str) -> R
 }
 
 /// Reads a float accessor of any of 1..=4 components into `Vec4`s (unused lanes zero).
-pub(crate) fn read_any_vec(src: &Source, acc: &gltf::Accessor<'_>, user: &str, comps: usize) -> Result<Vec<Vec4>> {
+pub(crate) fn read_any_vec(
+    src: &Source,
+    acc: &gltf::Accessor<'_>,
+    user: &str,
+    comps: usize,
+) -> Result<Vec<Vec4>> {
     let data = read_floats(src, acc, user, comps)?;
     Ok(data
         .chunks_exact(comps.max(1))
@@ -244,8 +285,14 @@ pub(crate) fn read_any_vec(src: &Source, acc: &gltf::Accessor<'_>, user: &str, c
 /// Reads a SCALAR index accessor of unsigned byte/short/int components.
 pub(crate) fn read_indices(src: &Source, acc: &gltf::Accessor<'_>, user: &str) -> Result<Vec<u32>> {
     let r = reader(src, acc, user);
-    if !matches!(acc.data_type(), DataType::U8 | DataType::U16 | DataType::U32) {
-        return Err(r.err(format!("index component type {:?} is not an unsigned integer", acc.data_type())));
+    if !matches!(
+        acc.data_type(),
+        DataType::U8 | DataType::U16 | DataType::U32
+    ) {
+        return Err(r.err(format!(
+            "index component type {:?} is not an unsigned integer",
+            acc.data_type()
+        )));
     }
     let (comps, raw) = r.raw(acc)?;
     if comps != 1 {

@@ -24,7 +24,13 @@ impl AliasTable {
     pub fn new(weights: &[f32]) -> AliasTable {
         let w: Vec<f64> = weights
             .iter()
-            .map(|&x| if x.is_finite() && x > 0.0 { f64::from(x) } else { 0.0 })
+            .map(|&x| {
+                if x.is_finite() && x > 0.0 {
+                    f64::from(x)
+                } else {
+                    0.0
+                }
+            })
             .collect();
         let total: f64 = w.iter().sum();
         let n = w.len();
@@ -34,7 +40,8 @@ impl AliasTable {
         let mut scaled: Vec<f64> = w.iter().map(|x| x * n as f64 / total).collect();
         let mut prob = vec![1.0f32; n];
         let mut alias: Vec<u32> = (0..n as u32).collect();
-        let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
+        let (mut small, mut large): (Vec<usize>, Vec<usize>) =
+            (0..n).partition(|&i| scaled[i] < 1.0);
         while let (Some(&l), Some(&g)) = (small.last(), large.last()) {
             small.pop();
             prob[l] = scaled[l] as f32;
@@ -74,7 +81,11 @@ impl AliasTable {
         let x = f64::from(u.clamp(0.0, 1.0)) * n as f64;
         let i = (x as usize).min(n - 1);
         let frac = (x - i as f64) as f32;
-        let k = if frac < self.prob[i] { i } else { self.alias[i] as usize };
+        let k = if frac < self.prob[i] {
+            i
+        } else {
+            self.alias[i] as usize
+        };
         Some((k, self.pmf[k]))
     }
 }

@@ -92,20 +92,32 @@ impl Sampler {
         let v0 = self.value(0);
         (0..self.times.len()).all(|k| self.value(k) == v0)
             && (self.interpolation != Interpolation::CubicSpline
-                || (0..self.times.len()).all(|k| self.values[3 * k] == Vec4::ZERO && self.values[3 * k + 2] == Vec4::ZERO))
+                || (0..self.times.len()).all(|k| {
+                    self.values[3 * k] == Vec4::ZERO && self.values[3 * k + 2] == Vec4::ZERO
+                }))
     }
 
     /// The value at time `t` (rotations normalized when `property` is `Rotation`).
     pub fn sample(&self, t: f32, property: Property) -> Vec4 {
         let n = self.times.len();
-        let fix = |v: Vec4| if property == Property::Rotation { Vec4::from(quat(v)) } else { v };
+        let fix = |v: Vec4| {
+            if property == Property::Rotation {
+                Vec4::from(quat(v))
+            } else {
+                v
+            }
+        };
         if n == 1 || t.is_nan() || t <= self.times[0] {
             return fix(self.value(0));
         }
         if t >= self.times[n - 1] {
             return fix(self.value(n - 1));
         }
-        let k = self.times.partition_point(|&x| x <= t).saturating_sub(1).min(n - 2);
+        let k = self
+            .times
+            .partition_point(|&x| x <= t)
+            .saturating_sub(1)
+            .min(n - 2);
         let dt = self.times[k + 1] - self.times[k];
         let s = (t - self.times[k]) / dt;
         match self.interpolation {
@@ -155,7 +167,12 @@ pub(crate) fn load_animations(src: &Source, warnings: &mut Warnings) -> Result<V
         let mut channels = Vec::new();
         // Channel targets are read from the JSON: gltf 1.4 does not validate them and its
         // `Target::node`/`property` unwrap.
-        let json_channels = src.doc.as_json().animations.get(anim.index()).map_or(&[][..], |a| &a.channels[..]);
+        let json_channels = src
+            .doc
+            .as_json()
+            .animations
+            .get(anim.index())
+            .map_or(&[][..], |a| &a.channels[..]);
         for (ci, ch) in json_channels.iter().enumerate() {
             let user = format!("{anim_label} channel {ci}");
             let invalid = |reason: String| Error::Invalid {
@@ -168,7 +185,10 @@ pub(crate) fn load_animations(src: &Source, warnings: &mut Warnings) -> Result<V
                 return Err(invalid(format!("target node {node} does not exist")));
             }
             let Some(sampler) = anim.samplers().nth(ch.sampler.value()) else {
-                return Err(invalid(format!("sampler {} does not exist", ch.sampler.value())));
+                return Err(invalid(format!(
+                    "sampler {} does not exist",
+                    ch.sampler.value()
+                )));
             };
             use gltf::json::animation::Property as P;
             use gltf::json::validation::Checked;
@@ -178,7 +198,10 @@ pub(crate) fn load_animations(src: &Source, warnings: &mut Warnings) -> Result<V
                 Checked::Valid(P::Scale) => Property::Scale,
                 Checked::Invalid => return Err(invalid("invalid target path".into())),
                 Checked::Valid(P::MorphTargetWeights) => {
-                    let msg = format!("{}: {user}: morph weights channel ignored", src.path.display());
+                    let msg = format!(
+                        "{}: {user}: morph weights channel ignored",
+                        src.path.display()
+                    );
                     warnings.push(WarningKind::WeightsChannelIgnored, 1, msg);
                     continue;
                 }
@@ -188,7 +211,11 @@ pub(crate) fn load_animations(src: &Source, warnings: &mut Warnings) -> Result<V
                 warnings.push(WarningKind::DuplicateChannel, 1, msg);
             }
             let sampler = load_sampler(src, &sampler, property, &user)?;
-            channels.push(Channel { node, property, sampler });
+            channels.push(Channel {
+                node,
+                property,
+                sampler,
+            });
         }
         out.push(Animation {
             name: anim.name().map(str::to_string),
@@ -198,7 +225,12 @@ pub(crate) fn load_animations(src: &Source, warnings: &mut Warnings) -> Result<V
     Ok(out)
 }
 
-fn load_sampler(src: &Source, s: &gltf::animation::Sampler<'_>, property: Property, user: &str) -> Result<Sampler> {
+fn load_sampler(
+    src: &Source,
+    s: &gltf::animation::Sampler<'_>,
+    property: Property,
+    user: &str,
+) -> Result<Sampler> {
     let invalid = |element: String, reason: String| Error::Invalid {
         path: src.path(),
         element,
@@ -239,12 +271,23 @@ fn load_sampler(src: &Source, s: &gltf::animation::Sampler<'_>, property: Proper
             position,
         });
     }
-    let per_key = if interpolation == Interpolation::CubicSpline { 3 } else { 1 };
+    let per_key = if interpolation == Interpolation::CubicSpline {
+        3
+    } else {
+        1
+    };
     if values.len() != per_key * times.len() {
-        let reason = format!("{} output values for {} keys ({interpolation:?} needs {})", values.len(), times.len(), per_key * times.len());
+        let reason = format!(
+            "{} output values for {} keys ({interpolation:?} needs {})",
+            values.len(),
+            times.len(),
+            per_key * times.len()
+        );
         return Err(invalid(out_label, reason));
     }
-    if property == Property::Rotation && (0..times.len()).any(|k| values[per_key * k + per_key / 2].length_squared() < 1e-12) {
+    if property == Property::Rotation
+        && (0..times.len()).any(|k| values[per_key * k + per_key / 2].length_squared() < 1e-12)
+    {
         return Err(invalid(out_label, "zero-length rotation quaternion".into()));
     }
     Ok(Sampler {

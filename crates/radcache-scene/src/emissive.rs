@@ -49,7 +49,11 @@ impl EmissiveTriangle {
         if len.is_nan() || len <= 0.0 || !len.is_finite() {
             return None;
         }
-        let flip = if world_from_object.determinant() < 0.0 { -1.0 } else { 1.0 };
+        let flip = if world_from_object.determinant() < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
         Some(EmissiveTriangle {
             instance: ids.0,
             mesh: ids.1,

@@ -86,10 +86,15 @@ pub(crate) fn scene_radiance(extras: &gltf::json::Extras) -> Result<Option<Vec3>
     let Some(rad) = value.get("environment").and_then(|e| e.get("radiance")) else {
         return Ok(None);
     };
-    let arr = rad.as_array().filter(|a| a.len() == 3).ok_or("environment.radiance must be [r, g, b]")?;
+    let arr = rad
+        .as_array()
+        .filter(|a| a.len() == 3)
+        .ok_or("environment.radiance must be [r, g, b]")?;
     let mut out = [0.0f32; 3];
     for (o, v) in out.iter_mut().zip(arr) {
-        let x = v.as_f64().ok_or("environment.radiance entries must be numbers")? as f32;
+        let x = v
+            .as_f64()
+            .ok_or("environment.radiance entries must be numbers")? as f32;
         if !x.is_finite() || x < 0.0 {
             return Err("environment.radiance entries must be finite and non-negative".into());
         }
@@ -133,12 +138,23 @@ mod tests {
     fn resolution_priority() {
         let scene = Some(Vec3::splat(0.5));
         let mut o = EnvOverride::default();
-        assert_eq!(Environment::resolve(&o, scene), Environment::Constant(Vec3::splat(0.5)));
+        assert_eq!(
+            Environment::resolve(&o, scene),
+            Environment::Constant(Vec3::splat(0.5))
+        );
         o.scale = 2.0;
         o.radiance = Some([1.0, 2.0, 3.0]);
-        assert_eq!(Environment::resolve(&o, scene), Environment::Constant(Vec3::new(2.0, 4.0, 6.0)));
+        assert_eq!(
+            Environment::resolve(&o, scene),
+            Environment::Constant(Vec3::new(2.0, 4.0, 6.0))
+        );
         o.map = Some("sky.exr".into());
-        assert!(matches!(Environment::resolve(&o, scene), Environment::Map { scale, .. } if scale == 2.0));
-        assert_eq!(Environment::resolve(&EnvOverride::default(), None), Environment::None);
+        assert!(
+            matches!(Environment::resolve(&o, scene), Environment::Map { scale, .. } if scale == 2.0)
+        );
+        assert_eq!(
+            Environment::resolve(&EnvOverride::default(), None),
+            Environment::None
+        );
     }
 }

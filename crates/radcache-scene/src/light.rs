@@ -18,6 +18,9 @@
 
 use glam::{Mat4, Vec3};
 
+use crate::error::{label, Error, Result};
+use crate::resources::Source;
+
 /// The kind of a punctual light.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum LightKind {
@@ -113,7 +116,9 @@ impl WorldLight {
             intensity: light.intensity,
             range: light.range,
             position: world_from_node.transform_point3(Vec3::ZERO),
-            direction: world_from_node.transform_vector3(-Vec3::Z).normalize_or(-Vec3::Z),
+            direction: world_from_node
+                .transform_vector3(-Vec3::Z)
+                .normalize_or(-Vec3::Z),
         }
     }
 
@@ -152,31 +157,60 @@ impl WorldLight {
     }
 }
 
-/// Loads the document's light definitions (empty without the extension).
-pub(crate) fn load_lights(doc: &gltf::Document) -> Vec<PunctualLight> {
-    let Some(lights) = doc.lights() else {
-        return Vec::new();
+/// Loads the document's light definitions (empty without the extension). Values the extension
+/// forbids are errors naming the light: a negative or non-finite intensity or colour component,
+/// and spot cones outside `0 ≤ inner < outer ≤ π/2`.
+pub(crate) fn load_lights(src: &Source) -> Result<Vec<PunctualLight>> {
+    let Some(lights) = src.doc.lights() else {
+        return Ok(Vec::new());
     };
-    lights
-        .map(|l| {
-            let kind = match l.kind() {
-                gltf::khr_lights_punctual::Kind::Point => LightKind::Point,
-                gltf::khr_lights_punctual::Kind::Directional => LightKind::Directional,
-                gltf::khr_lights_punctual::Kind::Spot {
+    let mut out = Vec::new();
+    for l in lights {
+        let invalid = |reason: String| Error::Invalid {
+            path: src.path(),
+            element: label("KHR_lights_punctual light", l.index(), l.name()),
+            reason,
+        };
+        let kind = match l.kind() {
+            gltf::khr_lights_punctual::Kind::Point => LightKind::Point,
+            gltf::khr_lights_punctual::Kind::Directional => LightKind::Directional,
+            gltf::khr_lights_punctual::Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                let ok = inner_cone_angle >= 0.0
+                    && inner_cone_angle < outer_cone_angle
+                    && outer_cone_angle <= std::f32::consts::FRAC_PI_2 + 1e-6;
+                if !ok {
+                    return Err(invalid(format!(
+                        "spot cone angles must satisfy 0 <= inner ({inner_cone_angle}) < outer ({outer_cone_angle}) <= pi/2"
+                    )));
+                }
+                LightKind::Spot {
                     inner_cone_angle,
                     outer_cone_angle,
-                } => LightKind::Spot {
-                    inner_cone_angle,
-                    outer_cone_angle,
-                },
-            };
-            PunctualLight {
-                name: l.name().map(str::to_string),
-                kind,
-                color: Vec3::from(l.color()),
-                intensity: l.intensity(),
-                range: l.range().filter(|r| *r > 0.0 && r.is_finite()),
+                }
             }
-        })
-        .collect()
+        };
+        let color = Vec3::from(l.color());
+        if !color.is_finite() || color.min_element() < 0.0 {
+            return Err(invalid(format!(
+                "colour {color} must be finite and non-negative"
+            )));
+        }
+        let intensity = l.intensity();
+        if !intensity.is_finite() || intensity < 0.0 {
+            return Err(invalid(format!(
+                "intensity {intensity} must be finite and non-negative"
+            )));
+        }
+        out.push(PunctualLight {
+            name: l.name().map(str::to_string),
+            kind,
+            color,
+            intensity,
+            range: l.range().filter(|r| *r > 0.0 && r.is_finite()),
+        });
+    }
+    Ok(out)
 }

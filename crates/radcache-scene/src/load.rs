@@ -69,7 +69,7 @@ impl Scene {
         for &n in &order {
             dynamic[n] = animated[n] || nodes[n].parent.is_some_and(|p| dynamic[p]);
         }
-        let lights = load_lights(&src.doc);
+        let lights = load_lights(&src)?;
         let light_instances = order
             .iter()
             .filter_map(|&n| nodes[n].light.map(|light| (n, light)))
@@ -93,7 +93,9 @@ impl Scene {
             .iter()
             .map(|m| {
                 let tex = m.emissive_texture.map_or(Vec3::ONE, |t| {
-                    textures.images[textures.textures[t.texture].image].mean_linear().truncate()
+                    textures.images[textures.textures[t.texture].image]
+                        .mean_linear()
+                        .truncate()
                 });
                 m.emissive * tex
             })
@@ -131,10 +133,15 @@ fn scene_roots(src: &Source, nodes: &[Node], w: &mut Warnings) -> Vec<usize> {
         Some(s) => s.nodes().map(|n| n.index()).collect(),
         None => {
             if !nodes.is_empty() {
-                let msg = format!("{}: no scene defined; using every parentless node as a root", src.path.display());
+                let msg = format!(
+                    "{}: no scene defined; using every parentless node as a root",
+                    src.path.display()
+                );
                 w.push(WarningKind::Other, 1, msg);
             }
-            (0..nodes.len()).filter(|&i| nodes[i].parent.is_none()).collect()
+            (0..nodes.len())
+                .filter(|&i| nodes[i].parent.is_none())
+                .collect()
         }
     }
 }
@@ -145,7 +152,11 @@ fn resolve_environment(src: &Source, opts: &LoadOptions, w: &mut Warnings) -> En
         Some(s) => match scene_radiance(s.extras()) {
             Ok(r) => r,
             Err(e) => {
-                let msg = format!("{}: {}: extras.environment ignored: {e}", src.path.display(), label("scene", s.index(), s.name()));
+                let msg = format!(
+                    "{}: {}: extras.environment ignored: {e}",
+                    src.path.display(),
+                    label("scene", s.index(), s.name())
+                );
                 w.push(WarningKind::Other, 1, msg);
                 None
             }
@@ -163,7 +174,12 @@ fn camera_name(node: &Node, index: usize, cam_name: Option<&str>) -> String {
         .unwrap_or_else(|| format!("#{index}"))
 }
 
-fn select_camera(src: &Source, scene: &Scene, opts: &LoadOptions, w: &mut Warnings) -> Result<Camera> {
+fn select_camera(
+    src: &Source,
+    scene: &Scene,
+    opts: &LoadOptions,
+    w: &mut Warnings,
+) -> Result<Camera> {
     let defs = camera_defs(&src.doc);
     let candidates: Vec<(usize, usize)> = scene
         .order
@@ -174,7 +190,8 @@ fn select_camera(src: &Source, scene: &Scene, opts: &LoadOptions, w: &mut Warnin
     let chosen = match &opts.camera_name {
         Some(want) => {
             let found = candidates.iter().find(|&&(n, c)| {
-                scene.nodes[n].name.as_deref() == Some(want.as_str()) || defs[c].0.as_deref() == Some(want.as_str())
+                scene.nodes[n].name.as_deref() == Some(want.as_str())
+                    || defs[c].0.as_deref() == Some(want.as_str())
             });
             match found {
                 Some(&f) => Some(f),
@@ -193,11 +210,18 @@ fn select_camera(src: &Source, scene: &Scene, opts: &LoadOptions, w: &mut Warnin
         None => candidates.first().copied(),
     };
     let Some((node, cam)) = chosen else {
-        let msg = format!("{}: the scene has no camera; using a default camera framing the scene bounds", src.path.display());
+        let msg = format!(
+            "{}: the scene has no camera; using a default camera framing the scene bounds",
+            src.path.display()
+        );
         w.push(WarningKind::DefaultCamera, 1, msg);
         return Ok(Camera::framing(&scene.bounds_at(0.0)));
     };
-    let element = format!("{} {}", scene.nodes[node].label(node), label("camera", cam, defs[cam].0.as_deref()));
+    let element = format!(
+        "{} {}",
+        scene.nodes[node].label(node),
+        label("camera", cam, defs[cam].0.as_deref())
+    );
     match &defs[cam].1 {
         CameraDef::Perspective(p) => Ok(Camera {
             name: camera_name(&scene.nodes[node], node, defs[cam].0.as_deref()),

@@ -82,7 +82,11 @@ pub fn emitted_radiance(normal: Vec3, radiance: Vec3, double_sided: bool, dir: V
 }
 
 /// Loads all glTF materials in order (the default material is appended by the caller if used).
-pub(crate) fn load_materials(src: &Source, textures: &mut TextureLoader, warnings: &mut Warnings) -> Result<Vec<Material>> {
+pub(crate) fn load_materials(
+    src: &Source,
+    textures: &mut TextureLoader,
+    warnings: &mut Warnings,
+) -> Result<Vec<Material>> {
     let mut out = Vec::new();
     for m in src.doc.materials() {
         let index = m.index().unwrap_or(out.len());
@@ -103,21 +107,45 @@ pub(crate) fn load_materials(src: &Source, textures: &mut TextureLoader, warning
             if v.is_finite() {
                 v.clamp(lo, hi)
             } else {
-                warnings.push(WarningKind::Other, 1, format!("{file}: {user}: non-finite {what}; using {lo}"));
+                warnings.push(
+                    WarningKind::Other,
+                    1,
+                    format!("{file}: {user}: non-finite {what}; using {lo}"),
+                );
                 lo
             }
         };
-        let base_color = Vec4::from_array(base_color.to_array().map(|c| sane(c, "base colour", 0.0, 1.0)));
-        let emissive = Vec3::from_array(emissive.to_array().map(|c| sane(c, "emission", 0.0, f32::MAX)));
+        let base_color = Vec4::from_array(
+            base_color
+                .to_array()
+                .map(|c| sane(c, "base colour", 0.0, 1.0)),
+        );
+        let emissive = Vec3::from_array(
+            emissive
+                .to_array()
+                .map(|c| sane(c, "emission", 0.0, f32::MAX)),
+        );
         let metallic = sane(pbr.metallic_factor(), "metallic factor", 0.0, 1.0);
         let roughness = sane(pbr.roughness_factor(), "roughness factor", 0.0, 1.0);
         out.push(Material {
             name: m.name().map(str::to_string),
             base_color,
-            base_color_texture: textures.get(src, pbr.base_color_texture(), true, &user, warnings)?,
+            base_color_texture: textures.get(
+                src,
+                pbr.base_color_texture(),
+                true,
+                &user,
+                warnings,
+            )?,
             metallic,
             roughness,
-            metallic_roughness_texture: textures.get(src, pbr.metallic_roughness_texture(), false, &user, warnings)?,
+            metallic_roughness_texture: textures.get(
+                src,
+                pbr.metallic_roughness_texture(),
+                false,
+                &user,
+                warnings,
+            )?,
             emissive,
             emissive_texture: textures.get(src, m.emissive_texture(), true, &user, warnings)?,
             double_sided: m.double_sided(),

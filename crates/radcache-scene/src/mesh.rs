@@ -95,7 +95,12 @@ struct PrimData {
     indices: Vec<u32>,
 }
 
-fn check_finite<T: Copy>(src: &Source, element: String, data: &[T], finite: impl Fn(T) -> bool) -> Result<()> {
+fn check_finite<T: Copy>(
+    src: &Source,
+    element: String,
+    data: &[T],
+    finite: impl Fn(T) -> bool,
+) -> Result<()> {
     match data.iter().position(|&v| !finite(v)) {
         Some(position) => Err(Error::NonFinite {
             path: src.path(),
@@ -125,7 +130,11 @@ pub(crate) fn load_mesh(
             warnings.push(
                 WarningKind::UnsupportedPrimitiveMode,
                 1,
-                format!("{}: {user}: mode {:?} is not TRIANGLES; skipped", src.path.display(), prim.mode()),
+                format!(
+                    "{}: {user}: mode {:?} is not TRIANGLES; skipped",
+                    src.path.display(),
+                    prim.mode()
+                ),
             );
             continue;
         }
@@ -133,14 +142,25 @@ pub(crate) fn load_mesh(
             warnings.push(
                 WarningKind::SkinOrMorphIgnored,
                 1,
-                format!("{}: {user}: morph targets ignored (rest pose used)", src.path.display()),
+                format!(
+                    "{}: {user}: morph targets ignored (rest pose used)",
+                    src.path.display()
+                ),
             );
         }
         let Some(data) = read_primitive(src, &prim, &user, warnings)? else {
             continue;
         };
         let material = material_of(prim.material().index());
-        append_primitive(src, &mut mesh, data, prim.index(), material, &user, warnings)?;
+        append_primitive(
+            src,
+            &mut mesh,
+            data,
+            prim.index(),
+            material,
+            &user,
+            warnings,
+        )?;
     }
     for &p in &mesh.positions {
         mesh.bounds.extend(p);
@@ -148,18 +168,31 @@ pub(crate) fn load_mesh(
     Ok(mesh)
 }
 
-fn read_primitive(src: &Source, prim: &gltf::Primitive<'_>, user: &str, warnings: &mut Warnings) -> Result<Option<PrimData>> {
+fn read_primitive(
+    src: &Source,
+    prim: &gltf::Primitive<'_>,
+    user: &str,
+    warnings: &mut Warnings,
+) -> Result<Option<PrimData>> {
     let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
         warnings.push(
             WarningKind::Other,
             1,
-            format!("{}: {user}: no POSITION attribute; skipped", src.path.display()),
+            format!(
+                "{}: {user}: no POSITION attribute; skipped",
+                src.path.display()
+            ),
         );
         return Ok(None);
     };
     let pos_user = format!("{user} POSITION");
     let positions = accessor::read_vec3(src, &pos_acc, &pos_user)?;
-    check_finite(src, accessor::element_label(&pos_acc, &pos_user), &positions, |v| v.is_finite())?;
+    check_finite(
+        src,
+        accessor::element_label(&pos_acc, &pos_user),
+        &positions,
+        |v| v.is_finite(),
+    )?;
     let n = positions.len();
     let count_err = |acc: &gltf::Accessor<'_>, what: &str, have: usize| Error::Accessor {
         path: src.path(),
@@ -170,7 +203,9 @@ fn read_primitive(src: &Source, prim: &gltf::Primitive<'_>, user: &str, warnings
         Some(acc) => {
             let u = format!("{user} NORMAL");
             let v = accessor::read_vec3(src, &acc, &u)?;
-            check_finite(src, accessor::element_label(&acc, &u), &v, |v| v.is_finite())?;
+            check_finite(src, accessor::element_label(&acc, &u), &v, |v| {
+                v.is_finite()
+            })?;
             if v.len() != n {
                 return Err(count_err(&acc, "NORMAL", v.len()));
             }
@@ -182,7 +217,9 @@ fn read_primitive(src: &Source, prim: &gltf::Primitive<'_>, user: &str, warnings
         Some(acc) => {
             let u = format!("{user} TEXCOORD_0");
             let v = accessor::read_vec2(src, &acc, &u)?;
-            check_finite(src, accessor::element_label(&acc, &u), &v, |v| v.is_finite())?;
+            check_finite(src, accessor::element_label(&acc, &u), &v, |v| {
+                v.is_finite()
+            })?;
             if v.len() != n {
                 return Err(count_err(&acc, "TEXCOORD_0", v.len()));
             }
@@ -262,7 +299,10 @@ fn append_primitive(
         warnings.push(
             WarningKind::DegenerateTriangles,
             dropped,
-            format!("{}: {user}: dropped {dropped} degenerate triangle(s)", src.path.display()),
+            format!(
+                "{}: {user}: dropped {dropped} degenerate triangle(s)",
+                src.path.display()
+            ),
         );
     }
     let usable_normals = normals.filter(|ns| ns.iter().all(|v| v.length_squared() > 1e-20));
@@ -289,7 +329,10 @@ fn append_primitive(
             warnings.push(
                 WarningKind::GeneratedNormals,
                 1,
-                format!("{}: {user}: missing or zero-length normals; flat normals generated", src.path.display()),
+                format!(
+                    "{}: {user}: missing or zero-length normals; flat normals generated",
+                    src.path.display()
+                ),
             );
             u32::try_from(first_vertex + 3 * kept.len()).map_err(|_| too_big())?;
             for t in &kept {
@@ -304,7 +347,8 @@ fn append_primitive(
             }
         }
     }
-    mesh.triangle_materials.extend(std::iter::repeat_n(material, kept.len()));
+    mesh.triangle_materials
+        .extend(std::iter::repeat_n(material, kept.len()));
     mesh.primitives.push(PrimitiveRange {
         gltf_primitive,
         material,

@@ -60,7 +60,11 @@ impl Node {
 }
 
 /// Reads all nodes with checked transforms; `animated[i]` marks TRS-animated nodes.
-pub(crate) fn load_nodes(src: &Source, animated: &[bool], warnings: &mut Warnings) -> Result<Vec<Node>> {
+pub(crate) fn load_nodes(
+    src: &Source,
+    animated: &[bool],
+    warnings: &mut Warnings,
+) -> Result<Vec<Node>> {
     let mut nodes = Vec::new();
     for n in src.doc.nodes() {
         let i = n.index();
@@ -78,7 +82,10 @@ pub(crate) fn load_nodes(src: &Source, animated: &[bool], warnings: &mut Warning
                 }
                 if animated.get(i).copied().unwrap_or(false) {
                     let (scale, rotation, translation) = m.to_scale_rotation_translation();
-                    let msg = format!("{}: {node_label}: animated node uses a matrix; decomposed to TRS", src.path.display());
+                    let msg = format!(
+                        "{}: {node_label}: animated node uses a matrix; decomposed to TRS",
+                        src.path.display()
+                    );
                     warnings.push(WarningKind::MatrixNodeAnimated, 1, msg);
                     LocalTransform::Trs(Trs {
                         translation,
@@ -94,7 +101,11 @@ pub(crate) fn load_nodes(src: &Source, animated: &[bool], warnings: &mut Warning
                 rotation,
                 scale,
             } => {
-                let (t, r, s) = (Vec3::from(translation), Quat::from_array(rotation), Vec3::from(scale));
+                let (t, r, s) = (
+                    Vec3::from(translation),
+                    Quat::from_array(rotation),
+                    Vec3::from(scale),
+                );
                 if !t.is_finite() || !r.is_finite() || !s.is_finite() {
                     return Err(invalid("non-finite translation, rotation or scale"));
                 }
@@ -109,7 +120,10 @@ pub(crate) fn load_nodes(src: &Source, animated: &[bool], warnings: &mut Warning
             }
         };
         if n.skin().is_some() {
-            let msg = format!("{}: {node_label}: skin ignored (rest pose used)", src.path.display());
+            let msg = format!(
+                "{}: {node_label}: skin ignored (rest pose used)",
+                src.path.display()
+            );
             warnings.push(WarningKind::SkinOrMorphIgnored, 1, msg);
         }
         nodes.push(Node {
@@ -152,7 +166,11 @@ fn link_parents(src: &Source, nodes: &mut [Node]) -> Result<()> {
 }
 
 /// Marks the nodes reachable from `roots` and returns them in traversal order.
-pub(crate) fn traversal_order(src: &Source, nodes: &mut [Node], roots: &[usize]) -> Result<Vec<usize>> {
+pub(crate) fn traversal_order(
+    src: &Source,
+    nodes: &mut [Node],
+    roots: &[usize],
+) -> Result<Vec<usize>> {
     let mut order = Vec::new();
     let mut stack: Vec<usize> = roots.iter().rev().copied().collect();
     for &r in roots {
@@ -165,7 +183,9 @@ pub(crate) fn traversal_order(src: &Source, nodes: &mut [Node], roots: &[usize])
         }
     }
     while let Some(n) = stack.pop() {
-        let Some(node) = nodes.get_mut(n) else { continue };
+        let Some(node) = nodes.get_mut(n) else {
+            continue;
+        };
         if node.in_scene {
             // With single parents this only happens for a cycle or a repeated root.
             return Err(Error::Invalid {

@@ -153,13 +153,21 @@ impl fmt::Display for ScenePlan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "plan:")?;
         if self.has_emissive() {
-            writeln!(f, "  emissive triangles: {} (power {:.4} W)", self.emissive_triangles, self.emissive_power)?;
+            writeln!(
+                f,
+                "  emissive triangles: {} (power {:.4} W)",
+                self.emissive_triangles, self.emissive_power
+            )?;
         } else {
             writeln!(f, "  emissive triangles: none")?;
         }
         let l = &self.lights;
         if self.has_punctual_lights() {
-            writeln!(f, "  punctual lights: {} point, {} spot, {} directional", l.point, l.spot, l.directional)?;
+            writeln!(
+                f,
+                "  punctual lights: {} point, {} spot, {} directional",
+                l.point, l.spot, l.directional
+            )?;
         } else {
             writeln!(f, "  punctual lights: none")?;
         }
@@ -169,7 +177,11 @@ impl fmt::Display for ScenePlan {
             EnvironmentKind::Map => "map",
         };
         writeln!(f, "  environment: {env}")?;
-        writeln!(f, "  textures: {}", if self.textures > 0 { "yes" } else { "no" })?;
+        writeln!(
+            f,
+            "  textures: {}",
+            if self.textures > 0 { "yes" } else { "no" }
+        )?;
         let a = &self.animation;
         let kind = match a.kind {
             AnimationKind::None => "none",
@@ -180,7 +192,13 @@ impl fmt::Display for ScenePlan {
         write!(f, "  animation: {kind}")?;
         if a.kind != AnimationKind::None {
             let yn = |b: bool| if b { "yes" } else { "no" };
-            write!(f, " (camera {}, lights {}, geometry {})", yn(a.camera), yn(a.lights), yn(a.geometry))?;
+            write!(
+                f,
+                " (camera {}, lights {}, geometry {})",
+                yn(a.camera),
+                yn(a.lights),
+                yn(a.geometry)
+            )?;
         }
         if let Some((t0, t1)) = a.time_range {
             write!(f, ", time range [{t0:.3}, {t1:.3}] s")?;

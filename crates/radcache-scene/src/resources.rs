@@ -35,6 +35,10 @@ impl Source {
             path: path.to_path_buf(),
             message: describe_gltf_error(&e),
         };
+        check_glb_header(&bytes).map_err(|message| Error::Parse {
+            path: path.to_path_buf(),
+            message,
+        })?;
         let gltf::Gltf { document, blob } =
             gltf::Gltf::from_slice_without_validation(&bytes).map_err(parse_err)?;
         let root = document.into_json();
@@ -129,7 +133,10 @@ impl Source {
         }
         match image.source() {
             gltf::image::Source::View { view, .. } => {
-                let len = self.buffers.get(view.buffer().index()).map_or(0, |b| b.0.len());
+                let len = self
+                    .buffers
+                    .get(view.buffer().index())
+                    .map_or(0, |b| b.0.len());
                 let end = view.offset().checked_add(view.length());
                 if end.is_none_or(|end| end > len) {
                     return Err(invalid(format!(
@@ -182,6 +189,26 @@ fn precheck(path: &Path, root: &gltf::json::Root) -> Result<()> {
     Ok(())
 }
 
+/// Checks a GLB header's declared length before the gltf crate reads it (gltf 1.4 subtracts the
+/// 12-byte header size from it unchecked, which overflows for a length below 12). Files that do
+/// not start with the `glTF` magic are JSON and pass.
+fn check_glb_header(bytes: &[u8]) -> std::result::Result<(), String> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let Some(len) = bytes.get(8..12) else {
+        return Err("GLB header is truncated".into());
+    };
+    let declared = u32::from_le_bytes([len[0], len[1], len[2], len[3]]) as usize;
+    if declared < 12 || declared > bytes.len() {
+        return Err(format!(
+            "GLB header declares {declared} bytes but the file has {} (and the header alone is 12)",
+            bytes.len()
+        ));
+    }
+    Ok(())
+}
+
 /// Required extensions this loader implements.
 const SUPPORTED_REQUIRED: &[&str] = &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
 
@@ -218,7 +245,10 @@ fn percent_decode(s: &str) -> Vec<u8> {
 /// Shortens data URIs for messages.
 fn short_uri(uri: &str) -> String {
     if uri.len() > 64 {
-        let cut = (0..=48).rev().find(|&i| uri.is_char_boundary(i)).unwrap_or(0);
+        let cut = (0..=48)
+            .rev()
+            .find(|&i| uri.is_char_boundary(i))
+            .unwrap_or(0);
         format!("{}...", &uri[..cut])
     } else {
         uri.to_string()

@@ -99,7 +99,9 @@ impl Scene {
     pub fn local_transforms(&self, t: f32) -> Vec<Mat4> {
         let mut trs: Vec<Option<Trs>> = vec![None; self.nodes.len()];
         for ch in self.animations.iter().flat_map(|a| &a.channels) {
-            let Some(node) = self.nodes.get(ch.node) else { continue };
+            let Some(node) = self.nodes.get(ch.node) else {
+                continue;
+            };
             let base = match node.local {
                 LocalTransform::Trs(b) => b,
                 LocalTransform::Matrix(_) => continue,
@@ -164,7 +166,13 @@ impl Scene {
                 }
                 let ids = (ii, inst.mesh, tri);
                 let local = mesh.triangle(tri);
-                tris.extend(EmissiveTriangle::new(ids, &local, m, radiance, material.double_sided));
+                tris.extend(EmissiveTriangle::new(
+                    ids,
+                    &local,
+                    m,
+                    radiance,
+                    material.double_sided,
+                ));
             }
         }
         EmitterTable::new(tris)
@@ -176,7 +184,9 @@ impl Scene {
         self.instances
             .iter()
             .zip(&xforms)
-            .fold(Aabb::EMPTY, |b, (i, m)| b.union(&self.meshes[i.mesh].bounds.transformed(m)))
+            .fold(Aabb::EMPTY, |b, (i, m)| {
+                b.union(&self.meshes[i.mesh].bounds.transformed(m))
+            })
     }
 
     /// Bounds over the animation range: the union of `bounds_at` at every key time and at 64
@@ -187,7 +197,9 @@ impl Scene {
         };
         let mut times = self.key_times();
         times.extend((0..=64).map(|k| t0 + (t1 - t0) * k as f32 / 64.0));
-        times.iter().fold(Aabb::EMPTY, |b, &t| b.union(&self.bounds_at(t)))
+        times
+            .iter()
+            .fold(Aabb::EMPTY, |b, &t| b.union(&self.bounds_at(t)))
     }
 
     /// Number of triangles over all meshes (each counted once).
@@ -197,6 +209,9 @@ impl Scene {
 
     /// Number of triangles over all instances.
     pub fn instanced_triangle_count(&self) -> usize {
-        self.instances.iter().map(|i| self.meshes[i.mesh].triangle_count()).sum()
+        self.instances
+            .iter()
+            .map(|i| self.meshes[i.mesh].triangle_count())
+            .sum()
     }
 }

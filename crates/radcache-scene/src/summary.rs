@@ -76,11 +76,17 @@ impl fmt::Display for Scene {
         let t0 = self.time_range().map_or(0.0, |r| r.0);
         writeln!(f, "  bounds at t={t0:.3}: {}", aabb(&self.bounds_at(t0)))?;
         if self.time_range().is_some() {
-            writeln!(f, "  bounds over range: {}", aabb(&self.bounds_over_range()))?;
+            writeln!(
+                f,
+                "  bounds over range: {}",
+                aabb(&self.bounds_over_range())
+            )?;
         }
         let view = self.camera_at(t0);
         let p = &view.perspective;
-        let aspect = p.aspect_ratio.map_or("image".to_string(), |a| format!("{a:.3}"));
+        let aspect = p
+            .aspect_ratio
+            .map_or("image".to_string(), |a| format!("{a:.3}"));
         let zfar = p.zfar.map_or("inf".to_string(), |z| format!("{z:.3}"));
         writeln!(
             f,

@@ -74,6 +74,32 @@ impl Image {
         Vec4::new(d(c(0)), d(c(1)), d(c(2)), c(3))
     }
 
+    /// All texels as linear RGBA `f32` (`4 · width · height` values, rows top to bottom), sRGB
+    /// decoded when `srgb`: for uploading as `R32G32B32A32_SFLOAT` instead of `R8G8B8A8_SRGB`.
+    pub fn to_linear_f32(&self) -> Vec<f32> {
+        let lut: Vec<f32> = (0..=255u8)
+            .map(|b| {
+                let v = f32::from(b) / 255.0;
+                if self.srgb {
+                    srgb_to_linear(v)
+                } else {
+                    v
+                }
+            })
+            .collect();
+        self.rgba8
+            .chunks_exact(4)
+            .flat_map(|t| {
+                [
+                    lut[t[0] as usize],
+                    lut[t[1] as usize],
+                    lut[t[2] as usize],
+                    f32::from(t[3]) / 255.0,
+                ]
+            })
+            .collect()
+    }
+
     /// Mean linear RGBA over all texels (used to estimate textured emitters' power).
     pub fn mean_linear(&self) -> Vec4 {
         let n = u64::from(self.width) * u64::from(self.height);
@@ -94,10 +120,14 @@ impl Image {
 fn to_rgba8(data: &gltf::image::Data) -> Option<Vec<u8>> {
     use gltf::image::Format as F;
     let p = &data.pixels;
-    let u16s = || p.chunks_exact(2).map(|b| (u16::from_ne_bytes([b[0], b[1]]) >> 8) as u8);
+    let u16s = || {
+        p.chunks_exact(2)
+            .map(|b| (u16::from_ne_bytes([b[0], b[1]]) >> 8) as u8)
+    };
     let f32s = || {
-        p.chunks_exact(4)
-            .map(|b| (f32::from_ne_bytes([b[0], b[1], b[2], b[3]]).clamp(0.0, 1.0) * 255.0 + 0.5) as u8)
+        p.chunks_exact(4).map(|b| {
+            (f32::from_ne_bytes([b[0], b[1], b[2], b[3]]).clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+        })
     };
     let expand = |vals: Vec<u8>, ch: usize| -> Vec<u8> {
         vals.chunks_exact(ch)
@@ -198,7 +228,8 @@ impl TextureLoader {
             wrap_s: wrap(sampler.wrap_s()),
             wrap_t: wrap(sampler.wrap_t()),
         });
-        self.texture_map.insert(tex.index(), self.textures.len() - 1);
+        self.texture_map
+            .insert(tex.index(), self.textures.len() - 1);
         Ok(Some(TextureRef {
             texture: self.textures.len() - 1,
         }))

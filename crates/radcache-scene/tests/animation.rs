@@ -28,7 +28,11 @@ fn rotation_of(v: Vec4) -> Quat {
 
 #[test]
 fn linear_translation_with_clamping() {
-    let s = sampler(Interpolation::Linear, &[1.0, 3.0], &[v3(0.0, 0.0, 0.0), v3(2.0, 4.0, 6.0)]);
+    let s = sampler(
+        Interpolation::Linear,
+        &[1.0, 3.0],
+        &[v3(0.0, 0.0, 0.0), v3(2.0, 4.0, 6.0)],
+    );
     let at = |t| s.sample(t, Property::Translation).truncate();
     close3(at(2.0), Vec3::new(1.0, 2.0, 3.0), 1e-6);
     close3(at(1.5), Vec3::new(0.5, 1.0, 1.5), 1e-6);
@@ -42,9 +46,16 @@ fn linear_translation_with_clamping() {
 
 #[test]
 fn step_holds_until_next_key() {
-    let s = sampler(Interpolation::Step, &[0.0, 1.0, 2.0], &[v3(1.0, 1.0, 1.0), v3(2.0, 2.0, 2.0), v3(3.0, 3.0, 3.0)]);
+    let s = sampler(
+        Interpolation::Step,
+        &[0.0, 1.0, 2.0],
+        &[v3(1.0, 1.0, 1.0), v3(2.0, 2.0, 2.0), v3(3.0, 3.0, 3.0)],
+    );
     let x = |t| s.sample(t, Property::Scale).x;
-    assert_eq!([x(-1.0), x(0.0), x(0.999), x(1.0), x(1.5), x(2.0), x(7.0)], [1.0, 1.0, 1.0, 2.0, 2.0, 3.0, 3.0]);
+    assert_eq!(
+        [x(-1.0), x(0.0), x(0.999), x(1.0), x(1.5), x(2.0), x(7.0)],
+        [1.0, 1.0, 1.0, 2.0, 2.0, 3.0, 3.0]
+    );
 }
 
 #[test]
@@ -53,18 +64,34 @@ fn linear_rotation_slerp_takes_the_shortest_path() {
     let y90 = Vec4::from(Quat::from_rotation_y(90f32.to_radians()));
     let s = sampler(Interpolation::Linear, &[0.0, 1.0], &[id, y90]);
     let q = rotation_of(s.sample(0.5, Property::Rotation));
-    close(q.angle_between(Quat::from_rotation_y(45f32.to_radians())), 0.0, 1e-4);
+    close(
+        q.angle_between(Quat::from_rotation_y(45f32.to_radians())),
+        0.0,
+        1e-4,
+    );
     let q = rotation_of(s.sample(0.25, Property::Rotation));
-    close(q.angle_between(Quat::from_rotation_y(22.5f32.to_radians())), 0.0, 1e-4);
+    close(
+        q.angle_between(Quat::from_rotation_y(22.5f32.to_radians())),
+        0.0,
+        1e-4,
+    );
     // The same end rotation with a negated quaternion: same path.
     let s = sampler(Interpolation::Linear, &[0.0, 1.0], &[id, -y90]);
     let q = rotation_of(s.sample(0.5, Property::Rotation));
-    close(q.angle_between(Quat::from_rotation_y(45f32.to_radians())), 0.0, 1e-4);
+    close(
+        q.angle_between(Quat::from_rotation_y(45f32.to_radians())),
+        0.0,
+        1e-4,
+    );
     // +270° about Y is -90°: the shortest path goes through -45°.
     let y270 = Vec4::from(Quat::from_rotation_y(270f32.to_radians()));
     let s = sampler(Interpolation::Linear, &[0.0, 1.0], &[id, y270]);
     let q = rotation_of(s.sample(0.5, Property::Rotation));
-    close(q.angle_between(Quat::from_rotation_y(-45f32.to_radians())), 0.0, 1e-4);
+    close(
+        q.angle_between(Quat::from_rotation_y(-45f32.to_radians())),
+        0.0,
+        1e-4,
+    );
     // Non-unit keys are normalized.
     let s = sampler(Interpolation::Step, &[0.0], &[id * 3.0]);
     rotation_of(s.sample(0.0, Property::Rotation));
@@ -75,7 +102,11 @@ fn cubic_spline_matches_the_hermite_formula() {
     // Keys at t = 0 and 2 (Δ = 2): v0 = 1, b0 = 2 (out), a1 = -1 (in), v1 = 3.
     // The in-tangent of key 0 and the out-tangent of key 1 are unused (100).
     let k = |x: f32| v3(x, 0.0, 0.0);
-    let s = sampler(Interpolation::CubicSpline, &[0.0, 2.0], &[k(100.0), k(1.0), k(2.0), k(-1.0), k(3.0), k(100.0)]);
+    let s = sampler(
+        Interpolation::CubicSpline,
+        &[0.0, 2.0],
+        &[k(100.0), k(1.0), k(2.0), k(-1.0), k(3.0), k(100.0)],
+    );
     let x = |t| s.sample(t, Property::Translation).x;
     // t = 0.5: s = 0.25, h00 = 0.84375, h10 = 0.140625, h01 = 0.15625, h11 = -0.046875:
     // 0.84375·1 + 2·0.140625·2 + 0.15625·3 + 2·(−0.046875)·(−1) = 1.96875
@@ -87,7 +118,11 @@ fn cubic_spline_matches_the_hermite_formula() {
     close(x(-5.0), 1.0, 0.0);
     close(x(5.0), 3.0, 0.0);
     assert!(!s.is_constant());
-    let flat = sampler(Interpolation::CubicSpline, &[0.0, 1.0], &[k(0.0), k(1.0), k(0.0), k(0.0), k(1.0), k(0.0)]);
+    let flat = sampler(
+        Interpolation::CubicSpline,
+        &[0.0, 1.0],
+        &[k(0.0), k(1.0), k(0.0), k(0.0), k(1.0), k(0.0)],
+    );
     assert!(flat.is_constant());
 }
 
@@ -95,15 +130,28 @@ fn cubic_spline_matches_the_hermite_formula() {
 fn cubic_spline_rotation_is_normalized() {
     let id = Vec4::from(Quat::IDENTITY);
     let y90 = Vec4::from(Quat::from_rotation_y(90f32.to_radians()));
-    let s = sampler(Interpolation::CubicSpline, &[0.0, 1.0], &[Vec4::ZERO, id, Vec4::ZERO, Vec4::ZERO, y90, Vec4::ZERO]);
+    let s = sampler(
+        Interpolation::CubicSpline,
+        &[0.0, 1.0],
+        &[Vec4::ZERO, id, Vec4::ZERO, Vec4::ZERO, y90, Vec4::ZERO],
+    );
     let q = rotation_of(s.sample(0.5, Property::Rotation));
-    close(q.angle_between(Quat::from_rotation_y(45f32.to_radians())), 0.0, 1e-4);
+    close(
+        q.angle_between(Quat::from_rotation_y(45f32.to_radians())),
+        0.0,
+        1e-4,
+    );
 }
 
 #[test]
 fn hierarchy_and_dynamic_flags_in_a_loaded_file() {
     let mut b = GltfBuilder::new();
-    let tri = PrimitiveDesc::triangles(vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], None, vec![0, 1, 2], None);
+    let tri = PrimitiveDesc::triangles(
+        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        None,
+        vec![0, 1, 2],
+        None,
+    );
     let mesh = b.add_mesh("tri", &[tri]);
     let child = b.add_node(&NodeDesc {
         name: Some("child".into()),
@@ -149,17 +197,36 @@ fn hierarchy_and_dynamic_flags_in_a_loaded_file() {
     b.add_scene("s", &[parent, other, still], None);
     let dir = temp_dir("anim");
     let (s, warnings) = load(&write(&b, &dir, "h"));
-    assert_eq!(common::warnings_of(&warnings, WarningKind::DefaultCamera).0, 1);
+    assert_eq!(
+        common::warnings_of(&warnings, WarningKind::DefaultCamera).0,
+        1
+    );
     assert_eq!(s.time_range(), Some((0.0, 4.0)));
     // Instances in traversal order: child (under parent), other, still.
     let nodes: Vec<usize> = s.instances.iter().map(|i| i.node).collect();
     assert_eq!(nodes, vec![child, other, still]);
     let dynamic: Vec<bool> = s.instances.iter().map(|i| i.dynamic).collect();
-    assert_eq!(dynamic, vec![true, false, false], "a constant channel does not make a node dynamic");
+    assert_eq!(
+        dynamic,
+        vec![true, false, false],
+        "a constant channel does not make a node dynamic"
+    );
     assert!(s.animated[child] && !s.animated[still] && !s.dynamic[parent]);
     let m = s.instance_transforms(1.0);
-    close3(m[0].transform_point3(Vec3::ZERO), Vec3::new(10.0, 2.0, 0.0), 1e-6);
-    close3(m[2].transform_vector3(Vec3::X), Vec3::new(2.0, 0.0, 0.0), 1e-6);
-    close3(s.instance_transforms(-1.0)[0].transform_point3(Vec3::ZERO), Vec3::new(10.0, 1.0, 0.0), 1e-6);
+    close3(
+        m[0].transform_point3(Vec3::ZERO),
+        Vec3::new(10.0, 2.0, 0.0),
+        1e-6,
+    );
+    close3(
+        m[2].transform_vector3(Vec3::X),
+        Vec3::new(2.0, 0.0, 0.0),
+        1e-6,
+    );
+    close3(
+        s.instance_transforms(-1.0)[0].transform_point3(Vec3::ZERO),
+        Vec3::new(10.0, 1.0, 0.0),
+        1e-6,
+    );
     assert_eq!(s.plan().animation.kind, AnimationKind::Geometry);
 }

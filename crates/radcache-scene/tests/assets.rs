@@ -8,14 +8,17 @@ use std::path::PathBuf;
 use common::{close, close3, load, temp_dir};
 use glam::Vec3;
 use radcache_scene::assets::{write_bundled_assets, CORNELL_YFOV};
-use radcache_scene::{AnimationKind, EnvironmentKind, Environment, LightKind, Scene};
+use radcache_scene::{AnimationKind, Environment, EnvironmentKind, LightKind, Scene};
 
 fn bundled() -> Vec<PathBuf> {
     write_bundled_assets(&temp_dir("assets")).unwrap()
 }
 
-fn mesh_named<'a>(s: &'a Scene, name: &str) -> usize {
-    s.meshes.iter().position(|m| m.name.as_deref() == Some(name)).unwrap()
+fn mesh_named(s: &Scene, name: &str) -> usize {
+    s.meshes
+        .iter()
+        .position(|m| m.name.as_deref() == Some(name))
+        .unwrap()
 }
 
 #[test]
@@ -39,17 +42,51 @@ fn cornell_box() {
     close(view.perspective.yfov, CORNELL_YFOV, 1e-6);
     assert_eq!(view.perspective.aspect_ratio, Some(1.0));
 
-    // Red wall on the left of the image, green on the right.
+    // Red wall on the left of the image, green on the right: project every vertex of each wall
+    // through the camera (NDC x < 0 is the left half of the image).
     let room = &s.meshes[mesh_named(&s, "room")];
-    let side = |material: &str| {
-        let m = s.materials.iter().position(|x| x.name.as_deref() == Some(material)).unwrap() as u32;
+    let aspect = view.perspective.aspect_or(1.0);
+    let ndc_x_of = |material: &str| -> Vec<f32> {
+        let m = s
+            .materials
+            .iter()
+            .position(|x| x.name.as_deref() == Some(material))
+            .unwrap() as u32;
         let p = room.primitives.iter().find(|p| p.material == m).unwrap();
-        let c = room.triangle(p.first_triangle as usize).iter().sum::<Vec3>() / 3.0;
-        (c - view.position).dot(view.right)
+        let verts = p.first_vertex as usize..(p.first_vertex + p.vertex_count) as usize;
+        assert_eq!(verts.len(), 4);
+        verts
+            .map(|v| {
+                view.project(room.positions[v], aspect)
+                    .expect("wall vertex behind the camera")
+                    .x
+            })
+            .collect()
     };
-    assert!(side("red") < 0.0, "red wall must be on the left");
-    assert!(side("green") > 0.0, "green wall must be on the right");
-    let red = s.materials.iter().find(|m| m.name.as_deref() == Some("red")).unwrap();
+    let red_x = ndc_x_of("red");
+    let green_x = ndc_x_of("green");
+    assert!(
+        red_x.iter().all(|&x| x < 0.0),
+        "red wall must be on the left: {red_x:?}"
+    );
+    assert!(
+        green_x.iter().all(|&x| x > 0.0),
+        "green wall must be on the right: {green_x:?}"
+    );
+    // The light is in the upper half of the image, centred horizontally.
+    let light = &s.meshes[mesh_named(&s, "light")];
+    for &p in &light.positions {
+        let ndc = view.project(p, aspect).unwrap();
+        assert!(
+            ndc.y > 0.5 && ndc.y < 1.0 && ndc.x.abs() < 0.2,
+            "light vertex at {ndc}"
+        );
+    }
+    let red = s
+        .materials
+        .iter()
+        .find(|m| m.name.as_deref() == Some("red"))
+        .unwrap();
     close3(red.diffuse_albedo(), Vec3::new(0.63, 0.065, 0.05), 1e-6);
 
     // Walls face the inside of the box.
@@ -57,7 +94,10 @@ fn cornell_box() {
     for t in 0..room.triangle_count() {
         let p = room.triangle(t);
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
-        assert!(n.dot(inside - p[0]) > 0.0, "room triangle {t} faces outward");
+        assert!(
+            n.dot(inside - p[0]) > 0.0,
+            "room triangle {t} faces outward"
+        );
     }
     // The light: 2 triangles facing down, 130 mm x 105 mm, emitting (17, 12, 4).
     let emitters = s.emitters_at(0.0);
@@ -81,7 +121,13 @@ fn cornell_box() {
     assert_eq!(plan.animation.kind, AnimationKind::None);
     assert_eq!(plan.animation.time_range, None);
     let text = s.summary();
-    for needle in ["triangles: 32", "materials: 4 (1 emissive)", "plan:", "animation: none", "emissive triangles: 2"] {
+    for needle in [
+        "triangles: 32",
+        "materials: 4 (1 emissive)",
+        "plan:",
+        "animation: none",
+        "emissive triangles: 2",
+    ] {
         assert!(text.contains(needle), "summary lacks {needle:?}:\n{text}");
     }
 }
@@ -90,7 +136,15 @@ fn cornell_box() {
 fn furnace() {
     let (s, warnings) = load(&bundled()[1]);
     assert!(warnings.is_empty(), "{warnings:?}");
-    assert_eq!((s.meshes.len(), s.triangle_count(), s.materials.len(), s.nodes.len()), (1, 12, 1, 2));
+    assert_eq!(
+        (
+            s.meshes.len(),
+            s.triangle_count(),
+            s.materials.len(),
+            s.nodes.len()
+        ),
+        (1, 12, 1, 2)
+    );
     let m = &s.materials[0];
     close3(m.diffuse_albedo(), Vec3::splat(0.5), 1e-6);
     close3(m.emissive, Vec3::ONE, 1e-6);
@@ -102,8 +156,15 @@ fn furnace() {
     close(emitters.triangles.iter().map(|t| t.area).sum(), 24.0, 1e-4);
     for t in &emitters.triangles {
         let c = t.positions.iter().sum::<Vec3>() / 3.0;
-        close3(t.emitted_radiance((view.position - c).normalize()), Vec3::ONE, 1e-6);
-        assert_eq!(t.emitted_radiance((c - view.position).normalize()), Vec3::ZERO);
+        close3(
+            t.emitted_radiance((view.position - c).normalize()),
+            Vec3::ONE,
+            1e-6,
+        );
+        assert_eq!(
+            t.emitted_radiance((c - view.position).normalize()),
+            Vec3::ZERO
+        );
     }
     let plan = s.plan();
     assert_eq!(plan.emissive_triangles, 12);
@@ -116,14 +177,20 @@ fn furnace() {
 fn animated_scene() {
     let (s, warnings) = load(&bundled()[2]);
     assert!(warnings.is_empty(), "{warnings:?}");
-    assert_eq!((s.meshes.len(), s.triangle_count(), s.materials.len()), (5, 46, 6));
+    assert_eq!(
+        (s.meshes.len(), s.triangle_count(), s.materials.len()),
+        (5, 46, 6)
+    );
     assert_eq!(s.light_instances.len(), 1);
     assert_eq!(s.lights[0].kind, LightKind::Point);
     assert_eq!(s.camera_count, 1);
     assert_eq!(s.animations.len(), 1);
     assert_eq!(s.animations[0].channels.len(), 6);
     assert_eq!(s.time_range(), Some((0.0, 5.0)));
-    assert_eq!(s.environment, Environment::Constant(Vec3::new(0.05, 0.05, 0.08)));
+    assert_eq!(
+        s.environment,
+        Environment::Constant(Vec3::new(0.05, 0.05, 0.08))
+    );
 
     let dynamic: Vec<(String, bool)> = s
         .instances
@@ -133,8 +200,16 @@ fn animated_scene() {
     for (name, dynamic) in &dynamic {
         assert_eq!(*dynamic, name == "mover" || name == "bouncer", "{name}");
     }
-    close3(s.camera_at(0.0).position, Vec3::new(0.278, 0.273, -0.8), 1e-6);
-    close3(s.camera_at(1.25).position, Vec3::new(0.278, 0.2865, -0.5), 1e-5);
+    close3(
+        s.camera_at(0.0).position,
+        Vec3::new(0.278, 0.273, -0.8),
+        1e-6,
+    );
+    close3(
+        s.camera_at(1.25).position,
+        Vec3::new(0.278, 0.2865, -0.5),
+        1e-5,
+    );
     close3(s.camera_at(5.0).position, Vec3::new(0.35, 0.3, 0.1), 1e-6);
     close3(s.camera_at(99.0).position, Vec3::new(0.35, 0.3, 0.1), 1e-6);
     let yaw195 = glam::Quat::from_rotation_y(195f32.to_radians());
@@ -146,7 +221,10 @@ fn animated_scene() {
     assert_eq!(plan.animation.kind, AnimationKind::Geometry);
     assert!(plan.animation.camera && plan.animation.geometry && !plan.animation.lights);
     assert_eq!(plan.animation.time_range, Some((0.0, 5.0)));
-    assert_eq!((plan.lights.point, plan.lights.spot, plan.lights.directional), (1, 0, 0));
+    assert_eq!(
+        (plan.lights.point, plan.lights.spot, plan.lights.directional),
+        (1, 0, 0)
+    );
     assert_eq!(plan.environment, EnvironmentKind::Constant);
     assert_eq!(plan.emissive_triangles, 2);
     let range = s.bounds_over_range();
@@ -154,7 +232,10 @@ fn animated_scene() {
     assert!(range.max.y >= start.max.y && range.min.x <= start.min.x);
     let text = s.to_string();
     assert!(text.contains("time range [0.000, 5.000] s"), "{text}");
-    assert!(text.contains("geometry (camera yes, lights no, geometry yes)"), "{text}");
+    assert!(
+        text.contains("geometry (camera yes, lights no, geometry yes)"),
+        "{text}"
+    );
 }
 
 /// Generate-and-check: the committed `assets/` must match the generators' output.
@@ -166,12 +247,14 @@ fn repository_assets_are_up_to_date() {
     for name in ["cornell", "furnace", "animated"] {
         for ext in ["gltf", "bin"] {
             let rel = format!("{name}/{name}.{ext}");
-            let Ok(committed) = std::fs::read(repo.join(&rel)) else {
-                eprintln!("skip: assets/{rel} not present");
-                continue;
-            };
+            let committed = std::fs::read(repo.join(&rel)).unwrap_or_else(|e| {
+                panic!("assets/{rel} is missing ({e}): run `cargo xtask assets`")
+            });
             let generated = std::fs::read(fresh.join(&rel)).unwrap();
-            assert!(committed == generated, "assets/{rel} is stale: regenerate with `cargo xtask assets`");
+            assert!(
+                committed == generated,
+                "assets/{rel} is stale: regenerate with `cargo xtask assets`"
+            );
         }
     }
 }

@@ -80,22 +80,40 @@ fn accessor_out_of_range() {
     let path = mutated("acc", |r| r["accessors"][0]["count"] = json!(1000));
     let e = load_err(&path);
     assert!(matches!(e, Error::Accessor { .. }), "{e:?}");
-    assert_mentions(&e, &["mesh 0 \"tri\" primitive 0 POSITION accessor 0", "exceed"]);
+    assert_mentions(
+        &e,
+        &["mesh 0 \"tri\" primitive 0 POSITION accessor 0", "exceed"],
+    );
     let path = mutated("acc-offset", |r| r["accessors"][1]["byteOffset"] = json!(4));
     assert_mentions(&load_err(&path), &["NORMAL accessor 1"]);
-    let path = mutated("view", |r| r["bufferViews"][0]["byteLength"] = json!(100_000));
+    let path = mutated("view", |r| {
+        r["bufferViews"][0]["byteLength"] = json!(100_000)
+    });
     let e = load_err(&path);
     assert!(matches!(e, Error::Accessor { .. }), "{e:?}");
     assert_mentions(&e, &["buffer view 0", "exceeds buffer 0"]);
     let path = mutated("type", |r| r["accessors"][0]["type"] = json!("VEC2"));
-    assert_mentions(&load_err(&path), &["POSITION accessor 0", "expected 3 components"]);
+    assert_mentions(
+        &load_err(&path),
+        &["POSITION accessor 0", "expected 3 components"],
+    );
 }
 
 #[test]
 fn index_out_of_range() {
     let b = triangle_scene(None, |p| p.indices = Some(vec![0, 1, 5]));
     let e = load_err(&write(&b, &temp_dir("idx"), "i"));
-    assert!(matches!(e, Error::IndexOutOfRange { index: 5, vertex_count: 3, .. }), "{e:?}");
+    assert!(
+        matches!(
+            e,
+            Error::IndexOutOfRange {
+                index: 5,
+                vertex_count: 3,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
     assert_mentions(&e, &["mesh 0 \"tri\" primitive 0 indices accessor"]);
 }
 
@@ -124,7 +142,8 @@ fn degenerate_triangles_warn_with_count() {
     });
     let (s, w) = common::load(&write(&b, &temp_dir("degen"), "d"));
     assert_eq!(warnings_of(&w, WarningKind::DegenerateTriangles), (1, 2));
-    assert!(w.iter().any(|w| w.message.contains("dropped 2 degenerate") && w.message.contains("mesh 0 \"tri\" primitive 0")));
+    assert!(w.iter().any(|w| w.message.contains("dropped 2 degenerate")
+        && w.message.contains("mesh 0 \"tri\" primitive 0")));
     assert_eq!(s.triangle_count(), 1);
 }
 
@@ -135,7 +154,10 @@ fn unsupported_required_extension() {
         r["extensionsRequired"] = json!(["EXT_made_up"]);
     });
     let e = load_err(&path);
-    assert!(matches!(&e, Error::UnsupportedExtension { name, .. } if name == "EXT_made_up"), "{e:?}");
+    assert!(
+        matches!(&e, Error::UnsupportedExtension { name, .. } if name == "EXT_made_up"),
+        "{e:?}"
+    );
     // Supported required extensions are fine.
     let path = mutated("ext-ok", |r| {
         r["extensionsUsed"] = json!(["KHR_lights_punctual"]);
@@ -155,7 +177,13 @@ fn orthographic_camera() {
     b.add_scene("s", &[node], None);
     let e = load_err(&write(&b, &temp_dir("ortho"), "o"));
     assert!(matches!(e, Error::OrthographicCamera { .. }), "{e:?}");
-    assert_mentions(&e, &["orthographic cameras are not supported yet", "camera 0 \"ortho\""]);
+    assert_mentions(
+        &e,
+        &[
+            "orthographic cameras are not supported yet",
+            "camera 0 \"ortho\"",
+        ],
+    );
 }
 
 #[test]
@@ -166,7 +194,10 @@ fn unknown_camera_name_lists_the_available_ones() {
         ..LoadOptions::default()
     };
     let e = Scene::load(&path, &opts).unwrap_err();
-    assert!(matches!(&e, Error::CameraNotFound { available, .. } if available == &["cam".to_string()]), "{e:?}");
+    assert!(
+        matches!(&e, Error::CameraNotFound { available, .. } if available == &["cam".to_string()]),
+        "{e:?}"
+    );
     assert_mentions(&e, &["\"nope\"", "\"cam\""]);
 }
 
@@ -174,7 +205,10 @@ fn unknown_camera_name_lists_the_available_ones() {
 fn hierarchy_errors() {
     let path = mutated("twoparents", |r| {
         r["nodes"][1]["children"] = json!([0]);
-        r["nodes"].as_array_mut().unwrap().push(json!({"children": [0]}));
+        r["nodes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"children": [0]}));
     });
     assert_mentions(&load_err(&path), &["node 0 \"tri\"", "two parents"]);
     let path = mutated("selfchild", |r| r["nodes"][0]["children"] = json!([0]));
@@ -198,7 +232,13 @@ fn bad_animation_data() {
         }],
     );
     let e = load_err(&write(&b, &dir, "a"));
-    assert_mentions(&e, &["animation 0 \"a\" channel 0 sampler 0 input", "strictly increasing"]);
+    assert_mentions(
+        &e,
+        &[
+            "animation 0 \"a\" channel 0 sampler 0 input",
+            "strictly increasing",
+        ],
+    );
     let (mut root, bin) = b.to_json(Some("a.bin"));
     root["animations"][0]["samplers"][0]["interpolation"] = json!("CUBICSPLINE");
     let path = dir.join("c.gltf");

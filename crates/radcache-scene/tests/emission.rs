@@ -18,7 +18,11 @@ fn front_face_only_unless_double_sided() {
     close(t.area, 0.5, 0.0);
     assert_eq!(t.emitted_radiance(Vec3::new(0.3, 0.2, 1.0).normalize()), le);
     assert_eq!(t.emitted_radiance(-Vec3::Z), Vec3::ZERO);
-    assert_eq!(t.emitted_radiance(Vec3::X), Vec3::ZERO, "grazing direction emits nothing");
+    assert_eq!(
+        t.emitted_radiance(Vec3::X),
+        Vec3::ZERO,
+        "grazing direction emits nothing"
+    );
     let d = EmissiveTriangle::new((0, 0, 0), &TRI, &Mat4::IDENTITY, le, true).unwrap();
     assert_eq!(d.emitted_radiance(Vec3::Z), le);
     assert_eq!(d.emitted_radiance(-Vec3::Z), le);
@@ -40,9 +44,18 @@ fn transforms_move_the_front_face() {
     let t = EmissiveTriangle::new((0, 0, 0), &TRI, &m, le, false).unwrap();
     close3(t.normal, Vec3::Z, 1e-6);
     // Scaling scales the area; a zero scale makes no emitter.
-    let t = EmissiveTriangle::new((0, 0, 0), &TRI, &Mat4::from_scale(Vec3::splat(2.0)), le, false).unwrap();
+    let t = EmissiveTriangle::new(
+        (0, 0, 0),
+        &TRI,
+        &Mat4::from_scale(Vec3::splat(2.0)),
+        le,
+        false,
+    )
+    .unwrap();
     close(t.area, 2.0, 1e-6);
-    assert!(EmissiveTriangle::new((0, 0, 0), &TRI, &Mat4::from_scale(Vec3::ZERO), le, false).is_none());
+    assert!(
+        EmissiveTriangle::new((0, 0, 0), &TRI, &Mat4::from_scale(Vec3::ZERO), le, false).is_none()
+    );
 }
 
 fn emissive_scene(double_sided: bool) -> radcache_scene::Scene {
@@ -63,10 +76,18 @@ fn loaded_emitters_follow_the_rule() {
         close3(t.radiance, Vec3::splat(5.0), 1e-6);
         assert_eq!(t.double_sided, double_sided);
         assert_eq!(t.emitted_radiance(Vec3::Z), Vec3::splat(5.0));
-        let back = if double_sided { Vec3::splat(5.0) } else { Vec3::ZERO };
+        let back = if double_sided {
+            Vec3::splat(5.0)
+        } else {
+            Vec3::ZERO
+        };
         assert_eq!(t.emitted_radiance(-Vec3::Z), back);
         let sides = if double_sided { 2.0 } else { 1.0 };
-        close(e.total_power, 5.0 * 0.5 * std::f32::consts::PI * sides, 1e-5);
+        close(
+            e.total_power,
+            5.0 * 0.5 * std::f32::consts::PI * sides,
+            1e-5,
+        );
         assert_eq!(e.sample(0.3), Some((0, 1.0)));
     }
 }
@@ -84,9 +105,15 @@ fn uniform(state: &mut u64) -> f32 {
 fn sampling_frequencies_match_the_pmf() {
     // Triangles of different sizes and radiances (one single-sided, one double-sided).
     let mut tris = Vec::new();
-    for (k, (scale, le, ds)) in [(1.0, 1.0, false), (2.0, 0.5, false), (0.5, 8.0, true), (3.0, 0.1, false), (1.0, 4.0, true)]
-        .into_iter()
-        .enumerate()
+    for (k, (scale, le, ds)) in [
+        (1.0, 1.0, false),
+        (2.0, 0.5, false),
+        (0.5, 8.0, true),
+        (3.0, 0.1, false),
+        (1.0, 4.0, true),
+    ]
+    .into_iter()
+    .enumerate()
     {
         let m = Mat4::from_scale(Vec3::splat(scale));
         tris.push(EmissiveTriangle::new((k, 0, k), &TRI, &m, Vec3::splat(le), ds).unwrap());
@@ -111,7 +138,10 @@ fn sampling_frequencies_match_the_pmf() {
         let p = f64::from(table.table.pmf[i]);
         let sigma = (p * (1.0 - p) / n as f64).sqrt();
         let freq = c as f64 / n as f64;
-        assert!((freq - p).abs() < 5.0 * sigma + 1e-9, "triangle {i}: frequency {freq} vs pmf {p}");
+        assert!(
+            (freq - p).abs() < 5.0 * sigma + 1e-9,
+            "triangle {i}: frequency {freq} vs pmf {p}"
+        );
     }
 }
 
@@ -119,11 +149,18 @@ fn sampling_frequencies_match_the_pmf() {
 fn textured_emission_uses_the_texture_mean_for_power() {
     let mut b = GltfBuilder::new();
     // 2x1 texture: one white texel, one black (sRGB 255 and 0): mean linear 0.5.
-    let tex = b.add_texture_rgba8(2, 1, &[255, 255, 255, 255, 0, 0, 0, 255], 33071).unwrap();
+    let tex = b
+        .add_texture_rgba8(2, 1, &[255, 255, 255, 255, 0, 0, 0, 255], 33071)
+        .unwrap();
     let mut m = MaterialDesc::emitter("lamp", [1.0; 3], [2.0; 3]);
     m.emissive_texture = Some(tex);
     let mat = b.add_material(&m);
-    let mut prim = PrimitiveDesc::triangles(TRI.map(|p| p.to_array()).to_vec(), None, vec![0, 1, 2], Some(mat));
+    let mut prim = PrimitiveDesc::triangles(
+        TRI.map(|p| p.to_array()).to_vec(),
+        None,
+        vec![0, 1, 2],
+        Some(mat),
+    );
     prim.texcoords = Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
     let mesh = b.add_mesh("m", &[prim]);
     let node = b.add_node(&NodeDesc {

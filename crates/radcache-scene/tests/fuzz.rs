@@ -46,7 +46,12 @@ fn textured_builder() -> GltfBuilder {
     m.base_color_texture = Some(tex);
     m.emissive_texture = Some(tex);
     let mat = b.add_material(&m);
-    let mut prim = PrimitiveDesc::triangles(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], None, vec![0, 1, 2], Some(mat));
+    let mut prim = PrimitiveDesc::triangles(
+        vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        None,
+        vec![0, 1, 2],
+        Some(mat),
+    );
     prim.texcoords = Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
     let mesh = b.add_mesh("m", &[prim]);
     let node = b.add_node(&NodeDesc {
@@ -181,13 +186,22 @@ fn mutate(rng: &mut Rng, root: &mut Value, bin: &mut Vec<u8>) {
             }
             let a = rng.below(accessors);
             let b = rng.below(accessors);
-            if let (Some(x), Some(y)) = (root["accessors"][a].get("bufferView").cloned(), root["accessors"][b].get("bufferView").cloned()) {
+            if let (Some(x), Some(y)) = (
+                root["accessors"][a].get("bufferView").cloned(),
+                root["accessors"][b].get("bufferView").cloned(),
+            ) {
                 set(root, "accessors", a, "bufferView", y);
                 set(root, "accessors", b, "bufferView", x);
             }
         }
         _ => {
-            let p = *rng.pick(&["/nodes/0/rotation", "/nodes/0/scale", "/nodes/1/matrix", "/materials/0/emissiveFactor", "/scenes/0/extras"]);
+            let p = *rng.pick(&[
+                "/nodes/0/rotation",
+                "/nodes/0/scale",
+                "/nodes/1/matrix",
+                "/materials/0/emissiveFactor",
+                "/scenes/0/extras",
+            ]);
             if let Some(v) = root.pointer_mut(p) {
                 *v = json!([0, 0, 0, 0]);
             }
@@ -197,8 +211,14 @@ fn mutate(rng: &mut Rng, root: &mut Value, bin: &mut Vec<u8>) {
 
 #[test]
 fn mutated_assets_never_panic() {
-    let iters: usize = std::env::var("RADCACHE_FUZZ_ITERS").ok().and_then(|s| s.parse().ok()).unwrap_or(500);
-    let seed: u64 = std::env::var("RADCACHE_FUZZ_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(0x5eed);
+    let iters: usize = std::env::var("RADCACHE_FUZZ_ITERS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(500);
+    let seed: u64 = std::env::var("RADCACHE_FUZZ_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0x5eed);
     let dir = common::temp_dir("fuzz");
     let sources = [
         ("cornell", cornell_builder()),
@@ -210,7 +230,9 @@ fn mutated_assets_never_panic() {
     for (si, (name, builder)) in sources.iter().enumerate() {
         let (root, bin) = builder.to_json(Some("f.bin"));
         for it in 0..iters {
-            let mut rng = Rng(seed.wrapping_mul(0x2545_f491_4f6c_dd1d) ^ ((si as u64) << 48) ^ (it as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+            let mut rng = Rng(seed.wrapping_mul(0x2545_f491_4f6c_dd1d)
+                ^ ((si as u64) << 48)
+                ^ (it as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
             let (mut r, mut b) = (root.clone(), bin.clone());
             for _ in 0..=rng.below(3) {
                 mutate(&mut rng, &mut r, &mut b);
@@ -229,7 +251,10 @@ fn mutated_assets_never_panic() {
                     ok += 1;
                 }
                 Err(e) => {
-                    assert!(e.to_string().contains("f.gltf"), "error does not name the file: {e}");
+                    assert!(
+                        e.to_string().contains("f.gltf"),
+                        "error does not name the file: {e}"
+                    );
                     err += 1;
                 }
             }

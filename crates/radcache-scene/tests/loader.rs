@@ -6,8 +6,12 @@ mod common;
 
 use common::{close, close3, load, temp_dir, triangle_scene, warnings_of, write};
 use glam::{Vec3, Vec4};
-use radcache_scene::writer::{write_files, BufferLayout, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
-use radcache_scene::{EnvOverride, Environment, EnvironmentKind, LoadOptions, Scene, WarningKind, WrapMode};
+use radcache_scene::writer::{
+    write_files, BufferLayout, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc,
+};
+use radcache_scene::{
+    EnvOverride, Environment, EnvironmentKind, LoadOptions, Scene, WarningKind, WrapMode,
+};
 use serde_json::json;
 
 #[test]
@@ -19,27 +23,8 @@ fn embedded_and_glb_buffers() {
     assert!(!dir.join("e.bin").exists());
     assert_eq!(load(&path).0.triangle_count(), 1);
 
-    // GLB: header, JSON chunk (space-padded), BIN chunk (zero-padded).
-    let (mut root, mut bin) = b.to_json(Some("unused.bin"));
-    root["buffers"][0].as_object_mut().unwrap().remove("uri");
-    let mut text = serde_json::to_vec(&root).unwrap();
-    while text.len() % 4 != 0 {
-        text.push(b' ');
-    }
-    while bin.len() % 4 != 0 {
-        bin.push(0);
-    }
-    let total = 12 + 8 + text.len() + 8 + bin.len();
-    let mut glb = Vec::new();
-    glb.extend_from_slice(b"glTF");
-    glb.extend_from_slice(&2u32.to_le_bytes());
-    glb.extend_from_slice(&(total as u32).to_le_bytes());
-    glb.extend_from_slice(&(text.len() as u32).to_le_bytes());
-    glb.extend_from_slice(b"JSON");
-    glb.extend_from_slice(&text);
-    glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    glb.extend_from_slice(b"BIN\0");
-    glb.extend_from_slice(&bin);
+    let (root, bin) = b.to_json(None);
+    let glb = common::glb_bytes(&root, &bin);
     let glb_path = dir.join("g.glb");
     std::fs::write(&glb_path, glb).unwrap();
     let (s, _) = load(&glb_path);
@@ -50,7 +35,12 @@ fn embedded_and_glb_buffers() {
 #[test]
 fn non_triangle_modes_are_skipped_with_a_warning() {
     let mut b = GltfBuilder::new();
-    let tri = PrimitiveDesc::triangles(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], None, vec![0, 1, 2], None);
+    let tri = PrimitiveDesc::triangles(
+        vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        None,
+        vec![0, 1, 2],
+        None,
+    );
     let mut lines = tri.clone();
     lines.mode = 1;
     let mesh = b.add_mesh("mixed", &[lines, tri]);
@@ -61,7 +51,9 @@ fn non_triangle_modes_are_skipped_with_a_warning() {
     b.add_scene("s", &[node], None);
     let (s, w) = load(&write(&b, &temp_dir("modes"), "m"));
     assert_eq!(warnings_of(&w, WarningKind::UnsupportedPrimitiveMode).0, 1);
-    assert!(w.iter().any(|w| w.message.contains("mesh 0 \"mixed\" primitive 0")));
+    assert!(w
+        .iter()
+        .any(|w| w.message.contains("mesh 0 \"mixed\" primitive 0")));
     assert_eq!(s.triangle_count(), 1);
     assert_eq!(s.meshes[0].primitives[0].gltf_primitive, 1);
     // No normals: flat normals generated; no material: the default material is appended.
@@ -100,7 +92,10 @@ fn merged_primitives_keep_per_triangle_materials() {
     let m = &s.meshes[0];
     assert_eq!(m.triangle_materials, vec![1, 1, 0, 0]);
     assert_eq!(m.indices, vec![0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7]);
-    assert_eq!((m.primitives[1].first_triangle, m.primitives[1].first_vertex), (2, 4));
+    assert_eq!(
+        (m.primitives[1].first_triangle, m.primitives[1].first_vertex),
+        (2, 4)
+    );
     close(m.triangle(2)[0].z, 1.0, 0.0);
     close3(m.bounds.max, Vec3::ONE, 0.0);
 }
@@ -109,14 +104,21 @@ fn merged_primitives_keep_per_triangle_materials() {
 fn alpha_modes_are_opaque_with_a_warning_and_textures_decode_srgb() {
     let mut b = GltfBuilder::new();
     // sRGB 188 ≈ linear 0.5029; alpha 128 stays linear.
-    let tex = b.add_texture_rgba8(1, 2, &[188, 0, 255, 128, 0, 0, 0, 255], 33648).unwrap();
+    let tex = b
+        .add_texture_rgba8(1, 2, &[188, 0, 255, 128, 0, 0, 0, 255], 33648)
+        .unwrap();
     let mut m = MaterialDesc::diffuse("glass", [1.0, 1.0, 1.0]);
     m.alpha_mode = Some("BLEND".into());
     m.base_color_texture = Some(tex);
     let mat = b.add_material(&m);
     let b = {
         let mut b = b;
-        let mut prim = PrimitiveDesc::triangles(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], None, vec![0, 1, 2], Some(mat));
+        let mut prim = PrimitiveDesc::triangles(
+            vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            None,
+            vec![0, 1, 2],
+            Some(mat),
+        );
         prim.texcoords = Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
         let mesh = b.add_mesh("m", &[prim]);
         let node = b.add_node(&NodeDesc {
@@ -152,7 +154,10 @@ fn camera_selection_by_name_and_traversal_order() {
         ..NodeDesc::default()
     });
     let (mut root, bin) = b.to_json(Some("c.bin"));
-    root["scenes"][0]["nodes"].as_array_mut().unwrap().push(json!(node));
+    root["scenes"][0]["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!(node));
     let dir = temp_dir("cams");
     let path = dir.join("c.gltf");
     write_files(&path, &root, Some(("c.bin", &bin))).unwrap();
@@ -182,21 +187,45 @@ fn environment_from_extras_and_overrides() {
     let path = dir.join("e.gltf");
     write_files(&path, &root, Some(("e.bin", &bin))).unwrap();
     let (s, _) = load(&path);
-    assert_eq!(s.environment, Environment::Constant(Vec3::new(0.5, 1.0, 2.0)));
-    let opts = |env| LoadOptions { camera_name: None, env };
-    let scaled = EnvOverride { scale: 2.0, ..EnvOverride::default() };
+    assert_eq!(
+        s.environment,
+        Environment::Constant(Vec3::new(0.5, 1.0, 2.0))
+    );
+    let opts = |env| LoadOptions {
+        camera_name: None,
+        env,
+    };
+    let scaled = EnvOverride {
+        scale: 2.0,
+        ..EnvOverride::default()
+    };
     let (s, _) = Scene::load(&path, &opts(scaled)).unwrap();
-    assert_eq!(s.environment, Environment::Constant(Vec3::new(1.0, 2.0, 4.0)));
-    let map = EnvOverride { map: Some("sky.exr".into()), radiance: Some([1.0; 3]), scale: 0.5 };
+    assert_eq!(
+        s.environment,
+        Environment::Constant(Vec3::new(1.0, 2.0, 4.0))
+    );
+    let map = EnvOverride {
+        map: Some("sky.exr".into()),
+        radiance: Some([1.0; 3]),
+        scale: 0.5,
+    };
     let (s, _) = Scene::load(&path, &opts(map)).unwrap();
-    assert_eq!(s.environment, Environment::Map { path: "sky.exr".into(), scale: 0.5 });
+    assert_eq!(
+        s.environment,
+        Environment::Map {
+            path: "sky.exr".into(),
+            scale: 0.5
+        }
+    );
     assert_eq!(s.plan().environment, EnvironmentKind::Map);
     // Malformed extras: warning, no environment.
     root["scenes"][0]["extras"] = json!({"environment": {"radiance": "bright"}});
     write_files(&path, &root, Some(("e.bin", &bin))).unwrap();
     let (s, w) = load(&path);
     assert_eq!(s.environment, Environment::None);
-    assert!(w.iter().any(|w| w.message.contains("extras.environment ignored")));
+    assert!(w
+        .iter()
+        .any(|w| w.message.contains("extras.environment ignored")));
 }
 
 #[test]

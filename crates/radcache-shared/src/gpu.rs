@@ -184,7 +184,10 @@ mod tests {
 
     #[test]
     fn generated_glsl_is_up_to_date() {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shaders/shared/layouts.glsl");
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../shaders/shared/layouts.glsl"
+        );
         let on_disk = std::fs::read_to_string(path).unwrap_or_default();
         assert!(
             on_disk == generated_glsl(),

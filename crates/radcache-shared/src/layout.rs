@@ -45,7 +45,12 @@ pub fn std430_violations<T: GpuStruct>() -> Vec<String> {
     let mut max_align = 4usize;
     for f in T::fields() {
         let Some((size, align)) = std430_size_align(f.glsl) else {
-            errors.push(format!("{}.{}: unsupported GLSL type {}", T::NAME, f.name, f.glsl));
+            errors.push(format!(
+                "{}.{}: unsupported GLSL type {}",
+                T::NAME,
+                f.name,
+                f.glsl
+            ));
             continue;
         };
         max_align = max_align.max(align);

@@ -37,7 +37,12 @@ impl std::fmt::Debug for AccelerationStructure {
 }
 
 impl AccelerationStructure {
-    fn new(ctx: &Context, name: &str, ty: vk::AccelerationStructureTypeKHR, size: u64) -> Result<Self> {
+    fn new(
+        ctx: &Context,
+        name: &str,
+        ty: vk::AccelerationStructureTypeKHR,
+        size: u64,
+    ) -> Result<Self> {
         let buffer = Buffer::new(
             ctx,
             &BufferDesc {
@@ -58,9 +63,14 @@ impl AccelerationStructure {
         // SAFETY: the buffer has AS storage usage, is bound, and is at least `size` bytes.
         let raw = unsafe { shared.accel.create_acceleration_structure(&info, None) }
             .call("vkCreateAccelerationStructureKHR")?;
-        let addr_info = vk::AccelerationStructureDeviceAddressInfoKHR::default().acceleration_structure(raw);
+        let addr_info =
+            vk::AccelerationStructureDeviceAddressInfoKHR::default().acceleration_structure(raw);
         // SAFETY: `raw` is a live acceleration structure of this device.
-        let address = unsafe { shared.accel.get_acceleration_structure_device_address(&addr_info) };
+        let address = unsafe {
+            shared
+                .accel
+                .get_acceleration_structure_device_address(&addr_info)
+        };
         shared.set_name(raw, name);
         Ok(AccelerationStructure {
             shared,
@@ -153,7 +163,8 @@ fn scratch(ctx: &Context, name: &str, size: u64) -> Result<Buffer> {
         &BufferDesc {
             name,
             size,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS,
             location: MemoryLocation::GpuOnly,
             alignment: u64::from(ctx.info().min_scratch_alignment.max(1)),
         },
@@ -169,8 +180,10 @@ impl Context {
         }
         let flags = vk::BuildAccelerationStructureFlagsKHR::PREFER_FAST_TRACE
             | vk::BuildAccelerationStructureFlagsKHR::ALLOW_COMPACTION;
-        let geometries: Vec<[vk::AccelerationStructureGeometryKHR<'_>; 1]> =
-            geoms.iter().map(|g| triangles(g).map(|t| [t])).collect::<Result<_>>()?;
+        let geometries: Vec<[vk::AccelerationStructureGeometryKHR<'_>; 1]> = geoms
+            .iter()
+            .map(|g| triangles(g).map(|t| [t]))
+            .collect::<Result<_>>()?;
         let mut built = Vec::with_capacity(geoms.len());
         let mut scratches = Vec::with_capacity(geoms.len());
         let mut infos = Vec::with_capacity(geoms.len());
@@ -197,11 +210,11 @@ impl Context {
                 sizes.acceleration_structure_size,
             )?;
             let s = scratch(self, "accel.blas_scratch", sizes.build_scratch_size)?;
-            info = info
-                .dst_acceleration_structure(blas.raw)
-                .scratch_data(vk::DeviceOrHostAddressKHR {
+            info = info.dst_acceleration_structure(blas.raw).scratch_data(
+                vk::DeviceOrHostAddressKHR {
                     device_address: s.device_address()?,
-                });
+                },
+            );
             stats.bytes_built += blas.size();
             infos.push(info);
             built.push(blas);
@@ -231,7 +244,9 @@ impl Context {
             // SAFETY: recording; inputs, destinations and scratch are live device-address buffers
             // kept alive until the submission is waited for below; one range per geometry.
             unsafe {
-                rec.shared.device.cmd_reset_query_pool(rec.cmd, pool, 0, handles.len() as u32);
+                rec.shared
+                    .device
+                    .cmd_reset_query_pool(rec.cmd, pool, 0, handles.len() as u32);
                 rec.shared
                     .accel
                     .cmd_build_acceleration_structures(rec.cmd, &infos, &range_refs);
@@ -240,13 +255,15 @@ impl Context {
         rec.barrier(Access::AS_BUILD_WRITE, Access::AS_BUILD_READ);
         // SAFETY: recording; the builds above completed (barrier) and the queries were reset.
         unsafe {
-            rec.shared.accel.cmd_write_acceleration_structures_properties(
-                rec.cmd,
-                &handles,
-                vk::QueryType::ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR,
-                pool,
-                0,
-            )
+            rec.shared
+                .accel
+                .cmd_write_acceleration_structures_properties(
+                    rec.cmd,
+                    &handles,
+                    vk::QueryType::ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR,
+                    pool,
+                    0,
+                )
         };
         let timings = self.submit(rec)?.wait();
         let mut compact_sizes = vec![0u64; handles.len()];
@@ -280,15 +297,27 @@ impl Context {
                     .mode(vk::CopyAccelerationStructureModeKHR::COMPACT);
                 // SAFETY: recording; `src` was built with ALLOW_COMPACTION, `dst` is at least the
                 // queried compacted size; both outlive the submission.
-                unsafe { rec.shared.accel.cmd_copy_acceleration_structure(rec.cmd, &info) };
+                unsafe {
+                    rec.shared
+                        .accel
+                        .cmd_copy_acceleration_structure(rec.cmd, &info)
+                };
                 stats.bytes_compacted += dst.size();
                 compacted.push(Blas(Arc::new(dst)));
             }
             Ok(())
         });
-        rec.barrier(Access::AS_BUILD_WRITE, Access::RAY_QUERY.union(Access::AS_BUILD_READ));
+        rec.barrier(
+            Access::AS_BUILD_WRITE,
+            Access::RAY_QUERY.union(Access::AS_BUILD_READ),
+        );
         result?;
-        stats.compact_ms = self.submit(rec)?.wait()?.iter().map(|t| t.duration_ms).sum();
+        stats.compact_ms = self
+            .submit(rec)?
+            .wait()?
+            .iter()
+            .map(|t| t.duration_ms)
+            .sum();
         Ok((compacted, stats))
     }
 }
@@ -316,7 +345,8 @@ struct RawInstance {
     blas_address: u64,
 }
 const _: () = assert!(
-    std::mem::size_of::<RawInstance>() == std::mem::size_of::<vk::AccelerationStructureInstanceKHR>()
+    std::mem::size_of::<RawInstance>()
+        == std::mem::size_of::<vk::AccelerationStructureInstanceKHR>()
 );
 
 /// How to bring a TLAS up to date.
@@ -348,10 +378,11 @@ impl std::fmt::Debug for Tlas {
     }
 }
 
-const TLAS_FLAGS: vk::BuildAccelerationStructureFlagsKHR = vk::BuildAccelerationStructureFlagsKHR::from_raw(
-    vk::BuildAccelerationStructureFlagsKHR::PREFER_FAST_TRACE.as_raw()
-        | vk::BuildAccelerationStructureFlagsKHR::ALLOW_UPDATE.as_raw(),
-);
+const TLAS_FLAGS: vk::BuildAccelerationStructureFlagsKHR =
+    vk::BuildAccelerationStructureFlagsKHR::from_raw(
+        vk::BuildAccelerationStructureFlagsKHR::PREFER_FAST_TRACE.as_raw()
+            | vk::BuildAccelerationStructureFlagsKHR::ALLOW_UPDATE.as_raw(),
+    );
 
 fn instance_geometry<'a>(address: u64) -> vk::AccelerationStructureGeometryKHR<'a> {
     let data = vk::AccelerationStructureGeometryInstancesDataKHR::default()
@@ -429,7 +460,13 @@ impl Tlas {
 impl Recorder {
     /// Uploads `instances` and builds or refits `tlas`, followed by a barrier that makes it
     /// visible to ray queries in compute and fragment shaders.
-    pub fn build_tlas(&mut self, ctx: &Context, tlas: &mut Tlas, instances: &[TlasInstance<'_>], update: TlasUpdate) -> Result<()> {
+    pub fn build_tlas(
+        &mut self,
+        ctx: &Context,
+        tlas: &mut Tlas,
+        instances: &[TlasInstance<'_>],
+        update: TlasUpdate,
+    ) -> Result<()> {
         let n = instances.len() as u32;
         if n > tlas.capacity {
             return Err(Error::Invalid(format!(
@@ -442,7 +479,9 @@ impl Recorder {
             .map(|i| RawInstance {
                 transform: i.transform,
                 custom_index_and_mask: (i.custom_index & 0x00ff_ffff) | (u32::from(i.mask) << 24),
-                sbt_offset_and_flags: vk::GeometryInstanceFlagsKHR::TRIANGLE_FACING_CULL_DISABLE.as_raw() << 24,
+                sbt_offset_and_flags: vk::GeometryInstanceFlagsKHR::TRIANGLE_FACING_CULL_DISABLE
+                    .as_raw()
+                    << 24,
                 blas_address: i.blas.0.address,
             })
             .collect();
@@ -459,7 +498,10 @@ impl Recorder {
         staging.write(0, &raw)?;
         let refit = update == TlasUpdate::Refit && tlas.count == Some(n);
         self.pass("accel.tlas_build", |rec| {
-            rec.barrier(Access::AS_BUILD_READ.union(Access::RAY_QUERY), Access::TRANSFER_WRITE);
+            rec.barrier(
+                Access::AS_BUILD_READ.union(Access::RAY_QUERY),
+                Access::TRANSFER_WRITE,
+            );
             rec.copy_buffer(&staging, 0, &tlas.instances, 0, (raw.len() * 64) as u64);
             rec.barrier(Access::TRANSFER_WRITE, Access::AS_BUILD_READ);
             let geometry = [instance_geometry(tlas.instances.device_address()?)];
@@ -490,7 +532,10 @@ impl Recorder {
                     .accel
                     .cmd_build_acceleration_structures(rec.cmd, &[info], &[&range])
             };
-            rec.barrier(Access::AS_BUILD_WRITE, Access::RAY_QUERY.union(Access::AS_BUILD_READ));
+            rec.barrier(
+                Access::AS_BUILD_WRITE,
+                Access::RAY_QUERY.union(Access::AS_BUILD_READ),
+            );
             Ok::<(), Error>(())
         })?;
         tlas.count = Some(n);

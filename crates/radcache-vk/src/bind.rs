@@ -95,27 +95,34 @@ impl Recorder {
                 .unwrap_or_else(|| panic!("pipeline {} has no binding {binding}", bound.name));
             let ok = matches!(
                 (layout.kind, res),
-                (BindingKind::StorageBuffer | BindingKind::UniformBuffer, Resource::Buffer(_))
-                    | (
-                        BindingKind::StorageBuffer | BindingKind::UniformBuffer,
-                        Resource::BufferRange(..)
-                    )
-                    | (BindingKind::AccelerationStructure, Resource::Tlas(_))
+                (
+                    BindingKind::StorageBuffer | BindingKind::UniformBuffer,
+                    Resource::Buffer(_)
+                ) | (
+                    BindingKind::StorageBuffer | BindingKind::UniformBuffer,
+                    Resource::BufferRange(..)
+                ) | (BindingKind::AccelerationStructure, Resource::Tlas(_))
                     | (BindingKind::StorageImage, Resource::StorageImage(_))
                     | (BindingKind::SampledImage, Resource::Sampled(..))
             );
-            assert!(ok, "pipeline {}: binding {binding} is {:?}, got {res:?}", bound.name, layout.kind);
+            assert!(
+                ok,
+                "pipeline {}: binding {binding} is {:?}, got {res:?}",
+                bound.name, layout.kind
+            );
             match res {
                 Resource::Buffer(b) => buffer_infos.push(vk::DescriptorBufferInfo {
                     buffer: b.raw(),
                     offset: 0,
                     range: vk::WHOLE_SIZE,
                 }),
-                Resource::BufferRange(b, offset, size) => buffer_infos.push(vk::DescriptorBufferInfo {
-                    buffer: b.raw(),
-                    offset: *offset,
-                    range: *size,
-                }),
+                Resource::BufferRange(b, offset, size) => {
+                    buffer_infos.push(vk::DescriptorBufferInfo {
+                        buffer: b.raw(),
+                        offset: *offset,
+                        range: *size,
+                    })
+                }
                 Resource::Tlas(t) => as_handles.push(t.raw()),
                 Resource::StorageImage(i) => image_infos.push(vk::DescriptorImageInfo {
                     sampler: vk::Sampler::null(),
@@ -244,7 +251,11 @@ impl Recorder {
                 vk::RenderingAttachmentInfo::default()
                     .image_view(c.image.view())
                     .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .load_op(if c.clear.is_some() { vk::AttachmentLoadOp::CLEAR } else { vk::AttachmentLoadOp::LOAD })
+                    .load_op(if c.clear.is_some() {
+                        vk::AttachmentLoadOp::CLEAR
+                    } else {
+                        vk::AttachmentLoadOp::LOAD
+                    })
                     .store_op(vk::AttachmentStoreOp::STORE)
                     .clear_value(vk::ClearValue {
                         color: vk::ClearColorValue {
@@ -257,7 +268,11 @@ impl Recorder {
             vk::RenderingAttachmentInfo::default()
                 .image_view(d.image.view())
                 .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-                .load_op(if d.clear.is_some() { vk::AttachmentLoadOp::CLEAR } else { vk::AttachmentLoadOp::LOAD })
+                .load_op(if d.clear.is_some() {
+                    vk::AttachmentLoadOp::CLEAR
+                } else {
+                    vk::AttachmentLoadOp::LOAD
+                })
                 .store_op(vk::AttachmentStoreOp::STORE)
                 .clear_value(vk::ClearValue {
                     depth_stencil: vk::ClearDepthStencilValue {
@@ -292,7 +307,9 @@ impl Recorder {
         // (callers transition them with `use_image`) and outlive the recording.
         unsafe {
             self.shared.device.cmd_begin_rendering(self.cmd, &info);
-            self.shared.device.cmd_set_viewport(self.cmd, 0, &[viewport]);
+            self.shared
+                .device
+                .cmd_set_viewport(self.cmd, 0, &[viewport]);
             self.shared.device.cmd_set_scissor(self.cmd, 0, &[area]);
         }
     }
@@ -331,9 +348,12 @@ impl Recorder {
     pub fn bind_index_buffer(&mut self, indices: &Buffer, offset: u64) {
         // SAFETY: recording; the buffer has INDEX_BUFFER usage (validated by the layer).
         unsafe {
-            self.shared
-                .device
-                .cmd_bind_index_buffer(self.cmd, indices.raw(), offset, vk::IndexType::UINT32)
+            self.shared.device.cmd_bind_index_buffer(
+                self.cmd,
+                indices.raw(),
+                offset,
+                vk::IndexType::UINT32,
+            )
         };
     }
 

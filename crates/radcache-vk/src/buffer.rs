@@ -55,7 +55,8 @@ impl Buffer {
     pub fn new(ctx: &Context, desc: &BufferDesc<'_>) -> Result<Self> {
         let shared = &ctx.shared;
         let size = desc.size.max(16);
-        let usage = desc.usage | vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST;
+        let usage =
+            desc.usage | vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST;
         let info = vk::BufferCreateInfo::default()
             .size(size)
             .usage(usage)
@@ -132,7 +133,10 @@ impl Buffer {
     /// The device address; the buffer must have `SHADER_DEVICE_ADDRESS` usage.
     pub fn device_address(&self) -> Result<u64> {
         self.address.ok_or_else(|| {
-            Error::Invalid(format!("buffer {:?} has no SHADER_DEVICE_ADDRESS usage", self.name))
+            Error::Invalid(format!(
+                "buffer {:?} has no SHADER_DEVICE_ADDRESS usage",
+                self.name
+            ))
         })
     }
 

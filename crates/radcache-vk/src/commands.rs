@@ -28,7 +28,9 @@ pub struct Recorder {
 
 impl std::fmt::Debug for Recorder {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Recorder").field("label", &self.label).finish()
+        f.debug_struct("Recorder")
+            .field("label", &self.label)
+            .finish()
     }
 }
 
@@ -90,8 +92,12 @@ impl Context {
         // SAFETY: the command buffer is in the recording state with every scope closed.
         unsafe { shared.device.end_command_buffer(rec.cmd) }.call("vkEndCommandBuffer")?;
         // SAFETY: the device is live.
-        let fence = unsafe { shared.device.create_fence(&vk::FenceCreateInfo::default(), None) }
-            .call("vkCreateFence")?;
+        let fence = unsafe {
+            shared
+                .device
+                .create_fence(&vk::FenceCreateInfo::default(), None)
+        }
+        .call("vkCreateFence")?;
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(rec.cmd)];
         let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
         let result = {
@@ -178,7 +184,11 @@ impl Recorder {
             return;
         };
         let has_begin = self.profiler.scopes[i].begin.is_some();
-        let end = if has_begin { self.profiler.take_query() } else { None };
+        let end = if has_begin {
+            self.profiler.take_query()
+        } else {
+            None
+        };
         if let Some(q) = end {
             // SAFETY: recording; `q` was reset at the start of this command buffer.
             unsafe {
@@ -199,7 +209,11 @@ impl Recorder {
 
     /// The names of the scopes recorded so far, in order.
     pub fn scope_names(&self) -> Vec<String> {
-        self.profiler.scopes.iter().map(|s| s.name.clone()).collect()
+        self.profiler
+            .scopes
+            .iter()
+            .map(|s| s.name.clone())
+            .collect()
     }
 }
 
@@ -226,7 +240,9 @@ pub struct Submission {
 
 impl std::fmt::Debug for Submission {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Submission").field("index", &self.index).finish()
+        f.debug_struct("Submission")
+            .field("index", &self.index)
+            .finish()
     }
 }
 

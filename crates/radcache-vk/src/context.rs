@@ -320,8 +320,8 @@ impl Context {
         let instance = &inst_ref.instance;
 
         // SAFETY: `instance` is a live instance.
-        let pds = unsafe { instance.enumerate_physical_devices() }
-            .call("vkEnumeratePhysicalDevices")?;
+        let pds =
+            unsafe { instance.enumerate_physical_devices() }.call("vkEnumeratePhysicalDevices")?;
         let caps = pds
             .iter()
             .map(|&pd| device::query_caps(instance, pd))
@@ -416,7 +416,11 @@ impl Context {
 
     /// Validation errors reported so far (0 when validation is off).
     pub fn validation_errors(&self) -> u32 {
-        self.shared.inst.messenger_state.errors.load(Ordering::SeqCst)
+        self.shared
+            .inst
+            .messenger_state
+            .errors
+            .load(Ordering::SeqCst)
     }
 
     /// The first validation error message, if any.

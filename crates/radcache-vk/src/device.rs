@@ -101,21 +101,28 @@ pub(crate) fn query_caps(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Re
     // SAFETY: the chain only holds structs the device's API version / extensions define.
     unsafe { instance.get_physical_device_features2(pd, &mut core) };
     let c = core.features;
-    let flags: [(&'static str, u32); 11] = [
+    let flags: [(&'static str, u32); 12] = [
         ("bufferDeviceAddress", f12.buffer_device_address),
         ("scalarBlockLayout", f12.scalar_block_layout),
         ("runtimeDescriptorArray", f12.runtime_descriptor_array),
-        ("descriptorBindingPartiallyBound", f12.descriptor_binding_partially_bound),
+        (
+            "descriptorBindingPartiallyBound",
+            f12.descriptor_binding_partially_bound,
+        ),
         (
             "shaderSampledImageArrayNonUniformIndexing",
             f12.shader_sampled_image_array_non_uniform_indexing,
         ),
         ("dynamicRendering", f13.dynamic_rendering),
         ("synchronization2", f13.synchronization2),
+        ("maintenance4", f13.maintenance4),
         ("accelerationStructure", fas.acceleration_structure),
         ("rayQuery", frq.ray_query),
         ("fragmentStoresAndAtomics", c.fragment_stores_and_atomics),
-        ("timestampComputeAndGraphics", props.limits.timestamp_compute_and_graphics),
+        (
+            "timestampComputeAndGraphics",
+            props.limits.timestamp_compute_and_graphics,
+        ),
     ];
     Ok(DeviceCaps {
         name: props
@@ -207,7 +214,8 @@ pub(crate) fn create_device(
         .shader_sampled_image_array_non_uniform_indexing(true);
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
         .dynamic_rendering(true)
-        .synchronization2(true);
+        .synchronization2(true)
+        .maintenance4(true);
     let mut fas =
         vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
     let mut frq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);

@@ -62,14 +62,18 @@ impl Image {
     pub fn new(ctx: &Context, desc: &ImageDesc<'_>) -> Result<Self> {
         let shared = &ctx.shared;
         if desc.width == 0 || desc.height == 0 {
-            return Err(Error::Invalid(format!("image {:?} has a zero extent", desc.name)));
+            return Err(Error::Invalid(format!(
+                "image {:?} has a zero extent",
+                desc.name
+            )));
         }
         let aspect = if is_depth(desc.format) {
             vk::ImageAspectFlags::DEPTH
         } else {
             vk::ImageAspectFlags::COLOR
         };
-        let usage = desc.usage | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
+        let usage =
+            desc.usage | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
@@ -228,7 +232,8 @@ impl Sampler {
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .max_lod(0.0);
         // SAFETY: the device is live; `info` is valid for the call.
-        let raw = unsafe { ctx.shared.device.create_sampler(&info, None) }.call("vkCreateSampler")?;
+        let raw =
+            unsafe { ctx.shared.device.create_sampler(&info, None) }.call("vkCreateSampler")?;
         ctx.shared.set_name(raw, name);
         Ok(Sampler {
             shared: ctx.shared.clone(),

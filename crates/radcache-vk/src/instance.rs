@@ -56,9 +56,10 @@ pub(crate) fn create_instance(want_validation: bool) -> Result<InstanceParts> {
     // SAFETY: as above.
     let exts = unsafe { entry.enumerate_instance_extension_properties(None) }
         .call("vkEnumerateInstanceExtensionProperties")?;
-    let has_debug_utils = exts
-        .iter()
-        .any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == ash::ext::debug_utils::NAME));
+    let has_debug_utils = exts.iter().any(|e| {
+        e.extension_name_as_c_str()
+            .is_ok_and(|n| n == ash::ext::debug_utils::NAME)
+    });
 
     let app_name = CString::from(c"radcache");
     let app = vk::ApplicationInfo::default()

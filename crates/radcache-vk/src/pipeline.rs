@@ -120,7 +120,9 @@ pub struct Pipeline {
 
 impl std::fmt::Debug for Pipeline {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Pipeline").field("name", &self.name).finish()
+        f.debug_struct("Pipeline")
+            .field("name", &self.name)
+            .finish()
     }
 }
 
@@ -135,7 +137,9 @@ fn create_layouts(
     push_constant_size: u32,
     stages: vk::ShaderStageFlags,
 ) -> Result<Layouts> {
-    if push_constant_size > shared.info.max_push_constants_size || !push_constant_size.is_multiple_of(4) {
+    if push_constant_size > shared.info.max_push_constants_size
+        || !push_constant_size.is_multiple_of(4)
+    {
         return Err(Error::Invalid(format!(
             "push constants of {push_constant_size} bytes (limit {}, multiple of 4)",
             shared.info.max_push_constants_size
@@ -282,12 +286,14 @@ impl Pipeline {
             .line_width(1.0);
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()
             .rasterization_samples(vk::SampleCountFlags::TYPE_1);
-        let depth = desc.depth.map_or_else(vk::PipelineDepthStencilStateCreateInfo::default, |d| {
-            vk::PipelineDepthStencilStateCreateInfo::default()
-                .depth_test_enable(true)
-                .depth_write_enable(d.write)
-                .depth_compare_op(d.compare)
-        });
+        let depth = desc
+            .depth
+            .map_or_else(vk::PipelineDepthStencilStateCreateInfo::default, |d| {
+                vk::PipelineDepthStencilStateCreateInfo::default()
+                    .depth_test_enable(true)
+                    .depth_write_enable(d.write)
+                    .depth_compare_op(d.compare)
+            });
         let attachment = match desc.blend {
             Blend::None => vk::PipelineColorBlendAttachmentState::default()
                 .color_write_mask(vk::ColorComponentFlags::RGBA),

@@ -49,8 +49,8 @@ impl ProfilerRecording {
             .query_type(vk::QueryType::TIMESTAMP)
             .query_count(MAX_QUERIES);
         // SAFETY: the device is live; `info` is valid for the call.
-        let pool = unsafe { shared.device.create_query_pool(&info, None) }
-            .call("vkCreateQueryPool")?;
+        let pool =
+            unsafe { shared.device.create_query_pool(&info, None) }.call("vkCreateQueryPool")?;
         Ok(ProfilerRecording {
             pool,
             next_query: 0,
@@ -67,7 +67,10 @@ impl ProfilerRecording {
             Some(self.next_query - 1)
         } else {
             if !self.overflow_warned {
-                log::warn!("more than {} pass scopes in one submission: later ones are not timed", MAX_QUERIES / 2);
+                log::warn!(
+                    "more than {} pass scopes in one submission: later ones are not timed",
+                    MAX_QUERIES / 2
+                );
                 self.overflow_warned = true;
             }
             None
@@ -100,7 +103,11 @@ impl ProfilerRecording {
         }
         .call("vkGetQueryPoolResults")?;
         let bits = shared.info.timestamp_valid_bits;
-        let mask = if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 };
+        let mask = if bits >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << bits) - 1
+        };
         let period = shared.info.timestamp_period_ns;
         let origin = raw[0] & mask;
         let ms = |ticks: u64| (ticks & mask) as f64 * period * 1e-6;

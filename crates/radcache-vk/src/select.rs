@@ -23,6 +23,7 @@ pub const REQUIRED_FEATURES: &[&str] = &[
     "shaderSampledImageArrayNonUniformIndexing",
     "dynamicRendering",
     "synchronization2",
+    "maintenance4",
     "accelerationStructure",
     "rayQuery",
     "fragmentStoresAndAtomics",
@@ -142,9 +143,19 @@ impl fmt::Display for DeviceReport {
         writeln!(f, "; devices seen:")?;
         for d in &self.devices {
             if d.filtered_out {
-                writeln!(f, "  - {} ({}): excluded by RADCACHE_DEVICE", d.name, d.kind)?;
+                writeln!(
+                    f,
+                    "  - {} ({}): excluded by RADCACHE_DEVICE",
+                    d.name, d.kind
+                )?;
             } else {
-                writeln!(f, "  - {} ({}): missing {}", d.name, d.kind, d.missing.join(", "))?;
+                writeln!(
+                    f,
+                    "  - {} ({}): missing {}",
+                    d.name,
+                    d.kind,
+                    d.missing.join(", ")
+                )?;
             }
         }
         Ok(())
@@ -220,7 +231,10 @@ mod tests {
         assert!(text.contains("old gpu"), "{text}");
         assert!(text.contains("excluded by RADCACHE_DEVICE"), "{text}");
         let err = choose(&devs[..1], &[], None).unwrap_err().to_string();
-        assert!(err.contains("VK_KHR_ray_query") && err.contains("feature rayQuery"), "{err}");
+        assert!(
+            err.contains("VK_KHR_ray_query") && err.contains("feature rayQuery"),
+            "{err}"
+        );
     }
 
     #[test]

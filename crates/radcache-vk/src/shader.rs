@@ -66,7 +66,9 @@ pub struct ShaderCompiler {
 
 impl std::fmt::Debug for ShaderCompiler {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("ShaderCompiler").field("root", &self.root).finish()
+        f.debug_struct("ShaderCompiler")
+            .field("root", &self.root)
+            .finish()
     }
 }
 
@@ -98,7 +100,8 @@ impl ShaderCompiler {
 
     fn read(&self, rel: &str) -> std::result::Result<String, String> {
         let full = self.root.join(rel);
-        let text = std::fs::read_to_string(&full).map_err(|e| format!("{}: {e}", full.display()))?;
+        let text =
+            std::fs::read_to_string(&full).map_err(|e| format!("{}: {e}", full.display()))?;
         if text.contains('\0') {
             return Err(format!("{}: contains a NUL byte", full.display()));
         }
@@ -125,7 +128,10 @@ impl ShaderCompiler {
         let source = self.read(path).map_err(shader_err)?;
         let read_files = RefCell::new(vec![(path.to_string(), hash_text(&source))]);
         let mut options = shaderc::CompileOptions::new().map_err(|e| shader_err(e.to_string()))?;
-        options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_3 as u32);
+        options.set_target_env(
+            shaderc::TargetEnv::Vulkan,
+            shaderc::EnvVersion::Vulkan1_3 as u32,
+        );
         options.set_target_spirv(shaderc::SpirvVersion::V1_6);
         options.set_source_language(shaderc::SourceLanguage::GLSL);
         options.set_optimization_level(shaderc::OptimizationLevel::Performance);
@@ -147,14 +153,18 @@ impl ShaderCompiler {
                 let rel = c.to_string_lossy().replace('\\', "/");
                 if self.root.join(&rel).is_file() {
                     let content = self.read(&rel)?;
-                    read_files.borrow_mut().push((rel.clone(), hash_text(&content)));
+                    read_files
+                        .borrow_mut()
+                        .push((rel.clone(), hash_text(&content)));
                     return Ok(shaderc::ResolvedInclude {
                         resolved_name: rel,
                         content,
                     });
                 }
             }
-            Err(format!("cannot find include {requested:?} (from {requester})"))
+            Err(format!(
+                "cannot find include {requested:?} (from {requester})"
+            ))
         });
         let artifact = self
             .compiler
@@ -164,18 +174,21 @@ impl ShaderCompiler {
                 other => shader_err(other.to_string()),
             })?;
         if artifact.get_num_warnings() > 0 {
-            log::warn!("shader {path}: {}", artifact.get_warning_messages().trim_end());
+            log::warn!(
+                "shader {path}: {}",
+                artifact.get_warning_messages().trim_end()
+            );
         }
         let spirv = Arc::new(artifact.as_binary().to_vec());
         drop(options);
         let files = read_files.into_inner();
-        self.cache
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .insert(key, Entry {
+        self.cache.lock().unwrap_or_else(|p| p.into_inner()).insert(
+            key,
+            Entry {
                 files,
                 spirv: spirv.clone(),
-            });
+            },
+        );
         Ok(spirv)
     }
 

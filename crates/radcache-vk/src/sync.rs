@@ -135,11 +135,19 @@ impl ImageUse {
                 ),
             ),
             ImageUse::ComputeSampled => (
-                if depth { L::DEPTH_READ_ONLY_OPTIMAL } else { L::SHADER_READ_ONLY_OPTIMAL },
+                if depth {
+                    L::DEPTH_READ_ONLY_OPTIMAL
+                } else {
+                    L::SHADER_READ_ONLY_OPTIMAL
+                },
                 Access::COMPUTE_READ,
             ),
             ImageUse::RasterSampled => (
-                if depth { L::DEPTH_READ_ONLY_OPTIMAL } else { L::SHADER_READ_ONLY_OPTIMAL },
+                if depth {
+                    L::DEPTH_READ_ONLY_OPTIMAL
+                } else {
+                    L::SHADER_READ_ONLY_OPTIMAL
+                },
                 Access::RASTER_READ,
             ),
             ImageUse::TransferSrc => (L::TRANSFER_SRC_OPTIMAL, Access::TRANSFER_READ),

@@ -29,7 +29,11 @@ impl Recorder {
         let (old_layout, src) = *state;
         let (new_layout, dst) = usage.layout_and_access(image.is_depth());
         let barrier = [vk::ImageMemoryBarrier2::default()
-            .src_stage_mask(if src.stage.is_empty() { vk::PipelineStageFlags2::NONE } else { src.stage })
+            .src_stage_mask(if src.stage.is_empty() {
+                vk::PipelineStageFlags2::NONE
+            } else {
+                src.stage
+            })
             .src_access_mask(src.access)
             .dst_stage_mask(dst.stage)
             .dst_access_mask(dst.access)
@@ -46,7 +50,14 @@ impl Recorder {
     }
 
     /// Copies `size` bytes between buffers.
-    pub fn copy_buffer(&mut self, src: &Buffer, src_offset: u64, dst: &Buffer, dst_offset: u64, size: u64) {
+    pub fn copy_buffer(
+        &mut self,
+        src: &Buffer,
+        src_offset: u64,
+        dst: &Buffer,
+        dst_offset: u64,
+        size: u64,
+    ) {
         if size == 0 {
             return;
         }
@@ -77,7 +88,10 @@ impl Recorder {
     /// stream.
     pub fn update_buffer<T: Pod>(&mut self, buffer: &Buffer, offset: u64, data: &[T]) {
         let bytes: &[u8] = bytemuck::cast_slice(data);
-        assert!(bytes.len() <= 65536 && bytes.len().is_multiple_of(4), "update_buffer size");
+        assert!(
+            bytes.len() <= 65536 && bytes.len().is_multiple_of(4),
+            "update_buffer size"
+        );
         if bytes.is_empty() {
             return;
         }
@@ -154,7 +168,10 @@ impl Context {
     /// Reads a whole image back as `T` texels (e.g. `[f32; 4]` for RGBA32F), waiting for the GPU.
     pub fn read_image<T: Pod>(&self, image: &Image) -> Result<Vec<T>> {
         let texel = texel_bytes(image.format()).ok_or_else(|| {
-            Error::Invalid(format!("readback of {:?} images is not supported", image.format()))
+            Error::Invalid(format!(
+                "readback of {:?} images is not supported",
+                image.format()
+            ))
         })?;
         if texel != std::mem::size_of::<T>() as u64 {
             return Err(Error::Invalid(format!(

@@ -13,8 +13,8 @@ use glam::{Mat4, Vec3};
 use radcache_tests::geometry::{room, uv_sphere, Mesh};
 use radcache_tests::Rng;
 use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, BlasGeometry, Buffer, BufferDesc, Context, MemoryLocation,
-    Pipeline, Resource, ShaderCompiler, Tlas, TlasInstance, TlasUpdate,
+    vk, Access, BindingKind, BindingLayout, BlasGeometry, Buffer, BufferDesc, Context,
+    MemoryLocation, Pipeline, Resource, ShaderCompiler, Tlas, TlasInstance, TlasUpdate,
 };
 
 use crate::results::{append, Figure};
@@ -60,7 +60,11 @@ fn scene() -> Scene {
         .iter()
         .map(|&(x, z)| Mat4::from_translation(Vec3::new(x, 0.0, z)))
         .collect();
-    Scene { sphere, room: room(Vec3::splat(-4.0), Vec3::splat(4.0)), transforms }
+    Scene {
+        sphere,
+        room: room(Vec3::splat(-4.0), Vec3::splat(4.0)),
+        transforms,
+    }
 }
 
 fn camera_rays(n: usize) -> Vec<GpuRay> {
@@ -74,10 +78,16 @@ fn camera_rays(n: usize) -> Vec<GpuRay> {
     (0..n)
         .map(|i| {
             let (x, y) = (i % width, i / width);
-            let u = ((x as f32 + 0.5) / width as f32 * 2.0 - 1.0) * tan * width as f32 / height as f32;
+            let u =
+                ((x as f32 + 0.5) / width as f32 * 2.0 - 1.0) * tan * width as f32 / height as f32;
             let v = (1.0 - (y as f32 + 0.5) / height as f32 * 2.0) * tan;
             let d = (forward + right * u + up * v).normalize();
-            GpuRay { origin: eye.to_array(), tmin: 0.0, dir: d.to_array(), tmax: 1e30 }
+            GpuRay {
+                origin: eye.to_array(),
+                tmin: 0.0,
+                dir: d.to_array(),
+                tmax: 1e30,
+            }
         })
         .collect()
 }
@@ -91,7 +101,9 @@ fn hemisphere_rays(s: &Scene, n: usize) -> Vec<GpuRay> {
             let k = rng.below(total);
             let tri = if k < sphere_tris * 4 {
                 let m = s.transforms[(k / sphere_tris) as usize];
-                s.sphere.triangle((k % sphere_tris) as usize).map(|p| m.transform_point3(p))
+                s.sphere
+                    .triangle((k % sphere_tris) as usize)
+                    .map(|p| m.transform_point3(p))
             } else {
                 s.room.triangle((k - sphere_tris * 4) as usize)
             };
@@ -104,29 +116,48 @@ fn hemisphere_rays(s: &Scene, n: usize) -> Vec<GpuRay> {
             // Cosine-distributed direction about the normal (Malley's method).
             let (r, phi) = (rng.f32().sqrt(), 2.0 * std::f32::consts::PI * rng.f32());
             let (t, bt) = nrm.any_orthonormal_pair();
-            let d = (t * r * phi.cos() + bt * r * phi.sin() + nrm * (1.0 - r * r).max(0.0).sqrt()).normalize();
-            GpuRay { origin: (p + nrm * 1e-4).to_array(), tmin: 0.0, dir: d.to_array(), tmax: 1e30 }
+            let d = (t * r * phi.cos() + bt * r * phi.sin() + nrm * (1.0 - r * r).max(0.0).sqrt())
+                .normalize();
+            GpuRay {
+                origin: (p + nrm * 1e-4).to_array(),
+                tmin: 0.0,
+                dir: d.to_array(),
+                tmax: 1e30,
+            }
         })
         .collect()
 }
 
 fn trace(ctx: &Context, pipe: &Pipeline, tlas: &Tlas, rays: &[GpuRay]) -> Result<f64> {
-    let ray_buf = ctx.create_buffer_init("bench.rays", vk::BufferUsageFlags::STORAGE_BUFFER, rays)?;
-    let hits = Buffer::new(ctx, &BufferDesc {
-        name: "bench.hits",
-        size: rays.len() as u64 * 32,
-        usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-        location: MemoryLocation::GpuOnly,
-        alignment: 0,
-    })?;
+    let ray_buf =
+        ctx.create_buffer_init("bench.rays", vk::BufferUsageFlags::STORAGE_BUFFER, rays)?;
+    let hits = Buffer::new(
+        ctx,
+        &BufferDesc {
+            name: "bench.hits",
+            size: rays.len() as u64 * 32,
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+            location: MemoryLocation::GpuOnly,
+            alignment: 0,
+        },
+    )?;
     let n = rays.len() as u32;
     let mut times = Vec::new();
     for run in 0..4 {
         let mut rec = ctx.begin("bench.rays")?;
         rec.pass("bench.trace", |rec| {
             rec.bind_pipeline(pipe);
-            rec.push_bindings(&[(0, Resource::Tlas(tlas)), (1, Resource::Buffer(&ray_buf)), (2, Resource::Buffer(&hits))]);
-            rec.push_constants(&Push { count: n, flags: 0, row_width: ROW, pad: 0 });
+            rec.push_bindings(&[
+                (0, Resource::Tlas(tlas)),
+                (1, Resource::Buffer(&ray_buf)),
+                (2, Resource::Buffer(&hits)),
+            ]);
+            rec.push_constants(&Push {
+                count: n,
+                flags: 0,
+                row_width: ROW,
+                pad: 0,
+            });
             rec.dispatch(ROW / 64, n.div_ceil(ROW), 1)
         })?;
         rec.barrier(Access::COMPUTE_WRITE, Access::COMPUTE_WRITE);
@@ -149,14 +180,27 @@ pub fn run(args: &[&str]) -> Result<()> {
     let info = ctx.info().clone();
     println!("device: {} ({}), {}", info.name, info.kind, info.driver);
     let s = scene();
-    let input = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
-    let flat = |m: &Mesh| m.positions.iter().map(|p| p.to_array()).collect::<Vec<[f32; 3]>>();
+    let input = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
+        | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
+    let flat = |m: &Mesh| {
+        m.positions
+            .iter()
+            .map(|p| p.to_array())
+            .collect::<Vec<[f32; 3]>>()
+    };
     let sv = ctx.create_buffer_init("bench.sphere_vertices", input, &flat(&s.sphere))?;
     let si = ctx.create_buffer_init("bench.sphere_indices", input, &s.sphere.indices)?;
     let rv = ctx.create_buffer_init("bench.room_vertices", input, &flat(&s.room))?;
     let ri = ctx.create_buffer_init("bench.room_indices", input, &s.room.indices)?;
-    let geometry = |name, m: &Mesh, vb, ib| {
-        BlasGeometry { name, vertices: vb, vertex_offset: 0, vertex_stride: 12, vertex_count: m.positions.len() as u32, indices: ib, index_offset: 0, triangle_count: m.triangle_count() as u32 }
+    let geometry = |name, m: &Mesh, vb, ib| BlasGeometry {
+        name,
+        vertices: vb,
+        vertex_offset: 0,
+        vertex_stride: 12,
+        vertex_count: m.positions.len() as u32,
+        indices: ib,
+        index_offset: 0,
+        triangle_count: m.triangle_count() as u32,
     };
     let wall = std::time::Instant::now();
     let (blases, stats) = ctx.build_blases(&[
@@ -165,8 +209,23 @@ pub fn run(args: &[&str]) -> Result<()> {
     ])?;
     let blas_wall_ms = wall.elapsed().as_secs_f64() * 1e3;
     let mut tlas = Tlas::new(&ctx, "bench.tlas", 8)?;
-    let mut instances: Vec<TlasInstance<'_>> = s.transforms.iter().enumerate().map(|(i, m)| TlasInstance { blas: &blases[0], transform: rows(*m), custom_index: i as u32, mask: 0xff }).collect();
-    instances.push(TlasInstance { blas: &blases[1], transform: rows(Mat4::IDENTITY), custom_index: 4, mask: 0xff });
+    let mut instances: Vec<TlasInstance<'_>> = s
+        .transforms
+        .iter()
+        .enumerate()
+        .map(|(i, m)| TlasInstance {
+            blas: &blases[0],
+            transform: rows(*m),
+            custom_index: i as u32,
+            mask: 0xff,
+        })
+        .collect();
+    instances.push(TlasInstance {
+        blas: &blases[1],
+        transform: rows(Mat4::IDENTITY),
+        custom_index: 4,
+        mask: 0xff,
+    });
     let mut rec = ctx.begin("bench.tlas")?;
     rec.build_tlas(&ctx, &mut tlas, &instances, TlasUpdate::Rebuild)?;
     let tlas_ms = ctx.submit(rec)?.wait()?[0].duration_ms;
@@ -183,20 +242,50 @@ pub fn run(args: &[&str]) -> Result<()> {
     let incoherent_ms = trace(&ctx, &pipe, &tlas, &hemisphere_rays(&s, n))?;
     let mrays = |ms: f64| n as f64 / (ms * 1e-3) / 1e6;
     let tris = s.sphere.triangle_count();
-    println!("sphere BLAS: {tris} triangles; {} instances + room", s.transforms.len());
-    println!("BLAS build + compaction: {:.2} ms GPU ({:.2} + {:.2}), {:.1} ms wall; {} -> {} bytes", stats.build_ms + stats.compact_ms, stats.build_ms, stats.compact_ms, blas_wall_ms, stats.bytes_built, stats.bytes_compacted);
-    println!("TLAS build ({} instances): {:.3} ms GPU", instances.len(), tlas_ms);
-    println!("coherent camera rays:     {n} rays in {coherent_ms:.1} ms = {:.2} Mrays/s", mrays(coherent_ms));
-    println!("incoherent hemisphere rays: {n} rays in {incoherent_ms:.1} ms = {:.2} Mrays/s", mrays(incoherent_ms));
+    println!(
+        "sphere BLAS: {tris} triangles; {} instances + room",
+        s.transforms.len()
+    );
+    println!(
+        "BLAS build + compaction: {:.2} ms GPU ({:.2} + {:.2}), {:.1} ms wall; {} -> {} bytes",
+        stats.build_ms + stats.compact_ms,
+        stats.build_ms,
+        stats.compact_ms,
+        blas_wall_ms,
+        stats.bytes_built,
+        stats.bytes_compacted
+    );
+    println!(
+        "TLAS build ({} instances): {:.3} ms GPU",
+        instances.len(),
+        tlas_ms
+    );
+    println!(
+        "coherent camera rays:     {n} rays in {coherent_ms:.1} ms = {:.2} Mrays/s",
+        mrays(coherent_ms)
+    );
+    println!(
+        "incoherent hemisphere rays: {n} rays in {incoherent_ms:.1} ms = {:.2} Mrays/s",
+        mrays(incoherent_ms)
+    );
     let case = format!("sphere{}k_x4+room", tris / 1000);
-    append("rays", &format!("{} ({})", info.name, info.driver), &[
-        Figure::new(&case, "coherent_mrays_per_s", mrays(coherent_ms), "Mrays/s"),
-        Figure::new(&case, "incoherent_mrays_per_s", mrays(incoherent_ms), "Mrays/s"),
-        Figure::new(&case, "blas_build_ms", stats.build_ms, "ms"),
-        Figure::new(&case, "blas_compact_ms", stats.compact_ms, "ms"),
-        Figure::new(&case, "tlas_build_ms", tlas_ms, "ms"),
-        Figure::new(&case, "rays", n as f64, "rays"),
-    ])?;
+    append(
+        "rays",
+        &format!("{} ({})", info.name, info.driver),
+        &[
+            Figure::new(&case, "coherent_mrays_per_s", mrays(coherent_ms), "Mrays/s"),
+            Figure::new(
+                &case,
+                "incoherent_mrays_per_s",
+                mrays(incoherent_ms),
+                "Mrays/s",
+            ),
+            Figure::new(&case, "blas_build_ms", stats.build_ms, "ms"),
+            Figure::new(&case, "blas_compact_ms", stats.compact_ms, "ms"),
+            Figure::new(&case, "tlas_build_ms", tlas_ms, "ms"),
+            Figure::new(&case, "rays", n as f64, "rays"),
+        ],
+    )?;
     drop(instances);
     Ok(())
 }

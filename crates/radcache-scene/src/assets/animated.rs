@@ -22,7 +22,13 @@ use crate::writer::{ChannelDesc, GltfBuilder, LightDesc, MaterialDesc, NodeDesc}
 /// Duration of the animated scene in seconds.
 pub const ANIMATED_DURATION: f32 = 5.0;
 
-fn cube_node(b: &mut GltfBuilder, name: &str, half: f32, rgb: [f32; 3], translation: [f32; 3]) -> usize {
+fn cube_node(
+    b: &mut GltfBuilder,
+    name: &str,
+    half: f32,
+    rgb: [f32; 3],
+    translation: [f32; 3],
+) -> usize {
     let mat = b.add_material(&MaterialDesc::diffuse(name, rgb));
     let mut soup = QuadSoup::default();
     soup.cuboid(Vec3::ZERO, Vec3::splat(half), false);
@@ -69,10 +75,26 @@ pub fn animated_builder() -> GltfBuilder {
     roots.extend([mover, bouncer, camera, bulb]);
 
     let keys = [0.0, 2.5, ANIMATED_DURATION];
-    let flat = |vs: &[[f32; 4]], n: usize| -> Vec<f32> { vs.iter().flat_map(|v| v[..n].to_vec()).collect() };
-    let cam_t = flat(&[[0.278, 0.273, -0.8, 0.0], [0.278, 0.3, -0.2, 0.0], [0.35, 0.3, 0.1, 0.0]], 3);
+    let flat = |vs: &[[f32; 4]], n: usize| -> Vec<f32> {
+        vs.iter().flat_map(|v| v[..n].to_vec()).collect()
+    };
+    let cam_t = flat(
+        &[
+            [0.278, 0.273, -0.8, 0.0],
+            [0.278, 0.3, -0.2, 0.0],
+            [0.35, 0.3, 0.1, 0.0],
+        ],
+        3,
+    );
     let cam_r = flat(&[yaw(180.0), yaw(180.0), yaw(195.0)], 4);
-    let mover_t = flat(&[[0.15, 0.08, 0.12, 0.0], [0.40, 0.08, 0.12, 0.0], [0.15, 0.08, 0.12, 0.0]], 3);
+    let mover_t = flat(
+        &[
+            [0.15, 0.08, 0.12, 0.0],
+            [0.40, 0.08, 0.12, 0.0],
+            [0.15, 0.08, 0.12, 0.0],
+        ],
+        3,
+    );
     let mover_r = flat(&[yaw(0.0), yaw(90.0), yaw(180.0)], 4);
     // CUBICSPLINE: per key (in-tangent, value, out-tangent).
     let bounce = [

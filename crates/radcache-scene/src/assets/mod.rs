@@ -50,7 +50,8 @@ impl QuadSoup {
             self.positions.push(p.to_array());
             self.normals.push(n.to_array());
         }
-        self.indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+        self.indices
+            .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
     }
 
     /// Adds the six faces of an axis-aligned box, normals outward (`inward = false`) or inward.
@@ -70,7 +71,12 @@ impl QuadSoup {
 
     /// The primitive with `material`.
     pub(crate) fn primitive(self, material: usize) -> PrimitiveDesc {
-        PrimitiveDesc::triangles(self.positions, Some(self.normals), self.indices, Some(material))
+        PrimitiveDesc::triangles(
+            self.positions,
+            Some(self.normals),
+            self.indices,
+            Some(material),
+        )
     }
 }
 
@@ -102,7 +108,11 @@ pub(crate) fn write_named(builder: &GltfBuilder, dir: &Path, name: &str) -> Resu
 /// `albedo` emitting `emission` W/(sr·m²); a 90° camera at the centre looks down −Z.
 pub fn furnace_builder(albedo: f32, emission: f32) -> GltfBuilder {
     let mut b = GltfBuilder::new();
-    let mat = b.add_material(&MaterialDesc::emitter("furnace", [albedo; 3], [emission; 3]));
+    let mat = b.add_material(&MaterialDesc::emitter(
+        "furnace",
+        [albedo; 3],
+        [emission; 3],
+    ));
     let mut soup = QuadSoup::default();
     soup.cuboid(Vec3::ZERO, Vec3::ONE, true);
     let mesh = b.add_mesh("furnace_box", &[soup.primitive(mat)]);

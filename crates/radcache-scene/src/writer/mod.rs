@@ -7,6 +7,7 @@
 //! split into `emissiveFactor` × `KHR_materials_emissive_strength` when it exceeds 1. The JSON is
 //! written with serde_json; [`GltfBuilder::to_json`] exposes it so tests can mutate it.
 
+mod desc;
 mod png;
 
 use std::collections::BTreeSet;
@@ -18,6 +19,8 @@ use crate::animation::{Interpolation, Property};
 use crate::error::{Error, Result};
 use crate::light::LightKind;
 
+pub use desc::{ChannelDesc, IndexFormat, LightDesc, MaterialDesc, NodeDesc, PrimitiveDesc};
+
 /// Where the binary buffer goes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BufferLayout {
@@ -25,155 +28,6 @@ pub enum BufferLayout {
     External,
     /// A `data:application/octet-stream;base64,` URI inside the JSON.
     Embedded,
-}
-
-/// Index component type of a primitive.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum IndexFormat {
-    /// The smallest of u16/u32 that fits (u8 is allowed by glTF but discouraged by the validator).
-    #[default]
-    Auto,
-    /// Unsigned byte.
-    U8,
-    /// Unsigned short.
-    U16,
-    /// Unsigned int.
-    U32,
-}
-
-/// A metallic-roughness material.
-#[derive(Clone, Debug, PartialEq)]
-pub struct MaterialDesc {
-    /// Name.
-    pub name: String,
-    /// Linear base colour factor.
-    pub base_color: [f32; 4],
-    /// Metallic factor.
-    pub metallic: f32,
-    /// Roughness factor.
-    pub roughness: f32,
-    /// Emitted radiance W/(sr·m²) (split into factor × strength on write).
-    pub emissive: [f32; 3],
-    /// Double-sided flag.
-    pub double_sided: bool,
-    /// Base colour texture index (from [`GltfBuilder::add_texture_rgba8`]).
-    pub base_color_texture: Option<usize>,
-    /// Emissive texture index.
-    pub emissive_texture: Option<usize>,
-    /// `alphaMode` other than OPAQUE (e.g. `"BLEND"`), for tests.
-    pub alpha_mode: Option<String>,
-}
-
-impl MaterialDesc {
-    /// A diffuse (metallic 0, roughness 1) material of linear albedo `rgb`.
-    pub fn diffuse(name: &str, rgb: [f32; 3]) -> MaterialDesc {
-        MaterialDesc {
-            name: name.into(),
-            base_color: [rgb[0], rgb[1], rgb[2], 1.0],
-            metallic: 0.0,
-            roughness: 1.0,
-            emissive: [0.0; 3],
-            double_sided: false,
-            base_color_texture: None,
-            emissive_texture: None,
-            alpha_mode: None,
-        }
-    }
-
-    /// A diffuse material that also emits `radiance`.
-    pub fn emitter(name: &str, rgb: [f32; 3], radiance: [f32; 3]) -> MaterialDesc {
-        MaterialDesc {
-            emissive: radiance,
-            ..MaterialDesc::diffuse(name, rgb)
-        }
-    }
-}
-
-/// One primitive of a mesh.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PrimitiveDesc {
-    /// Vertex positions.
-    pub positions: Vec<[f32; 3]>,
-    /// Unit normals (optional).
-    pub normals: Option<Vec<[f32; 3]>>,
-    /// TEXCOORD_0 (optional).
-    pub texcoords: Option<Vec<[f32; 2]>>,
-    /// Indices (optional: non-indexed).
-    pub indices: Option<Vec<u32>>,
-    /// Index component type.
-    pub index_format: IndexFormat,
-    /// Material index.
-    pub material: Option<usize>,
-    /// Primitive mode (4 = TRIANGLES).
-    pub mode: u32,
-}
-
-impl PrimitiveDesc {
-    /// An indexed triangle primitive.
-    pub fn triangles(positions: Vec<[f32; 3]>, normals: Option<Vec<[f32; 3]>>, indices: Vec<u32>, material: Option<usize>) -> PrimitiveDesc {
-        PrimitiveDesc {
-            positions,
-            normals,
-            texcoords: None,
-            indices: Some(indices),
-            index_format: IndexFormat::Auto,
-            material,
-            mode: 4,
-        }
-    }
-}
-
-/// A node.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct NodeDesc {
-    /// Name.
-    pub name: Option<String>,
-    /// Translation.
-    pub translation: Option<[f32; 3]>,
-    /// Rotation quaternion (x, y, z, w).
-    pub rotation: Option<[f32; 4]>,
-    /// Scale.
-    pub scale: Option<[f32; 3]>,
-    /// Column-major matrix (instead of TRS).
-    pub matrix: Option<[f32; 16]>,
-    /// Mesh index.
-    pub mesh: Option<usize>,
-    /// Camera index.
-    pub camera: Option<usize>,
-    /// Punctual light index.
-    pub light: Option<usize>,
-    /// Child node indices.
-    pub children: Vec<usize>,
-}
-
-/// A punctual light.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LightDesc {
-    /// Name.
-    pub name: Option<String>,
-    /// Kind (and spot cone angles).
-    pub kind: LightKind,
-    /// Linear colour.
-    pub color: [f32; 3],
-    /// Candela (point/spot) or lux (directional).
-    pub intensity: f32,
-    /// Range (m).
-    pub range: Option<f32>,
-}
-
-/// One animation channel (its sampler is written alongside).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ChannelDesc {
-    /// Target node.
-    pub node: usize,
-    /// Target property.
-    pub property: Property,
-    /// Interpolation.
-    pub interpolation: Interpolation,
-    /// Key times (s).
-    pub times: Vec<f32>,
-    /// Flat output values: 3 or 4 per element; CUBICSPLINE has 3 elements per key (in, value, out).
-    pub values: Vec<f32>,
 }
 
 /// Builds a glTF document; see the module docs.
@@ -259,11 +113,23 @@ impl GltfBuilder {
         };
         let (bytes, ct): (Vec<u8>, u32) = match format {
             IndexFormat::U8 => (indices.iter().map(|&i| i as u8).collect(), 5121),
-            IndexFormat::U16 => (indices.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect(), 5123),
-            _ => (indices.iter().flat_map(|&i| i.to_le_bytes()).collect(), 5125),
+            IndexFormat::U16 => (
+                indices
+                    .iter()
+                    .flat_map(|&i| (i as u16).to_le_bytes())
+                    .collect(),
+                5123,
+            ),
+            _ => (
+                indices.iter().flat_map(|&i| i.to_le_bytes()).collect(),
+                5125,
+            ),
         };
         let view = self.view(&bytes, Some(34963));
-        push(&mut self.accessors, json!({"bufferView": view, "componentType": ct, "count": indices.len(), "type": "SCALAR"}))
+        push(
+            &mut self.accessors,
+            json!({"bufferView": view, "componentType": ct, "count": indices.len(), "type": "SCALAR"}),
+        )
     }
 
     /// Adds a material; returns its index.
@@ -278,8 +144,10 @@ impl GltfBuilder {
             let strength = peak.max(1.0);
             v["emissiveFactor"] = nums(&m.emissive.map(|e| e / strength));
             if strength > 1.0 {
-                v["extensions"] = json!({"KHR_materials_emissive_strength": {"emissiveStrength": num(strength)}});
-                self.extensions_used.insert("KHR_materials_emissive_strength".into());
+                v["extensions"] =
+                    json!({"KHR_materials_emissive_strength": {"emissiveStrength": num(strength)}});
+                self.extensions_used
+                    .insert("KHR_materials_emissive_strength".into());
             }
         }
         if let Some(t) = m.emissive_texture {
@@ -300,14 +168,23 @@ impl GltfBuilder {
         for p in prims {
             let flat: Vec<f32> = p.positions.iter().flatten().copied().collect();
             let mut attrs = Map::new();
-            attrs.insert("POSITION".into(), json!(self.add_float_accessor(&flat, 3, Some(34962))));
+            attrs.insert(
+                "POSITION".into(),
+                json!(self.add_float_accessor(&flat, 3, Some(34962))),
+            );
             if let Some(n) = &p.normals {
                 let flat: Vec<f32> = n.iter().flatten().copied().collect();
-                attrs.insert("NORMAL".into(), json!(self.add_float_accessor(&flat, 3, Some(34962))));
+                attrs.insert(
+                    "NORMAL".into(),
+                    json!(self.add_float_accessor(&flat, 3, Some(34962))),
+                );
             }
             if let Some(t) = &p.texcoords {
                 let flat: Vec<f32> = t.iter().flatten().copied().collect();
-                attrs.insert("TEXCOORD_0".into(), json!(self.add_float_accessor(&flat, 2, Some(34962))));
+                attrs.insert(
+                    "TEXCOORD_0".into(),
+                    json!(self.add_float_accessor(&flat, 2, Some(34962))),
+                );
             }
             let mut prim = json!({"attributes": attrs});
             if let Some(i) = &p.indices {
@@ -325,7 +202,14 @@ impl GltfBuilder {
     }
 
     /// Adds a perspective camera; returns its index.
-    pub fn add_perspective_camera(&mut self, name: &str, yfov: f32, aspect: Option<f32>, znear: f32, zfar: Option<f32>) -> usize {
+    pub fn add_perspective_camera(
+        &mut self,
+        name: &str,
+        yfov: f32,
+        aspect: Option<f32>,
+        znear: f32,
+        zfar: Option<f32>,
+    ) -> usize {
         let mut p = json!({"yfov": num(yfov), "znear": num(znear)});
         if let Some(a) = aspect {
             p["aspectRatio"] = num(a);
@@ -333,13 +217,19 @@ impl GltfBuilder {
         if let Some(f) = zfar {
             p["zfar"] = num(f);
         }
-        push(&mut self.cameras, json!({"name": name, "type": "perspective", "perspective": p}))
+        push(
+            &mut self.cameras,
+            json!({"name": name, "type": "perspective", "perspective": p}),
+        )
     }
 
     /// Adds an orthographic camera (for tests; the loader rejects it); returns its index.
     pub fn add_orthographic_camera(&mut self, name: &str, xmag: f32, ymag: f32) -> usize {
         let o = json!({"xmag": num(xmag), "ymag": num(ymag), "znear": 0.01, "zfar": 100.0});
-        push(&mut self.cameras, json!({"name": name, "type": "orthographic", "orthographic": o}))
+        push(
+            &mut self.cameras,
+            json!({"name": name, "type": "orthographic", "orthographic": o}),
+        )
     }
 
     /// Adds a KHR_lights_punctual light; returns its index.
@@ -351,7 +241,11 @@ impl GltfBuilder {
             LightKind::Spot { .. } => "spot",
             LightKind::Directional => "directional",
         });
-        if let LightKind::Spot { inner_cone_angle, outer_cone_angle } = l.kind {
+        if let LightKind::Spot {
+            inner_cone_angle,
+            outer_cone_angle,
+        } = l.kind
+        {
             v["spot"] = json!({"innerConeAngle": num(inner_cone_angle), "outerConeAngle": num(outer_cone_angle)});
         }
         if let Some(r) = l.range {
@@ -369,7 +263,12 @@ impl GltfBuilder {
         if let Some(s) = &n.name {
             v["name"] = json!(s);
         }
-        for (key, val) in [("translation", n.translation.map(|x| nums(&x))), ("rotation", n.rotation.map(|x| nums(&x))), ("scale", n.scale.map(|x| nums(&x))), ("matrix", n.matrix.map(|x| nums(&x)))] {
+        for (key, val) in [
+            ("translation", n.translation.map(|x| nums(&x))),
+            ("rotation", n.rotation.map(|x| nums(&x))),
+            ("scale", n.scale.map(|x| nums(&x))),
+            ("matrix", n.matrix.map(|x| nums(&x))),
+        ] {
             if let Some(val) = val {
                 v[key] = val;
             }
@@ -392,7 +291,11 @@ impl GltfBuilder {
     pub fn add_animation(&mut self, name: &str, channels: &[ChannelDesc]) -> usize {
         let (mut chans, mut samplers) = (Vec::new(), Vec::new());
         for (i, c) in channels.iter().enumerate() {
-            let comps = if c.property == Property::Rotation { 4 } else { 3 };
+            let comps = if c.property == Property::Rotation {
+                4
+            } else {
+                3
+            };
             let input = self.add_float_accessor(&c.times, 1, None);
             let output = self.add_float_accessor(&c.values, comps, None);
             let interp = match c.interpolation {
@@ -408,17 +311,32 @@ impl GltfBuilder {
             samplers.push(json!({"input": input, "output": output, "interpolation": interp}));
             chans.push(json!({"sampler": i, "target": {"node": c.node, "path": path}}));
         }
-        push(&mut self.animations, json!({"name": name, "channels": chans, "samplers": samplers}))
+        push(
+            &mut self.animations,
+            json!({"name": name, "channels": chans, "samplers": samplers}),
+        )
     }
 
     /// Adds an RGBA8 image (embedded PNG) and a texture using it; returns the texture index.
     /// `wrap` is the glTF wrap mode for both axes (10497 REPEAT, 33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT).
-    pub fn add_texture_rgba8(&mut self, width: u32, height: u32, rgba: &[u8], wrap: u32) -> Option<usize> {
+    pub fn add_texture_rgba8(
+        &mut self,
+        width: u32,
+        height: u32,
+        rgba: &[u8],
+        wrap: u32,
+    ) -> Option<usize> {
         let png = png::encode_rgba8(width, height, rgba)?;
         let view = self.view(&png, None);
-        let image = push(&mut self.images, json!({"bufferView": view, "mimeType": "image/png"}));
+        let image = push(
+            &mut self.images,
+            json!({"bufferView": view, "mimeType": "image/png"}),
+        );
         let sampler = push(&mut self.samplers, json!({"wrapS": wrap, "wrapT": wrap}));
-        Some(push(&mut self.textures, json!({"source": image, "sampler": sampler})))
+        Some(push(
+            &mut self.textures,
+            json!({"source": image, "sampler": sampler}),
+        ))
     }
 
     /// Adds a scene with `roots` and optional `extras`; the first scene is the default one.
@@ -436,11 +354,26 @@ impl GltfBuilder {
         if !self.bin.is_empty() {
             let uri = match bin_uri {
                 Some(u) => u.to_string(),
-                None => format!("data:application/octet-stream;base64,{}", crate::base64::encode(&self.bin)),
+                None => format!(
+                    "data:application/octet-stream;base64,{}",
+                    crate::base64::encode(&self.bin)
+                ),
             };
             root["buffers"] = json!([{"byteLength": self.bin.len(), "uri": uri}]);
         }
-        let lists = [("bufferViews", &self.views), ("accessors", &self.accessors), ("materials", &self.materials), ("meshes", &self.meshes), ("nodes", &self.nodes), ("cameras", &self.cameras), ("animations", &self.animations), ("scenes", &self.scenes), ("images", &self.images), ("textures", &self.textures), ("samplers", &self.samplers)];
+        let lists = [
+            ("bufferViews", &self.views),
+            ("accessors", &self.accessors),
+            ("materials", &self.materials),
+            ("meshes", &self.meshes),
+            ("nodes", &self.nodes),
+            ("cameras", &self.cameras),
+            ("animations", &self.animations),
+            ("scenes", &self.scenes),
+            ("images", &self.images),
+            ("textures", &self.textures),
+            ("samplers", &self.samplers),
+        ];
         for (key, list) in lists {
             if !list.is_empty() {
                 root[key] = Value::Array(list.clone());
@@ -460,9 +393,19 @@ impl GltfBuilder {
 
     /// Writes `path` (a `.gltf`), plus `<stem>.bin` next to it for [`BufferLayout::External`].
     pub fn write(&self, path: &Path, layout: BufferLayout) -> Result<()> {
-        let bin_name = format!("{}.bin", path.file_stem().and_then(|s| s.to_str()).unwrap_or("buffer"));
-        let (root, bin) = self.to_json((layout == BufferLayout::External).then_some(bin_name.as_str()));
-        write_files(path, &root, (layout == BufferLayout::External).then_some((&bin_name, &bin)))
+        let bin_name = format!(
+            "{}.bin",
+            path.file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("buffer")
+        );
+        let (root, bin) =
+            self.to_json((layout == BufferLayout::External).then_some(bin_name.as_str()));
+        write_files(
+            path,
+            &root,
+            (layout == BufferLayout::External).then_some((&bin_name, &bin)),
+        )
     }
 }
 

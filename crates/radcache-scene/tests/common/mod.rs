@@ -41,7 +41,10 @@ pub fn write(b: &GltfBuilder, dir: &Path, name: &str) -> PathBuf {
 
 /// A unit right triangle in the XY plane (normal +Z) and a camera at z = 2, as a builder
 /// whose single primitive can be customised by `f`.
-pub fn triangle_scene(material: Option<MaterialDesc>, f: impl FnOnce(&mut PrimitiveDesc)) -> GltfBuilder {
+pub fn triangle_scene(
+    material: Option<MaterialDesc>,
+    f: impl FnOnce(&mut PrimitiveDesc),
+) -> GltfBuilder {
     let mut b = GltfBuilder::new();
     let mat = material.map(|m| b.add_material(&m));
     let mut prim = PrimitiveDesc::triangles(
@@ -78,4 +81,35 @@ pub fn close(a: f32, b: f32, tol: f32) {
 #[track_caller]
 pub fn close3(a: glam::Vec3, b: glam::Vec3, tol: f32) {
     assert!((a - b).length() <= tol, "{a} != {b} (tol {tol})");
+}
+
+/// A GLB file (header, space-padded JSON chunk, zero-padded BIN chunk) of `root` and `bin`; the
+/// first buffer loses its `uri` so that it refers to the BIN chunk.
+pub fn glb_bytes(root: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
+    let mut root = root.clone();
+    if let Some(b) = root.pointer_mut("/buffers/0").and_then(|b| b.as_object_mut()) {
+        b.remove("uri");
+    }
+    let mut text = serde_json::to_vec(&root).unwrap();
+    while text.len() % 4 != 0 {
+        text.push(b' ');
+    }
+    let mut bin = bin.to_vec();
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let total = 12 + 8 + text.len() + if bin.is_empty() { 0 } else { 8 + bin.len() };
+    let mut glb = Vec::with_capacity(total);
+    glb.extend_from_slice(b"glTF");
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&(total as u32).to_le_bytes());
+    glb.extend_from_slice(&(text.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"JSON");
+    glb.extend_from_slice(&text);
+    if !bin.is_empty() {
+        glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        glb.extend_from_slice(b"BIN\0");
+        glb.extend_from_slice(&bin);
+    }
+    glb
 }

@@ -1,0 +1,158 @@
+//! Plain descriptions of glTF elements handed to [`GltfBuilder`](super::GltfBuilder).
+
+use crate::animation::{Interpolation, Property};
+use crate::light::LightKind;
+
+/// Index component type of a primitive.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum IndexFormat {
+    /// The smallest of u16/u32 that fits (u8 is allowed by glTF but discouraged by the validator).
+    #[default]
+    Auto,
+    /// Unsigned byte.
+    U8,
+    /// Unsigned short.
+    U16,
+    /// Unsigned int.
+    U32,
+}
+
+/// A metallic-roughness material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialDesc {
+    /// Name.
+    pub name: String,
+    /// Linear base colour factor.
+    pub base_color: [f32; 4],
+    /// Metallic factor.
+    pub metallic: f32,
+    /// Roughness factor.
+    pub roughness: f32,
+    /// Emitted radiance W/(sr·m²) (split into factor × strength on write).
+    pub emissive: [f32; 3],
+    /// Double-sided flag.
+    pub double_sided: bool,
+    /// Base colour texture index (from [`GltfBuilder::add_texture_rgba8`]).
+    pub base_color_texture: Option<usize>,
+    /// Emissive texture index.
+    pub emissive_texture: Option<usize>,
+    /// `alphaMode` other than OPAQUE (e.g. `"BLEND"`), for tests.
+    pub alpha_mode: Option<String>,
+}
+
+impl MaterialDesc {
+    /// A diffuse (metallic 0, roughness 1) material of linear albedo `rgb`.
+    pub fn diffuse(name: &str, rgb: [f32; 3]) -> MaterialDesc {
+        MaterialDesc {
+            name: name.into(),
+            base_color: [rgb[0], rgb[1], rgb[2], 1.0],
+            metallic: 0.0,
+            roughness: 1.0,
+            emissive: [0.0; 3],
+            double_sided: false,
+            base_color_texture: None,
+            emissive_texture: None,
+            alpha_mode: None,
+        }
+    }
+
+    /// A diffuse material that also emits `radiance`.
+    pub fn emitter(name: &str, rgb: [f32; 3], radiance: [f32; 3]) -> MaterialDesc {
+        MaterialDesc {
+            emissive: radiance,
+            ..MaterialDesc::diffuse(name, rgb)
+        }
+    }
+}
+
+/// One primitive of a mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrimitiveDesc {
+    /// Vertex positions.
+    pub positions: Vec<[f32; 3]>,
+    /// Unit normals (optional).
+    pub normals: Option<Vec<[f32; 3]>>,
+    /// TEXCOORD_0 (optional).
+    pub texcoords: Option<Vec<[f32; 2]>>,
+    /// Indices (optional: non-indexed).
+    pub indices: Option<Vec<u32>>,
+    /// Index component type.
+    pub index_format: IndexFormat,
+    /// Material index.
+    pub material: Option<usize>,
+    /// Primitive mode (4 = TRIANGLES).
+    pub mode: u32,
+}
+
+impl PrimitiveDesc {
+    /// An indexed triangle primitive.
+    pub fn triangles(
+        positions: Vec<[f32; 3]>,
+        normals: Option<Vec<[f32; 3]>>,
+        indices: Vec<u32>,
+        material: Option<usize>,
+    ) -> PrimitiveDesc {
+        PrimitiveDesc {
+            positions,
+            normals,
+            texcoords: None,
+            indices: Some(indices),
+            index_format: IndexFormat::Auto,
+            material,
+            mode: 4,
+        }
+    }
+}
+
+/// A node.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NodeDesc {
+    /// Name.
+    pub name: Option<String>,
+    /// Translation.
+    pub translation: Option<[f32; 3]>,
+    /// Rotation quaternion (x, y, z, w).
+    pub rotation: Option<[f32; 4]>,
+    /// Scale.
+    pub scale: Option<[f32; 3]>,
+    /// Column-major matrix (instead of TRS).
+    pub matrix: Option<[f32; 16]>,
+    /// Mesh index.
+    pub mesh: Option<usize>,
+    /// Camera index.
+    pub camera: Option<usize>,
+    /// Punctual light index.
+    pub light: Option<usize>,
+    /// Child node indices.
+    pub children: Vec<usize>,
+}
+
+/// A punctual light.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightDesc {
+    /// Name.
+    pub name: Option<String>,
+    /// Kind (and spot cone angles).
+    pub kind: LightKind,
+    /// Linear colour.
+    pub color: [f32; 3],
+    /// Candela (point/spot) or lux (directional).
+    pub intensity: f32,
+    /// Range (m).
+    pub range: Option<f32>,
+}
+
+/// One animation channel (its sampler is written alongside).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChannelDesc {
+    /// Target node.
+    pub node: usize,
+    /// Target property.
+    pub property: Property,
+    /// Interpolation.
+    pub interpolation: Interpolation,
+    /// Key times (s).
+    pub times: Vec<f32>,
+    /// Flat output values: 3 or 4 per element; CUBICSPLINE has 3 elements per key (in, value, out).
+    pub values: Vec<f32>,
+}
