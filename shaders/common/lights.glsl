@@ -94,6 +94,9 @@ float emitter_area_pdf(vec3 emission, bool two_sided) {
 // point, its distance, the radiance it sends toward p, and the solid-angle pdf.
 bool sample_emitter(vec3 p, vec3 u, out vec3 dir, out float dist, out vec3 radiance, out float pdf) {
     uint n = frame.counts.x;
+    if (n == 0u) {
+        return false;
+    }
     uint i = min(uint(u.x * float(n)), n - 1u);
     GpuAlias a = emitter_alias[i];
     uint t = alias_pick(u.x, n, a.prob, a.alias, i);
@@ -155,8 +158,13 @@ vec3 punctual_incident(GpuLight l, vec3 p, out vec3 dir, out float dist) {
 }
 #endif
 
+// Ray queries this invocation has issued (shadow rays here; passes add their own), for the
+// rays-per-pass statistics.
+uint rays_traced = 0u;
+
 // True when nothing blocks the segment from `origin` along `dir` up to `tmax`.
 bool unoccluded(vec3 origin, vec3 dir, float tmax) {
+    rays_traced++;
     rayQueryEXT q;
     rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT | gl_RayFlagsTerminateOnFirstHitEXT, 0xFF,
                           origin, 0.0, dir, tmax);

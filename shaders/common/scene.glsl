@@ -74,6 +74,11 @@ Surface surface_at(uint instance, uint prim, vec2 bary, vec3 dir) {
     vec3 ng = cross(e1, e2);
     float len = length(ng);
     ng = len > 0.0 ? ng / len : vec3(0.0, 0.0, 1.0);
+    // A mirroring instance transform (w.w < 0) turns counter-clockwise into clockwise: glTF keeps
+    // the front face on the side the transformed normals point to.
+    if (inst.normal_to_world[3][3] < 0.0) {
+        ng = -ng;
+    }
     s.front_face = dot(ng, dir) < 0.0;
     s.geometric_normal = s.front_face ? ng : -ng;
     vec3 ns = (inst.normal_to_world * vec4(n_obj, 0.0)).xyz;

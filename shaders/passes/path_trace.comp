@@ -25,6 +25,10 @@ layout(binding = B_PASS_BASE + 1, std430) buffer Compensation {
     vec4 compensation[];  // per pixel: Kahan compensation (rgb)
 };
 
+layout(binding = B_PASS_BASE + 2, std430) buffer RayCount {
+    uint ray_count;  // ray queries issued by this dispatch (cleared by the host per submission)
+};
+
 layout(push_constant) uniform Push {
     uint sample_start;
     uint sample_count;
@@ -108,6 +112,7 @@ vec3 trace_path(Ray ray, inout Rng rng) {
     vec3 throughput = vec3(1.0);
     float bsdf_pdf = 0.0;  // solid-angle pdf of the last BSDF sample; 0 for camera rays
     for (uint depth = 0u; depth < MAX_VERTICES; ++depth) {
+        rays_traced++;
         rayQueryEXT q;
         rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, ray.origin, 0.0, ray.dir, 1e30);
         while (rayQueryProceedEXT(q)) {
@@ -188,4 +193,5 @@ void main() {
     }
     accum[index] = vec4(sum, accum[index].a + float(pc.sample_count));
     compensation[index] = vec4(c, 0.0);
+    atomicAdd(ray_count, rays_traced);
 }

@@ -1,1 +1,53 @@
-fn main() {}
+//! `radcache`: render glTF scenes with global illumination, inspect them, compare images.
+
+mod compare;
+mod info;
+mod progress;
+mod render;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser, Debug)]
+#[command(name = "radcache", version, about = "Irradiance-caching renderer for glTF scenes")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render a scene to an EXR (and optionally a PNG preview).
+    Render(render::RenderArgs),
+    /// Print a scene's summary and the plan of what its frames need.
+    Info(info::InfoArgs),
+    /// Compare a candidate image against a reference (RMSE, relMSE, MAE, block RMSE, FLIP, ...).
+    Compare(compare::CompareArgs),
+}
+
+/// Where the GLSL sources live: `RADCACHE_SHADERS`, else the source tree this binary was built
+/// from.
+pub(crate) fn shader_root() -> PathBuf {
+    std::env::var_os("RADCACHE_SHADERS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shaders")))
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(args) => render::run(&args),
+        Command::Info(args) => info::run(&args),
+        Command::Compare(args) => compare::run(&args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

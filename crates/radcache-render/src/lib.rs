@@ -1,1 +1,20 @@
-//! placeholder
+//! radcache-render: the frame's passes on the GPU, over `radcache-vk`.
+//!
+//! - [`GpuScene`]: the scene's buffers, BLASes and TLAS at a time t, and the shader defines of its
+//!   plan (only the light sources the scene has are compiled in).
+//! - [`PathTracer`] and [`render_path`]: the unbiased reference path tracer.
+//! - [`EnvMap`]: an equirectangular environment map with its importance-sampling table.
+//! - [`bindings`]: the binding numbers shared with GLSL.
+
+pub mod bindings;
+mod env_map;
+mod error;
+mod gpu_scene;
+mod path_trace;
+mod render;
+
+pub use env_map::{gpu_alias, texel_solid_angle, EnvMap};
+pub use error::{Error, Result};
+pub use gpu_scene::{vulkan_clip_from_view, GpuScene, UploadStats, REFITS_PER_REBUILD};
+pub use path_trace::PathTracer;
+pub use render::{render_path, Budget, FrameOutput, PathSettings, Progress};

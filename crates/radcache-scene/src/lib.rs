@@ -10,6 +10,28 @@
 //! Units: 1 glTF unit = 1 m; colours and radiometry are linear RGB; emission in W/(sr·m²); light
 //! intensities in the KHR_lights_punctual units (cd, lx) used as radiometric values.
 //!
+//! **For a GPU uploader.** Geometry: `scene.meshes[m]` holds `positions`, `normals`,
+//! `texcoords` (one entry per vertex), `indices` (3 per triangle, CCW front faces) and
+//! `triangle_materials` (one per triangle), plus per-primitive [`PrimitiveRange`]s. Placement:
+//! `scene.instances[i].mesh` with `scene.instance_transforms(t)[i]` (`world_from_object`; a negative
+//! determinant makes the clockwise side the front, per the glTF spec); `Instance::dynamic` says
+//! whether it moves. Materials: `scene.materials` (the last one is the default material when a
+//! primitive had none), textures `scene.textures[k].image` → `scene.images[..]` as RGBA8 with an
+//! `srgb` flag, or linear `f32` via [`Image::to_linear_f32`]. Emitters at time `t`:
+//! `scene.emitters_at(t)` ([`EmitterTable`]: world-space triangles, power, alias table).
+//! Punctual lights: `scene.lights_at(t)`. Camera: `scene.camera_at(t)` ([`CameraView`], with
+//! `clip_from_world` and `ray_direction`). Environment: `scene.environment`. Plan: `scene.plan()`.
+//!
+//! **Bad input** never panics (a seeded mutation test checks this). It is one [`Error`] naming the
+//! file and the element (buffer, accessor with its mesh/primitive/attribute user, node, camera,
+//! animation channel/sampler, light, image): unreadable or invalid files, missing or short buffers,
+//! accessors or buffer views out of range, vertex indices out of range, NaN/Inf vertex data or key
+//! values, unsupported required extensions, orthographic cameras, broken hierarchies. Droppable
+//! elements are dropped with a [`Warning`] that carries a count: degenerate triangles,
+//! non-TRIANGLES primitives, primitives without POSITION. Features outside the renderer's model are
+//! loaded with a documented fallback and a warning: alpha MASK/BLEND (opaque), skins and morph
+//! targets (rest pose), texCoord sets other than 0 (texture ignored), missing normals (flat).
+//!
 //! The [`writer`] module builds valid glTF files (used by tests and by [`assets`], which generates
 //! the bundled Cornell box, furnace and animated scenes).
 

@@ -251,7 +251,7 @@ fn read_primitive(
             (0..n32).collect()
         }
     };
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         warnings.push(
             WarningKind::Other,
             1,

@@ -11,8 +11,19 @@ use crate::light::LightKind;
 use crate::math::Aabb;
 use crate::scene::Scene;
 
+/// `x` with 3 decimals, printing values that round to zero as `0.000` (never `-0.000`).
+fn f3(x: f32) -> String {
+    let s = format!("{x:.3}");
+    if s == "-0.000" {
+        "0.000".into()
+    } else {
+        s
+    }
+}
+
+/// `(x, y, z)` with 3 decimals.
 fn v3(v: Vec3) -> String {
-    format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z)
+    format!("({}, {}, {})", f3(v.x), f3(v.y), f3(v.z))
 }
 
 fn aabb(b: &Aabb) -> String {

@@ -98,6 +98,56 @@ fn linear_rotation_slerp_takes_the_shortest_path() {
 }
 
 #[test]
+fn rotation_keys_boundaries_and_step() {
+    // Keys: identity at t = 0, 90° about Z at t = 1, 180° about Z at t = 3 (hand-written xyzw).
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    let keys = [
+        Vec4::new(0.0, 0.0, 0.0, 1.0),
+        Vec4::new(0.0, 0.0, h, h),
+        Vec4::new(0.0, 0.0, 1.0, 0.0),
+    ];
+    let s = sampler(Interpolation::Linear, &[0.0, 1.0, 3.0], &keys);
+    let at = |t: f32| s.sample(t, Property::Rotation);
+    let near = |a: Vec4, b: Vec4| {
+        assert!(
+            (a - b).length() < 1e-5 || (a + b).length() < 1e-5,
+            "{a} != {b}"
+        )
+    };
+    // Before the first key, exactly at each key, after the last key.
+    near(at(-2.0), keys[0]);
+    near(at(0.0), keys[0]);
+    near(at(1.0), keys[1]);
+    near(at(3.0), keys[2]);
+    near(at(9.0), keys[2]);
+    // Midway between keys 1 and 2 (t = 2): 135° about Z = (0, 0, sin 67.5°, cos 67.5°).
+    near(at(2.0), Vec4::new(0.0, 0.0, 0.923_879_5, 0.382_683_4));
+    // A quarter into the first segment: 22.5° about Z = (0, 0, sin 11.25°, cos 11.25°).
+    near(at(0.25), Vec4::new(0.0, 0.0, 0.195_090_3, 0.980_785_3));
+    // STEP rotations hold the previous key, including just before a key.
+    let s = sampler(Interpolation::Step, &[0.0, 1.0, 3.0], &keys);
+    let at = |t: f32| s.sample(t, Property::Rotation);
+    near(at(0.999), keys[0]);
+    near(at(1.0), keys[1]);
+    near(at(2.999), keys[1]);
+    near(at(3.0), keys[2]);
+}
+
+#[test]
+fn linear_translation_is_exact_at_interior_keys() {
+    let s = sampler(
+        Interpolation::Linear,
+        &[0.0, 0.5, 2.0],
+        &[v3(0.0, 0.0, 0.0), v3(1.0, -1.0, 2.0), v3(4.0, 2.0, 2.0)],
+    );
+    let at = |t| s.sample(t, Property::Translation).truncate();
+    close3(at(0.5), Vec3::new(1.0, -1.0, 2.0), 0.0);
+    close3(at(0.25), Vec3::new(0.5, -0.5, 1.0), 1e-6);
+    // Second segment: s = (1.5 - 0.5) / 1.5 = 2/3.
+    close3(at(1.5), Vec3::new(3.0, 1.0, 2.0), 1e-6);
+}
+
+#[test]
 fn cubic_spline_matches_the_hermite_formula() {
     // Keys at t = 0 and 2 (Δ = 2): v0 = 1, b0 = 2 (out), a1 = -1 (in), v1 = 3.
     // The in-tangent of key 0 and the out-tangent of key 1 are unused (100).

@@ -99,6 +99,31 @@ fn cornell_box() {
             "room triangle {t} faces outward"
         );
     }
+    // Blocks face outward; every vertex normal agrees with its triangle's winding.
+    for name in ["tall_block", "short_block"] {
+        let m = &s.meshes[mesh_named(&s, name)];
+        let center = m.bounds.center();
+        for t in 0..m.triangle_count() {
+            let p = m.triangle(t);
+            let n = (p[1] - p[0]).cross(p[2] - p[0]);
+            let c = (p[0] + p[1] + p[2]) / 3.0;
+            assert!(n.dot(c - center) > 0.0, "{name} triangle {t} faces inward");
+        }
+    }
+    for m in &s.meshes {
+        for t in 0..m.triangle_count() {
+            let p = m.triangle(t);
+            let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+            for k in 0..3 {
+                let vn = m.normals[m.indices[3 * t + k] as usize];
+                assert!(
+                    vn.dot(n) > 0.99,
+                    "{:?} triangle {t}: normal {vn} vs winding {n}",
+                    m.name
+                );
+            }
+        }
+    }
     // The light: 2 triangles facing down, 130 mm x 105 mm, emitting (17, 12, 4).
     let emitters = s.emitters_at(0.0);
     assert_eq!(emitters.triangles.len(), 2);

@@ -257,3 +257,71 @@ fn index_formats_and_non_indexed_primitives_load() {
     let (s, _) = common::load(&write(&b, &temp_dir("noidx"), "f"));
     assert_eq!(s.triangle_count(), 1);
 }
+
+#[test]
+fn malformed_glb_headers() {
+    let b = triangle_scene(None, |_| {});
+    let (root, bin) = b.to_json(None);
+    let good = common::glb_bytes(&root, &bin);
+    let dir = temp_dir("glb");
+    let path = dir.join("g.glb");
+    std::fs::write(&path, &good).unwrap();
+    assert!(Scene::load(&path, &LoadOptions::default()).is_ok());
+    // Declared total length below the 12-byte header, beyond the file, and a truncated header.
+    for (tag, bytes) in [
+        (
+            "tiny length",
+            [&good[..8], &4u32.to_le_bytes(), &good[12..]].concat(),
+        ),
+        (
+            "long length",
+            [&good[..8], &u32::MAX.to_le_bytes(), &good[12..]].concat(),
+        ),
+        ("truncated", good[..10].to_vec()),
+        ("short JSON chunk", good[..40].to_vec()),
+    ] {
+        std::fs::write(&path, bytes).unwrap();
+        let e = load_err(&path);
+        assert!(matches!(e, Error::Parse { .. }), "{tag}: {e:?}");
+        assert_mentions(&e, &["g.glb", "invalid glTF"]);
+    }
+}
+
+#[test]
+fn invalid_punctual_lights() {
+    let light = |kind: &str, extra: Value| {
+        let mut l = json!({"type": kind, "intensity": 1.0});
+        for (k, v) in extra.as_object().unwrap() {
+            l[k] = v.clone();
+        }
+        l
+    };
+    let cases = [
+        (
+            light("point", json!({"intensity": -2.0})),
+            "intensity -2 must be finite and non-negative",
+        ),
+        (light("point", json!({"color": [1.0, -0.5, 0.0]})), "colour"),
+        (
+            light(
+                "spot",
+                json!({"spot": {"innerConeAngle": 0.5, "outerConeAngle": 0.3}}),
+            ),
+            "spot cone angles",
+        ),
+        (
+            light("spot", json!({"spot": {"outerConeAngle": 2.0}})),
+            "spot cone angles",
+        ),
+    ];
+    for (i, (l, needle)) in cases.into_iter().enumerate() {
+        let path = mutated(&format!("light{i}"), |r| {
+            r["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+            r["extensions"] = json!({"KHR_lights_punctual": {"lights": [{"type": "point"}, l]}});
+            r["nodes"][0]["extensions"] = json!({"KHR_lights_punctual": {"light": 1}});
+        });
+        let e = load_err(&path);
+        assert!(matches!(e, Error::Invalid { .. }), "{e:?}");
+        assert_mentions(&e, &["t.gltf", "KHR_lights_punctual light 1", needle]);
+    }
+}

@@ -139,6 +139,10 @@ fn alpha_modes_are_opaque_with_a_warning_and_textures_decode_srgb() {
     close(t.z, 1.0, 1e-6);
     close(t.w, 128.0 / 255.0, 1e-6);
     assert_eq!(img.texel_linear(0, 1), Vec4::new(0.0, 0.0, 0.0, 1.0));
+    let f = img.to_linear_f32();
+    assert_eq!(f.len(), 8);
+    assert_eq!(Vec4::from_slice(&f[..4]), t);
+    assert_eq!(f[4..], [0.0, 0.0, 0.0, 1.0]);
     assert_eq!(s.meshes[0].texcoords[1], glam::Vec2::X);
     assert_eq!(s.plan().textures, 1);
 }
@@ -250,4 +254,85 @@ fn weights_channels_are_ignored_with_a_warning() {
     assert_eq!(warnings_of(&w, WarningKind::WeightsChannelIgnored).0, 1);
     assert!(s.animations[0].channels.is_empty());
     assert_eq!(s.time_range(), None);
+}
+
+#[test]
+fn sparse_and_normalized_accessors() {
+    let b = triangle_scene(None, |_| {});
+    let (mut root, mut bin) = b.to_json(Some("s.bin"));
+    // Sparse POSITION: vertex 2 becomes (0.5, 2, 0) (indices u8 [2], values VEC3 f32), appended
+    // to the buffer in two new views.
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let idx_at = bin.len();
+    bin.extend_from_slice(&[2, 0, 0, 0]);
+    let val_at = bin.len();
+    for v in [0.5f32, 2.0, 0.0] {
+        bin.extend_from_slice(&v.to_le_bytes());
+    }
+    // Normalized u16 TEXCOORD_0: (0, 0), (65535, 0), (0, 32768).
+    let uv_at = bin.len();
+    for v in [0u16, 0, 65535, 0, 0, 32768] {
+        bin.extend_from_slice(&v.to_le_bytes());
+    }
+    root["buffers"][0]["byteLength"] = json!(bin.len());
+    let views = root["bufferViews"].as_array_mut().unwrap();
+    let first = views.len();
+    views.push(json!({"buffer": 0, "byteOffset": idx_at, "byteLength": 1}));
+    views.push(json!({"buffer": 0, "byteOffset": val_at, "byteLength": 12}));
+    views.push(json!({"buffer": 0, "byteOffset": uv_at, "byteLength": 12}));
+    root["accessors"][0]["sparse"] = json!({
+        "count": 1,
+        "indices": {"bufferView": first, "componentType": 5121},
+        "values": {"bufferView": first + 1}
+    });
+    let accessors = root["accessors"].as_array_mut().unwrap();
+    accessors.push(json!({"bufferView": first + 2, "componentType": 5123, "normalized": true, "count": 3, "type": "VEC2"}));
+    let uv = accessors.len() - 1;
+    root["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(uv);
+    let dir = temp_dir("sparse");
+    let path = dir.join("s.gltf");
+    write_files(&path, &root, Some(("s.bin", &bin))).unwrap();
+    let (s, _) = load(&path);
+    let m = &s.meshes[0];
+    assert_eq!(
+        m.positions,
+        vec![Vec3::ZERO, Vec3::X, Vec3::new(0.5, 2.0, 0.0)]
+    );
+    assert_eq!(m.texcoords[1], glam::Vec2::X);
+    close(m.texcoords[2].y, 32768.0 / 65535.0, 1e-7);
+    // A sparse index beyond the accessor's count is an error naming the accessor.
+    bin[idx_at] = 3;
+    write_files(&path, &root, Some(("s.bin", &bin))).unwrap();
+    let e = Scene::load(&path, &LoadOptions::default()).unwrap_err();
+    let text = e.to_string();
+    assert!(
+        text.contains("POSITION accessor 0") && text.contains("sparse index 3"),
+        "{text}"
+    );
+}
+
+#[test]
+fn skins_and_morph_targets_use_the_rest_pose_with_warnings() {
+    let b = triangle_scene(None, |_| {});
+    let (mut root, bin) = b.to_json(Some("k.bin"));
+    // A morph target reusing the NORMAL accessor as a position displacement, and a skin.
+    root["meshes"][0]["primitives"][0]["targets"] = json!([{"POSITION": 1}]);
+    root["meshes"][0]["weights"] = json!([1.0]);
+    root["skins"] = json!([{"joints": [1]}]);
+    root["nodes"][0]["skin"] = json!(0);
+    let dir = temp_dir("skin");
+    let path = dir.join("k.gltf");
+    write_files(&path, &root, Some(("k.bin", &bin))).unwrap();
+    let (s, w) = load(&path);
+    assert_eq!(warnings_of(&w, WarningKind::SkinOrMorphIgnored).0, 2);
+    assert!(w.iter().any(|w| w
+        .message
+        .contains("mesh 0 \"tri\" primitive 0: morph targets")));
+    assert!(w
+        .iter()
+        .any(|w| w.message.contains("node 0 \"tri\": skin ignored")));
+    // Rest pose: the morph target is not applied.
+    assert_eq!(s.meshes[0].positions[0], Vec3::ZERO);
 }

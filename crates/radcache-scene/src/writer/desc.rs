@@ -32,7 +32,7 @@ pub struct MaterialDesc {
     pub emissive: [f32; 3],
     /// Double-sided flag.
     pub double_sided: bool,
-    /// Base colour texture index (from [`GltfBuilder::add_texture_rgba8`]).
+    /// Base colour texture index (from [`GltfBuilder::add_texture_rgba8`](super::GltfBuilder::add_texture_rgba8)).
     pub base_color_texture: Option<usize>,
     /// Emissive texture index.
     pub emissive_texture: Option<usize>,

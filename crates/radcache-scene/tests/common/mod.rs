@@ -87,15 +87,18 @@ pub fn close3(a: glam::Vec3, b: glam::Vec3, tol: f32) {
 /// first buffer loses its `uri` so that it refers to the BIN chunk.
 pub fn glb_bytes(root: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
     let mut root = root.clone();
-    if let Some(b) = root.pointer_mut("/buffers/0").and_then(|b| b.as_object_mut()) {
+    if let Some(b) = root
+        .pointer_mut("/buffers/0")
+        .and_then(|b| b.as_object_mut())
+    {
         b.remove("uri");
     }
     let mut text = serde_json::to_vec(&root).unwrap();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let mut bin = bin.to_vec();
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + text.len() + if bin.is_empty() { 0 } else { 8 + bin.len() };

@@ -1,66 +1,9 @@
-//! Seeded mutation test of the loader (a bounded stand-in for a fuzzer): take each valid asset's
-//! JSON and binary buffer, apply random mutations (byte flips and truncation of the buffer,
-//! accessor count/offset/componentType/type changes, buffer-view edits, deleted fields, replaced
-//! numbers, swapped indices), load, and require only that loading returns (Ok or Err) without
-//! panicking. A panic fails the test; the seed and iteration are printed first so it can be replayed.
-//!
-//! `RADCACHE_FUZZ_ITERS` sets the number of mutated files per asset (default 500);
-//! `RADCACHE_FUZZ_SEED` the base seed.
+//! Mutations: JSON-level edits of a glTF document (with byte edits of its `.bin`), and
+//! byte-level edits of whole GLB files.
 
-mod common;
-
-use radcache_scene::assets::{animated_builder, cornell_builder, furnace_builder};
-use radcache_scene::writer::{write_files, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
-use radcache_scene::{LoadOptions, Scene};
 use serde_json::{json, Value};
 
-/// splitmix64.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        if n == 0 {
-            0
-        } else {
-            (self.next() % n as u64) as usize
-        }
-    }
-    fn pick<'a, T>(&mut self, xs: &'a [T]) -> &'a T {
-        &xs[self.below(xs.len())]
-    }
-}
-
-/// A small textured scene so that image decoding is exercised too.
-fn textured_builder() -> GltfBuilder {
-    let mut b = GltfBuilder::new();
-    let pixels: Vec<u8> = (0..4 * 4 * 4).map(|i| (i * 37 % 256) as u8).collect();
-    let tex = b.add_texture_rgba8(4, 4, &pixels, 10497).unwrap();
-    let mut m = MaterialDesc::emitter("t", [1.0; 3], [2.0; 3]);
-    m.base_color_texture = Some(tex);
-    m.emissive_texture = Some(tex);
-    let mat = b.add_material(&m);
-    let mut prim = PrimitiveDesc::triangles(
-        vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
-        None,
-        vec![0, 1, 2],
-        Some(mat),
-    );
-    prim.texcoords = Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
-    let mesh = b.add_mesh("m", &[prim]);
-    let node = b.add_node(&NodeDesc {
-        mesh: Some(mesh),
-        ..NodeDesc::default()
-    });
-    b.add_scene("s", &[node], None);
-    b
-}
+use crate::Rng;
 
 /// Collects JSON pointers of every value in the tree.
 fn pointers(v: &Value, prefix: String, out: &mut Vec<String>) {
@@ -111,10 +54,11 @@ fn set(root: &mut Value, array: &str, index: usize, field: &str, value: Value) {
     }
 }
 
-fn mutate(rng: &mut Rng, root: &mut Value, bin: &mut Vec<u8>) {
+/// Applies one JSON-level (or `.bin` byte-level) mutation.
+pub fn mutate_json(rng: &mut Rng, root: &mut Value, bin: &mut Vec<u8>) {
     let accessors = root["accessors"].as_array().map_or(0, Vec::len);
     let views = root["bufferViews"].as_array().map_or(0, Vec::len);
-    match rng.below(10) {
+    match rng.below(12) {
         0 | 1 => {
             for _ in 0..=rng.below(8) {
                 if !bin.is_empty() {
@@ -194,6 +138,69 @@ fn mutate(rng: &mut Rng, root: &mut Value, bin: &mut Vec<u8>) {
                 set(root, "accessors", b, "bufferView", x);
             }
         }
+        9 => {
+            // Replace a string with another meaningful glTF string (types, paths, modes, URIs).
+            let mut ps = Vec::new();
+            pointers(root, String::new(), &mut ps);
+            let strings: Vec<String> = ps
+                .into_iter()
+                .filter(|p| root.pointer(p).is_some_and(Value::is_string))
+                .collect();
+            if !strings.is_empty() {
+                let p = rng.pick(&strings).clone();
+                let choices = [
+                    "spot",
+                    "point",
+                    "directional",
+                    "orthographic",
+                    "perspective",
+                    "STEP",
+                    "LINEAR",
+                    "CUBICSPLINE",
+                    "rotation",
+                    "scale",
+                    "translation",
+                    "weights",
+                    "BLEND",
+                    "MASK",
+                    "image/png",
+                    "image/jpeg",
+                    "data:,",
+                    "data:application/octet-stream;base64,AAAA",
+                    "../f.bin",
+                    "%FF.bin",
+                    "file:///etc/passwd",
+                    "",
+                    "VEC4",
+                    "MAT3",
+                ];
+                if let Some(v) = root.pointer_mut(&p) {
+                    *v = json!(*rng.pick(&choices));
+                }
+            }
+        }
+        10 => {
+            // Add a reference field with an arbitrary index somewhere it is meaningful.
+            let (array, field) = *rng.pick(&[
+                ("nodes", "mesh"),
+                ("nodes", "camera"),
+                ("nodes", "skin"),
+                ("nodes", "children"),
+                ("meshes", "weights"),
+                ("materials", "emissiveTexture"),
+                ("textures", "source"),
+                ("textures", "sampler"),
+                ("scenes", "nodes"),
+            ]);
+            let n = root[array].as_array().map_or(0, Vec::len);
+            let i = rng.below(n);
+            let value = match field {
+                "children" | "nodes" | "weights" => json!([rng.below(8), rng.below(8)]),
+                "emissiveTexture" => json!({"index": rng.below(4), "texCoord": rng.below(2)}),
+                _ => json!(rng.below(8)),
+            };
+            set(root, array, i, field, value);
+        }
         _ => {
             let p = *rng.pick(&[
                 "/nodes/0/rotation",
@@ -209,57 +216,65 @@ fn mutate(rng: &mut Rng, root: &mut Value, bin: &mut Vec<u8>) {
     }
 }
 
-#[test]
-fn mutated_assets_never_panic() {
-    let iters: usize = std::env::var("RADCACHE_FUZZ_ITERS")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(500);
-    let seed: u64 = std::env::var("RADCACHE_FUZZ_SEED")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(0x5eed);
-    let dir = common::temp_dir("fuzz");
-    let sources = [
-        ("cornell", cornell_builder()),
-        ("furnace", furnace_builder(0.5, 1.0)),
-        ("animated", animated_builder()),
-        ("textured", textured_builder()),
-    ];
-    let (mut ok, mut err) = (0usize, 0usize);
-    for (si, (name, builder)) in sources.iter().enumerate() {
-        let (root, bin) = builder.to_json(Some("f.bin"));
-        for it in 0..iters {
-            let mut rng = Rng(seed.wrapping_mul(0x2545_f491_4f6c_dd1d)
-                ^ ((si as u64) << 48)
-                ^ (it as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
-            let (mut r, mut b) = (root.clone(), bin.clone());
-            for _ in 0..=rng.below(3) {
-                mutate(&mut rng, &mut r, &mut b);
-            }
-            let path = dir.join("f.gltf");
-            write_files(&path, &r, Some(("f.bin", &b))).unwrap();
-            eprintln!("fuzz {name} iteration {it} (RADCACHE_FUZZ_SEED={seed})");
-            let opts = LoadOptions::default();
-            match Scene::load(&path, &opts) {
-                Ok((scene, _)) => {
-                    // Exercise the time-dependent queries too.
-                    let t = scene.time_range().map_or(0.0, |r| r.1 * 0.5);
-                    let _ = scene.summary();
-                    let _ = scene.emitters_at(t);
-                    let _ = scene.camera_at(t);
-                    ok += 1;
-                }
-                Err(e) => {
-                    assert!(
-                        e.to_string().contains("f.gltf"),
-                        "error does not name the file: {e}"
-                    );
-                    err += 1;
+/// u32 values that make interesting lengths, offsets and counts.
+fn interesting_u32(rng: &mut Rng, len: usize) -> u32 {
+    let choices = [0, 1, 3, 4, 11, 12, 19, 20, 0x7fff_ffff, 0xffff_ffff];
+    match rng.below(3) {
+        0 => *rng.pick(&choices),
+        1 => (len as u32)
+            .wrapping_add(rng.below(9) as u32)
+            .wrapping_sub(4),
+        _ => rng.next_u64() as u32,
+    }
+}
+
+/// Applies one byte-level mutation to a whole GLB file: bit flips, a u32 overwritten with an
+/// interesting value (often in the 12-byte header or a chunk header), truncation, insertion or
+/// deletion of a byte range.
+pub fn mutate_bytes(rng: &mut Rng, bytes: &mut Vec<u8>) {
+    let len = bytes.len();
+    match rng.below(6) {
+        0 => {
+            for _ in 0..=rng.below(8) {
+                if !bytes.is_empty() {
+                    let i = rng.below(bytes.len());
+                    bytes[i] ^= 1 << rng.below(8);
                 }
             }
         }
+        1 | 2 => {
+            // Headers: GLB length at 8, JSON chunk length at 12, BIN chunk length after the JSON.
+            let json_len = bytes
+                .get(12..16)
+                .map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+            let targets = [
+                8,
+                12,
+                16,
+                20 + json_len,
+                24 + json_len,
+                rng.below(len.max(1)) & !3,
+            ];
+            let at = *rng.pick(&targets);
+            let v = interesting_u32(rng, len).to_le_bytes();
+            if at + 4 <= bytes.len() {
+                bytes[at..at + 4].copy_from_slice(&v);
+            }
+        }
+        3 => {
+            let n = rng.below(len + 1);
+            bytes.truncate(n);
+        }
+        4 => {
+            let at = rng.below(len + 1);
+            let n = 1 + rng.below(8);
+            let insert: Vec<u8> = (0..n).map(|_| rng.next_u64() as u8).collect();
+            bytes.splice(at..at, insert);
+        }
+        _ => {
+            let at = rng.below(len + 1);
+            let end = (at + 1 + rng.below(16)).min(len);
+            bytes.drain(at..end);
+        }
     }
-    println!("fuzz: {ok} loaded, {err} rejected");
-    assert!(ok > 0 && err > 0);
 }

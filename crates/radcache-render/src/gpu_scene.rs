@@ -1,0 +1,631 @@
+//! The scene on the GPU: vertex, index, material, texture, light and environment buffers, one
+//! BLAS per mesh, and a TLAS of the instances at the current time.
+//!
+//! Geometry is static per mesh (no skinning or morphing), so BLASes are built once; when time
+//! moves, only what changed is redone: instance transforms are rewritten and the TLAS is refitted
+//! (rebuilt every [`REFITS_PER_REBUILD`] refits, so its quality does not decay over long
+//! animations); emitters and lights are rewritten only when an emissive instance or a light node
+//! moved. Host-visible buffers are written directly: call [`GpuScene::set_time`] and
+//! [`GpuScene::set_view`] only between submissions that read the scene.
+
+use glam::{Mat3, Mat4, Vec3};
+use radcache_scene::{CameraView, Environment, LightKind, Scene, ScenePlan};
+use radcache_shared::gpu::{
+    FrameConstants, GpuAlias, GpuEmitter, GpuInstance, GpuLight, GpuMaterial, GpuMesh, GpuTexture,
+    GpuVertex,
+};
+use radcache_vk::{
+    vk, Blas, BlasBuildStats, BlasGeometry, Buffer, BufferDesc, Context, MemoryLocation,
+    Recorder, Resource, Tlas, TlasInstance, TlasUpdate,
+};
+
+use crate::bindings as b;
+use crate::env_map::{gpu_alias, EnvMap};
+use crate::error::Result;
+
+/// A full TLAS rebuild after this many refits.
+pub const REFITS_PER_REBUILD: u32 = 16;
+
+/// Figures of the upload, for reports.
+#[derive(Debug, Clone, Default)]
+pub struct UploadStats {
+    /// BLAS build figures.
+    pub blas: BlasBuildStats,
+    /// Bytes of scene buffers (geometry, materials, textures, lights, environment).
+    pub buffer_bytes: u64,
+    /// Number of BLASes (meshes with triangles).
+    pub blas_count: usize,
+}
+
+/// The scene's GPU resources at one time.
+pub struct GpuScene {
+    plan: ScenePlan,
+    frame: Buffer,
+    vertices: Buffer,
+    indices: Buffer,
+    instances: Buffer,
+    tri_materials: Buffer,
+    materials: Buffer,
+    textures: Buffer,
+    texels: Buffer,
+    emitters: Buffer,
+    emitter_alias: Buffer,
+    lights: Buffer,
+    env_texels: Buffer,
+    env_alias: Buffer,
+    blases: Vec<Option<Blas>>,
+    tlas: Tlas,
+    meshes: Vec<GpuMesh>,
+    instance_mesh: Vec<usize>,
+    transforms: Vec<Mat4>,
+    time: Option<f32>,
+    pending: Option<TlasUpdate>,
+    refits: u32,
+    constants: FrameConstants,
+    env_constant: Vec3,
+    env_scale: f32,
+    env_size: (u32, u32),
+    emitter_count: u32,
+    emitter_power: f32,
+    light_count: u32,
+    scene_scale: f32,
+    stats: UploadStats,
+}
+
+fn storage(
+    ctx: &Context,
+    name: &str,
+    extra: vk::BufferUsageFlags,
+    bytes: &[u8],
+) -> Result<Buffer> {
+    let usage = vk::BufferUsageFlags::STORAGE_BUFFER | extra;
+    if bytes.is_empty() {
+        // Vulkan has no empty buffers; an unused binding still needs a valid one.
+        return Ok(Buffer::new(
+            ctx,
+            &BufferDesc {
+                name,
+                size: 16,
+                usage,
+                location: MemoryLocation::GpuOnly,
+                alignment: 0,
+            },
+        )?);
+    }
+    Ok(ctx.create_buffer_init(name, usage, bytes)?)
+}
+
+fn host_buffer(ctx: &Context, name: &str, usage: vk::BufferUsageFlags, size: u64) -> Result<Buffer> {
+    Ok(Buffer::new(
+        ctx,
+        &BufferDesc {
+            name,
+            size: size.max(16),
+            usage,
+            location: MemoryLocation::CpuToGpu,
+            alignment: 0,
+        },
+    )?)
+}
+
+fn cols(m: Mat4) -> [[f32; 4]; 4] {
+    m.to_cols_array_2d()
+}
+
+/// The upper three rows of `m`, row-major (the TLAS instance layout).
+fn rows3x4(m: Mat4) -> [f32; 12] {
+    let t = m.transpose().to_cols_array();
+    let mut out = [0.0; 12];
+    out.copy_from_slice(&t[..12]);
+    out
+}
+
+/// `clip_from_view` for radcache's rasterization and ray generation: a right-handed view looking
+/// down −Z, reversed depth (1 at the near plane, 0 at infinity) and Vulkan's y-down clip space.
+pub fn vulkan_clip_from_view(yfov: f32, aspect: f32, znear: f32) -> Mat4 {
+    let flip_y = Mat4::from_diagonal(glam::Vec4::new(1.0, -1.0, 1.0, 1.0));
+    flip_y * Mat4::perspective_infinite_reverse_rh(yfov, aspect, znear)
+}
+
+impl std::fmt::Debug for GpuScene {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GpuScene")
+            .field("plan", &self.plan)
+            .field("emitter_count", &self.emitter_count)
+            .field("light_count", &self.light_count)
+            .field("scene_scale", &self.scene_scale)
+            .finish_non_exhaustive()
+    }
+}
+
+impl GpuScene {
+    /// Uploads `scene` (and the environment map, when the scene uses one) and builds its BLASes.
+    /// The TLAS is built by the first [`GpuScene::set_time`] + [`GpuScene::record_update`].
+    pub fn new(ctx: &Context, scene: &Scene, env_map: Option<&EnvMap>) -> Result<GpuScene> {
+        let plan = scene.plan();
+        let mut stats = UploadStats::default();
+        let mut vertices = Vec::new();
+        let mut indices = Vec::new();
+        let mut tri_materials = Vec::new();
+        let mut meshes = Vec::with_capacity(scene.meshes.len());
+        for mesh in &scene.meshes {
+            meshes.push(GpuMesh {
+                ranges: [
+                    vertices.len() as u32,
+                    indices.len() as u32,
+                    tri_materials.len() as u32,
+                    mesh.triangle_count() as u32,
+                ],
+            });
+            for (i, p) in mesh.positions.iter().enumerate() {
+                let n = mesh.normals.get(i).copied().unwrap_or(Vec3::ZERO);
+                let uv = mesh.texcoords.get(i).copied().unwrap_or_default();
+                vertices.push(GpuVertex {
+                    position_u: [p.x, p.y, p.z, uv.x],
+                    normal_v: [n.x, n.y, n.z, uv.y],
+                });
+            }
+            indices.extend_from_slice(&mesh.indices);
+            tri_materials.extend_from_slice(&mesh.triangle_materials);
+        }
+        let geometry_usage = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
+            | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
+        let none = vk::BufferUsageFlags::empty();
+        let vertex_buf = storage(ctx, "scene.vertices", geometry_usage, bytemuck::cast_slice(&vertices))?;
+        let index_buf = storage(ctx, "scene.indices", geometry_usage, bytemuck::cast_slice(&indices))?;
+        let tri_mat_buf = storage(ctx, "scene.triangle_materials", none, bytemuck::cast_slice(&tri_materials))?;
+
+        // Materials and textures.
+        let materials: Vec<GpuMaterial> = scene
+            .materials
+            .iter()
+            .zip(&scene.material_emission)
+            .map(|(m, e)| GpuMaterial {
+                base_color: m.base_color.to_array(),
+                emission: [e.x, e.y, e.z, if m.double_sided { 1.0 } else { 0.0 }],
+                textures: [
+                    m.base_color_texture.map_or(-1, |t| t.texture as i32),
+                    m.emissive_texture.map_or(-1, |t| t.texture as i32),
+                    -1,
+                    -1,
+                ],
+                params: [m.metallic, m.roughness, 0.0, 0.0],
+            })
+            .collect();
+        let mut texels: Vec<u32> = Vec::new();
+        let mut image_offsets = Vec::with_capacity(scene.images.len());
+        for image in &scene.images {
+            image_offsets.push(texels.len() as u32);
+            texels.extend(
+                image
+                    .rgba8
+                    .chunks_exact(4)
+                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])),
+            );
+        }
+        let wrap = |w: radcache_scene::WrapMode| match w {
+            radcache_scene::WrapMode::Repeat => 0u32,
+            radcache_scene::WrapMode::ClampToEdge => 1,
+            radcache_scene::WrapMode::MirroredRepeat => 2,
+        };
+        let textures: Vec<GpuTexture> = scene
+            .textures
+            .iter()
+            .map(|t| {
+                let image = &scene.images[t.image];
+                let srgb = if image.srgb { 0x100 } else { 0 };
+                GpuTexture {
+                    info: [
+                        image_offsets[t.image],
+                        image.width,
+                        image.height,
+                        wrap(t.wrap_s) | (wrap(t.wrap_t) << 4) | srgb,
+                    ],
+                }
+            })
+            .collect();
+        let material_buf = storage(ctx, "scene.materials", none, bytemuck::cast_slice(&materials))?;
+        let texture_buf = storage(ctx, "scene.textures", none, bytemuck::cast_slice(&textures))?;
+        let texel_buf = storage(ctx, "scene.texels", none, bytemuck::cast_slice(&texels))?;
+
+        // Environment.
+        let (env_constant, env_scale) = match &scene.environment {
+            Environment::None => (Vec3::ZERO, 0.0),
+            Environment::Constant(l) => (*l, 0.0),
+            Environment::Map { scale, .. } => (Vec3::ZERO, *scale),
+        };
+        let (env_texels, env_alias, env_size) = match (env_map, &scene.environment) {
+            (Some(map), Environment::Map { .. }) => (
+                map.texels.clone(),
+                map.alias.clone(),
+                (map.width, map.height),
+            ),
+            _ => (Vec::new(), Vec::new(), (0, 0)),
+        };
+        let env_texel_buf = storage(ctx, "scene.env_texels", none, bytemuck::cast_slice(&env_texels))?;
+        let env_alias_buf = storage(ctx, "scene.env_alias", none, bytemuck::cast_slice(&env_alias))?;
+
+        // One BLAS per mesh with triangles.
+        let geoms: Vec<(usize, BlasGeometry<'_>)> = scene
+            .meshes
+            .iter()
+            .enumerate()
+            .filter(|(_, m)| m.triangle_count() > 0)
+            .map(|(i, m)| {
+                let r = meshes[i].ranges;
+                (
+                    i,
+                    BlasGeometry {
+                        name: "scene.blas",
+                        vertices: &vertex_buf,
+                        vertex_offset: u64::from(r[0]) * std::mem::size_of::<GpuVertex>() as u64,
+                        vertex_stride: std::mem::size_of::<GpuVertex>() as u64,
+                        vertex_count: m.positions.len() as u32,
+                        indices: &index_buf,
+                        index_offset: u64::from(r[1]) * 4,
+                        triangle_count: m.triangle_count() as u32,
+                    },
+                )
+            })
+            .collect();
+        let mut blases: Vec<Option<Blas>> = (0..scene.meshes.len()).map(|_| None).collect();
+        if !geoms.is_empty() {
+            let list: Vec<BlasGeometry<'_>> = geoms.iter().map(|(_, g)| *g).collect();
+            let (built, blas_stats) = ctx.build_blases(&list)?;
+            for ((mesh, _), blas) in geoms.iter().zip(built) {
+                blases[*mesh] = Some(blas);
+            }
+            stats.blas = blas_stats;
+            stats.blas_count = geoms.len();
+        }
+        drop(geoms);
+
+        let instance_count = scene.instances.len() as u64;
+        let tlas = Tlas::new(ctx, "scene.tlas", scene.instances.len().max(1) as u32)?;
+        let instances = host_buffer(
+            ctx,
+            "scene.instances",
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            instance_count * std::mem::size_of::<GpuInstance>() as u64,
+        )?;
+        let max_emitters: usize = scene
+            .instances
+            .iter()
+            .map(|i| {
+                let mesh = &scene.meshes[i.mesh];
+                mesh.triangle_materials
+                    .iter()
+                    .filter(|&&m| scene.material_emission[m as usize].max_element() > 0.0)
+                    .count()
+            })
+            .sum();
+        let emitters = host_buffer(
+            ctx,
+            "scene.emitters",
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            (max_emitters * std::mem::size_of::<GpuEmitter>()) as u64,
+        )?;
+        let emitter_alias = host_buffer(
+            ctx,
+            "scene.emitter_alias",
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            (max_emitters * std::mem::size_of::<GpuAlias>()) as u64,
+        )?;
+        let lights = host_buffer(
+            ctx,
+            "scene.lights",
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            (scene.light_instances.len() * std::mem::size_of::<GpuLight>()) as u64,
+        )?;
+        let frame = host_buffer(
+            ctx,
+            "scene.frame",
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            std::mem::size_of::<FrameConstants>() as u64,
+        )?;
+        stats.buffer_bytes = [
+            &vertex_buf,
+            &index_buf,
+            &tri_mat_buf,
+            &material_buf,
+            &texture_buf,
+            &texel_buf,
+            &env_texel_buf,
+            &env_alias_buf,
+            &instances,
+            &emitters,
+            &emitter_alias,
+            &lights,
+        ]
+        .iter()
+        .map(|b| b.size())
+        .sum();
+        let bounds = scene.bounds_over_range();
+        let diagonal = if bounds.is_empty() { 1.0 } else { bounds.size().length() };
+        Ok(GpuScene {
+            plan,
+            frame,
+            vertices: vertex_buf,
+            indices: index_buf,
+            instances,
+            tri_materials: tri_mat_buf,
+            materials: material_buf,
+            textures: texture_buf,
+            texels: texel_buf,
+            emitters,
+            emitter_alias,
+            lights,
+            env_texels: env_texel_buf,
+            env_alias: env_alias_buf,
+            blases,
+            tlas,
+            meshes,
+            instance_mesh: scene.instances.iter().map(|i| i.mesh).collect(),
+            transforms: Vec::new(),
+            time: None,
+            pending: None,
+            refits: 0,
+            constants: bytemuck::Zeroable::zeroed(),
+            env_constant,
+            env_scale,
+            env_size,
+            emitter_count: 0,
+            emitter_power: 0.0,
+            light_count: 0,
+            scene_scale: if diagonal.is_finite() && diagonal > 0.0 { diagonal } else { 1.0 },
+            stats,
+        })
+    }
+
+    /// The plan the scene was uploaded with.
+    pub fn plan(&self) -> &ScenePlan {
+        &self.plan
+    }
+
+    /// Upload figures.
+    pub fn stats(&self) -> &UploadStats {
+        &self.stats
+    }
+
+    /// Bounding-box diagonal over the animation (the scale epsilons are relative to).
+    pub fn scene_scale(&self) -> f32 {
+        self.scene_scale
+    }
+
+    /// Emissive triangles at the current time.
+    pub fn emitter_count(&self) -> u32 {
+        self.emitter_count
+    }
+
+    /// Moves the scene to time `t`: rewrites instances, emitters and lights that changed and marks
+    /// the TLAS for a refit (or a build, the first time). Returns true when anything moved.
+    pub fn set_time(&mut self, scene: &Scene, t: f32) -> Result<bool> {
+        if self.time == Some(t) {
+            return Ok(false);
+        }
+        let transforms = scene.instance_transforms(t);
+        let first = self.time.is_none();
+        let moved = first || transforms != self.transforms;
+        self.time = Some(t);
+        if moved {
+            let gpu: Vec<GpuInstance> = scene
+                .instances
+                .iter()
+                .zip(&transforms)
+                .map(|(inst, m)| {
+                    let r = self.meshes[inst.mesh].ranges;
+                    let mut normal = Mat4::from_mat3(Mat3::from_mat4(*m).inverse().transpose());
+                    // w.w carries the handedness: a mirroring transform flips the front face.
+                    normal.w_axis.w = if m.determinant() < 0.0 { -1.0 } else { 1.0 };
+                    GpuInstance {
+                        world_from_object: cols(*m),
+                        normal_to_world: cols(normal),
+                        mesh: [inst.mesh as u32, r[0], r[1], r[2]],
+                    }
+                })
+                .collect();
+            self.instances.write(0, &gpu)?;
+            self.pending = Some(if first || self.refits >= REFITS_PER_REBUILD {
+                TlasUpdate::Rebuild
+            } else {
+                TlasUpdate::Refit
+            });
+            self.write_emitters(scene, t)?;
+            self.transforms = transforms;
+        }
+        let lights_moved = first || self.plan.animation.lights;
+        if lights_moved {
+            self.write_lights(scene, t)?;
+        }
+        Ok(moved || lights_moved)
+    }
+
+    fn write_emitters(&mut self, scene: &Scene, t: f32) -> Result<()> {
+        if !self.plan.has_emissive() {
+            return Ok(());
+        }
+        let table = scene.emitters_at(t);
+        let gpu: Vec<GpuEmitter> = table
+            .triangles
+            .iter()
+            .map(|tri| {
+                let mesh = &scene.meshes[tri.mesh];
+                let idx = &mesh.indices[3 * tri.triangle..3 * tri.triangle + 3];
+                let uv = |k: usize| {
+                    mesh.texcoords
+                        .get(idx[k] as usize)
+                        .copied()
+                        .unwrap_or_default()
+                };
+                let material = mesh.triangle_materials[tri.triangle];
+                let [p0, mut p1, mut p2] = tri.positions;
+                let (mut uv1, mut uv2) = (uv(1), uv(2));
+                // The shader takes the front side from the corner order: keep it equal to the
+                // CPU's normal (which accounts for mirroring transforms).
+                if (p1 - p0).cross(p2 - p0).dot(tri.normal) < 0.0 {
+                    std::mem::swap(&mut p1, &mut p2);
+                    std::mem::swap(&mut uv1, &mut uv2);
+                }
+                let uv0 = uv(0);
+                GpuEmitter {
+                    p0: [p0.x, p0.y, p0.z, tri.area],
+                    p1: [p1.x, p1.y, p1.z, 0.0],
+                    p2: [p2.x, p2.y, p2.z, 0.0],
+                    radiance: [
+                        tri.radiance.x,
+                        tri.radiance.y,
+                        tri.radiance.z,
+                        if tri.double_sided { 1.0 } else { 0.0 },
+                    ],
+                    uvs: [uv0.x, uv0.y, uv1.x, uv1.y],
+                    uv2_material: [uv2.x, uv2.y, material as f32, 0.0],
+                }
+            })
+            .collect();
+        self.emitters.write(0, &gpu)?;
+        self.emitter_alias.write(0, &gpu_alias(&table.table))?;
+        self.emitter_count = gpu.len() as u32;
+        self.emitter_power = table.total_power;
+        Ok(())
+    }
+
+    fn write_lights(&mut self, scene: &Scene, t: f32) -> Result<()> {
+        let lights: Vec<GpuLight> = scene
+            .lights_at(t)
+            .iter()
+            .map(|l| {
+                let (kind, spot) = match l.kind {
+                    LightKind::Point => (0.0, [0.0; 4]),
+                    LightKind::Spot {
+                        inner_cone_angle,
+                        outer_cone_angle,
+                    } => {
+                        // glTF KHR_lights_punctual's recommended falloff.
+                        let scale =
+                            1.0 / (inner_cone_angle.cos() - outer_cone_angle.cos()).max(0.001);
+                        (1.0, [scale, -outer_cone_angle.cos() * scale, 0.0, 0.0])
+                    }
+                    LightKind::Directional => (2.0, [0.0; 4]),
+                };
+                let i = l.color * l.intensity;
+                GpuLight {
+                    position: [l.position.x, l.position.y, l.position.z, kind],
+                    direction: [
+                        l.direction.x,
+                        l.direction.y,
+                        l.direction.z,
+                        l.range.unwrap_or(0.0),
+                    ],
+                    intensity: [i.x, i.y, i.z, 0.0],
+                    spot,
+                }
+            })
+            .collect();
+        self.lights.write(0, &lights)?;
+        self.light_count = lights.len() as u32;
+        Ok(())
+    }
+
+    /// Records the pending TLAS build or refit (nothing when the scene did not move).
+    pub fn record_update(&mut self, ctx: &Context, rec: &mut Recorder) -> Result<()> {
+        let Some(update) = self.pending.take() else {
+            return Ok(());
+        };
+        let (blases, instance_mesh) = (&self.blases, &self.instance_mesh);
+        let instances: Vec<TlasInstance<'_>> = self
+            .transforms
+            .iter()
+            .enumerate()
+            .filter_map(|(i, m)| {
+                let blas = blases[*instance_mesh.get(i)?].as_ref()?;
+                Some(TlasInstance {
+                    blas,
+                    transform: rows3x4(*m),
+                    custom_index: i as u32,
+                    mask: 0xff,
+                })
+            })
+            .collect();
+        let tlas = &mut self.tlas;
+        rec.pass("scene.tlas", |rec| rec.build_tlas(ctx, tlas, &instances, update))?;
+        self.refits = match update {
+            TlasUpdate::Rebuild => 0,
+            TlasUpdate::Refit => self.refits + 1,
+        };
+        Ok(())
+    }
+
+    /// Writes the frame constants for `view` at `width × height`.
+    pub fn set_view(&mut self, view: &CameraView, width: u32, height: u32, frame: u32, seed: u32) -> Result<()> {
+        let aspect = width as f32 / height.max(1) as f32;
+        let clip_from_world =
+            vulkan_clip_from_view(view.perspective.yfov, aspect, view.perspective.znear)
+                * view.view_from_world();
+        let world_from_clip = clip_from_world.inverse();
+        let p = view.position;
+        self.constants = FrameConstants {
+            clip_from_world: cols(clip_from_world),
+            world_from_clip: cols(world_from_clip),
+            camera_position: [p.x, p.y, p.z, self.scene_scale],
+            environment: [
+                self.env_constant.x,
+                self.env_constant.y,
+                self.env_constant.z,
+                self.env_scale,
+            ],
+            resolution: [width, height, frame, seed],
+            counts: [
+                self.emitter_count,
+                self.light_count,
+                self.transforms.len() as u32,
+                self.env_size.0,
+            ],
+            totals: [self.emitter_power, self.env_size.1 as f32, 0.0, 0.0],
+        };
+        self.frame.write(0, std::slice::from_ref(&self.constants))?;
+        Ok(())
+    }
+
+    /// The frame constants last written.
+    pub fn constants(&self) -> &FrameConstants {
+        &self.constants
+    }
+
+    /// Shader defines that compile in only the light sources the scene has.
+    pub fn defines(&self) -> Vec<(&'static str, &'static str)> {
+        let mut d = Vec::new();
+        if self.plan.has_emissive() {
+            d.push(("HAS_EMITTERS", "1"));
+        }
+        if self.plan.has_punctual_lights() {
+            d.push(("HAS_LIGHTS", "1"));
+        }
+        if self.env_constant.max_element() > 0.0 {
+            d.push(("HAS_ENV_CONSTANT", "1"));
+        }
+        if self.env_size.0 > 0 {
+            d.push(("HAS_ENV_MAP", "1"));
+        }
+        d
+    }
+
+    /// The scene's binding table (bindings 0–13), to prefix a pass's own bindings.
+    pub fn bindings(&self) -> Vec<(u32, Resource<'_>)> {
+        vec![
+            (b::FRAME, Resource::Buffer(&self.frame)),
+            (b::TLAS, Resource::Tlas(&self.tlas)),
+            (b::VERTICES, Resource::Buffer(&self.vertices)),
+            (b::INDICES, Resource::Buffer(&self.indices)),
+            (b::INSTANCES, Resource::Buffer(&self.instances)),
+            (b::TRI_MATERIALS, Resource::Buffer(&self.tri_materials)),
+            (b::MATERIALS, Resource::Buffer(&self.materials)),
+            (b::TEXTURES, Resource::Buffer(&self.textures)),
+            (b::TEXELS, Resource::Buffer(&self.texels)),
+            (b::EMITTERS, Resource::Buffer(&self.emitters)),
+            (b::EMITTER_ALIAS, Resource::Buffer(&self.emitter_alias)),
+            (b::LIGHTS, Resource::Buffer(&self.lights)),
+            (b::ENV_TEXELS, Resource::Buffer(&self.env_texels)),
+            (b::ENV_ALIAS, Resource::Buffer(&self.env_alias)),
+        ]
+    }
+}
