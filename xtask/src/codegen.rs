@@ -1,24 +1,39 @@
-//! `cargo xtask codegen [--check]`: writes the generated GLSL (`shaders/shared/layouts.glsl`) from
-//! `radcache-shared`, or with `--check` fails if the file on disk is stale.
+//! `cargo xtask codegen [--check]`: writes the generated GLSL from the Rust sources of truth
+//! (`shaders/shared/layouts.glsl` from `radcache-shared`, `shaders/shared/bindings.glsl` from
+//! `radcache-render::bindings`), or with `--check` fails if a file on disk is stale.
 
 use anyhow::{bail, Result};
 
 pub fn run(args: &[&str]) -> Result<()> {
-    let path = crate::root().join("shaders/shared/layouts.glsl");
-    let text = radcache_shared::gpu::generated_glsl();
-    let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
-    match args {
-        ["--check"] if on_disk != text => {
-            bail!("{} is stale: run `cargo xtask codegen`", path.display())
-        }
-        ["--check"] => println!("{} is up to date", path.display()),
-        [] if on_disk == text => println!("{} unchanged", path.display()),
-        [] => {
-            std::fs::create_dir_all(path.parent().unwrap_or(&crate::root()))?;
+    let check = match args {
+        [] => false,
+        ["--check"] => true,
+        _ => bail!("usage: cargo xtask codegen [--check]"),
+    };
+    let files = [
+        ("layouts.glsl", radcache_shared::gpu::generated_glsl()),
+        ("bindings.glsl", radcache_render::bindings::generated_glsl()),
+    ];
+    let dir = crate::root().join("shaders/shared");
+    let mut stale = Vec::new();
+    for (name, text) in files {
+        let path = dir.join(name);
+        let on_disk = std::fs::read_to_string(&path).unwrap_or_default();
+        if on_disk == text {
+            println!("{} is up to date", path.display());
+        } else if check {
+            stale.push(path.display().to_string());
+        } else {
+            std::fs::create_dir_all(&dir)?;
             std::fs::write(&path, text)?;
             println!("wrote {}", path.display());
         }
-        _ => bail!("usage: cargo xtask codegen [--check]"),
+    }
+    if !stale.is_empty() {
+        bail!(
+            "stale generated files (run `cargo xtask codegen`): {}",
+            stale.join(", ")
+        );
     }
     Ok(())
 }

@@ -1,5 +1,6 @@
 //! radcache's project tasks: `cargo xtask <task>`.
 
+mod assets;
 mod bench;
 mod codegen;
 mod results;
@@ -16,8 +17,10 @@ cargo xtask <task>
 Tasks:
   test              run the whole test suite on lavapipe with validation (the README's command)
   shaders           compile every shader in shaders/ and run spirv-val on the output
-  codegen [--check] write shaders/shared/*.glsl from radcache-shared (--check: fail if stale)
+  codegen [--check] write shaders/shared/*.glsl from the Rust layouts (--check: fail if stale)
+  assets [--check]  write the bundled glTF scenes into assets/ (--check: fail if they differ)
   bench rays        raw ray-query throughput and BLAS/TLAS build times on the chosen device
+  bench pt          path tracer on the Cornell box at 256² and 512²: samples/s and rays/s
   help              this text
 
 Benchmarks append their figures to bench/results.csv.
@@ -47,6 +50,9 @@ fn try_main() -> Result<()> {
         ["test", rest @ ..] => test::run(rest),
         ["shaders"] => shaders::run(),
         ["codegen", rest @ ..] => codegen::run(rest),
+        ["assets", rest @ ..] => {
+            assets::run(&rest.iter().map(|s| s.to_string()).collect::<Vec<_>>())
+        }
         ["bench", rest @ ..] => bench::run(rest),
         [] | ["help"] | ["--help"] | ["-h"] => {
             print!("{HELP}");

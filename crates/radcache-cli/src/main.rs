@@ -11,7 +11,11 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser, Debug)]
-#[command(name = "radcache", version, about = "Irradiance-caching renderer for glTF scenes")]
+#[command(
+    name = "radcache",
+    version,
+    about = "Irradiance-caching renderer for glTF scenes"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

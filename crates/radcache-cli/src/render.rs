@@ -7,7 +7,7 @@ use std::time::Instant;
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 use radcache_image::{
-    png_beside, write_exr, write_png, ExrOptions, Image, Metadata, PngOptions, ToneMap,
+    png_beside, write_exr, write_png, ExrOptions, Image, Layer, Metadata, PngOptions, ToneMap,
 };
 use radcache_render::{render_path, vulkan_clip_from_view, Budget, EnvMap, GpuScene, PathSettings};
 use radcache_scene::{EnvOverride, Environment, LoadOptions, Scene};
@@ -38,7 +38,10 @@ impl EnvArgs {
             Some(text) => Some(parse_rgb(text)?),
         };
         if !self.env_scale.is_finite() || self.env_scale < 0.0 {
-            bail!("--env-scale must be finite and non-negative, got {}", self.env_scale);
+            bail!(
+                "--env-scale must be finite and non-negative, got {}",
+                self.env_scale
+            );
         }
         Ok(EnvOverride {
             map: self.env_map.clone(),
@@ -109,6 +112,9 @@ pub struct RenderArgs {
     /// Store half floats in the EXR.
     #[arg(long)]
     half: bool,
+    /// Add albedo, normal and depth layers to the EXR.
+    #[arg(long)]
+    aov: bool,
     /// Also write a PNG preview beside the EXR.
     #[arg(long)]
     png: bool,
@@ -127,8 +133,14 @@ fn parse_resolution(text: &str) -> Result<(u32, u32)> {
     let (w, h) = text
         .split_once(['x', 'X'])
         .with_context(|| format!("--resolution {text:?}: expected WxH, e.g. 640x480"))?;
-    let w: u32 = w.trim().parse().with_context(|| format!("--resolution {text:?}: bad width"))?;
-    let h: u32 = h.trim().parse().with_context(|| format!("--resolution {text:?}: bad height"))?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .with_context(|| format!("--resolution {text:?}: bad width"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .with_context(|| format!("--resolution {text:?}: bad height"))?;
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
         bail!("--resolution {text:?}: each side must be in 1..=16384");
     }
@@ -188,6 +200,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         seed: args.seed,
         frame: args.frame,
         time: args.time,
+        aovs: args.aov,
         ..PathSettings::default()
     };
     let mut bar = ProgressLine::new(format!("frame {}", args.frame), "spp", args.quiet);
@@ -202,7 +215,12 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         );
     }
 
-    let image = Image::from_pixels(width, height, out.pixels.clone())?;
+    let mut image = Image::from_pixels(width, height, out.pixels.clone())?;
+    if let Some(aovs) = &out.aovs {
+        image.add_layer(Layer::albedo(aovs.albedo.clone()))?;
+        image.add_layer(Layer::normal(aovs.normal.clone()))?;
+        image.add_layer(Layer::depth(aovs.depth.clone()))?;
+    }
     let aspect = width as f32 / height as f32;
     let mut meta = Metadata::new();
     meta.method = Some("path".into());
@@ -226,7 +244,10 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         },
     };
     let t_write = Instant::now();
-    for path in [Some(output.as_path()), args.stats.as_deref()].into_iter().flatten() {
+    for path in [Some(output.as_path()), args.stats.as_deref()]
+        .into_iter()
+        .flatten()
+    {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("creating the output folder {}", dir.display()))?;
@@ -246,7 +267,14 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     }
     let write_s = t_write.elapsed().as_secs_f64();
     if let Some(path) = &args.stats {
-        write_stats(path, args, &ctx, &out, (width, height), [load_s, upload_s, write_s])?;
+        write_stats(
+            path,
+            args,
+            &ctx,
+            &out,
+            (width, height),
+            [load_s, upload_s, write_s],
+        )?;
     }
     if !args.quiet {
         let rays: u64 = out.rays.values().sum();
@@ -259,9 +287,15 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         );
     }
     drop(gpu);
+    let first = ctx.first_validation_error();
     let report = ctx.shutdown();
     if report.validation_errors > 0 {
-        log::error!("{} Vulkan validation errors", report.validation_errors);
+        // The image is written; the run still fails, since a validation error is a bug.
+        bail!(
+            "{} Vulkan validation errors (first: {})",
+            report.validation_errors,
+            first.unwrap_or_default()
+        );
     }
     Ok(ExitCode::SUCCESS)
 }

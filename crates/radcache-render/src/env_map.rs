@@ -51,7 +51,12 @@ impl EnvMap {
     /// first one: an environment must not inject NaN/Inf into the image.
     pub fn load(path: &Path) -> Result<EnvMap> {
         let (image, _) = radcache_image::read_exr(path)?;
-        EnvMap::from_rgb(path, image.width(), image.height(), image.pixels().collect())
+        EnvMap::from_rgb(
+            path,
+            image.width(),
+            image.height(),
+            image.pixels().collect(),
+        )
     }
 
     /// Builds the map from linear RGB texels (rows top to bottom); `path` names it in errors.
@@ -110,7 +115,9 @@ mod tests {
     #[test]
     fn solid_angles_cover_the_sphere() {
         let (w, h) = (16, 8);
-        let total: f64 = (0..h).map(|y| texel_solid_angle(y, w, h) * f64::from(w)).sum();
+        let total: f64 = (0..h)
+            .map(|y| texel_solid_angle(y, w, h) * f64::from(w))
+            .sum();
         assert!((total - 4.0 * PI).abs() < 1e-9, "{total}");
     }
 
@@ -120,7 +127,10 @@ mod tests {
         rgb[5][1] = f32::NAN;
         let e = EnvMap::from_rgb(Path::new("sky.exr"), 4, 2, rgb).unwrap_err();
         let text = e.to_string();
-        assert!(text.contains("sky.exr") && text.contains("(1, 1)"), "{text}");
+        assert!(
+            text.contains("sky.exr") && text.contains("(1, 1)"),
+            "{text}"
+        );
     }
 
     #[test]

@@ -15,8 +15,8 @@ use radcache_shared::gpu::{
     GpuVertex,
 };
 use radcache_vk::{
-    vk, Blas, BlasBuildStats, BlasGeometry, Buffer, BufferDesc, Context, MemoryLocation,
-    Recorder, Resource, Tlas, TlasInstance, TlasUpdate,
+    vk, Blas, BlasBuildStats, BlasGeometry, Buffer, BufferDesc, Context, MemoryLocation, Recorder,
+    Resource, Tlas, TlasInstance, TlasUpdate,
 };
 
 use crate::bindings as b;
@@ -72,12 +72,7 @@ pub struct GpuScene {
     stats: UploadStats,
 }
 
-fn storage(
-    ctx: &Context,
-    name: &str,
-    extra: vk::BufferUsageFlags,
-    bytes: &[u8],
-) -> Result<Buffer> {
+fn storage(ctx: &Context, name: &str, extra: vk::BufferUsageFlags, bytes: &[u8]) -> Result<Buffer> {
     let usage = vk::BufferUsageFlags::STORAGE_BUFFER | extra;
     if bytes.is_empty() {
         // Vulkan has no empty buffers; an unused binding still needs a valid one.
@@ -95,7 +90,12 @@ fn storage(
     Ok(ctx.create_buffer_init(name, usage, bytes)?)
 }
 
-fn host_buffer(ctx: &Context, name: &str, usage: vk::BufferUsageFlags, size: u64) -> Result<Buffer> {
+fn host_buffer(
+    ctx: &Context,
+    name: &str,
+    usage: vk::BufferUsageFlags,
+    size: u64,
+) -> Result<Buffer> {
     Ok(Buffer::new(
         ctx,
         &BufferDesc {
@@ -171,9 +171,24 @@ impl GpuScene {
         let geometry_usage = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
             | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
         let none = vk::BufferUsageFlags::empty();
-        let vertex_buf = storage(ctx, "scene.vertices", geometry_usage, bytemuck::cast_slice(&vertices))?;
-        let index_buf = storage(ctx, "scene.indices", geometry_usage, bytemuck::cast_slice(&indices))?;
-        let tri_mat_buf = storage(ctx, "scene.triangle_materials", none, bytemuck::cast_slice(&tri_materials))?;
+        let vertex_buf = storage(
+            ctx,
+            "scene.vertices",
+            geometry_usage,
+            bytemuck::cast_slice(&vertices),
+        )?;
+        let index_buf = storage(
+            ctx,
+            "scene.indices",
+            geometry_usage,
+            bytemuck::cast_slice(&indices),
+        )?;
+        let tri_mat_buf = storage(
+            ctx,
+            "scene.triangle_materials",
+            none,
+            bytemuck::cast_slice(&tri_materials),
+        )?;
 
         // Materials and textures.
         let materials: Vec<GpuMaterial> = scene
@@ -224,7 +239,12 @@ impl GpuScene {
                 }
             })
             .collect();
-        let material_buf = storage(ctx, "scene.materials", none, bytemuck::cast_slice(&materials))?;
+        let material_buf = storage(
+            ctx,
+            "scene.materials",
+            none,
+            bytemuck::cast_slice(&materials),
+        )?;
         let texture_buf = storage(ctx, "scene.textures", none, bytemuck::cast_slice(&textures))?;
         let texel_buf = storage(ctx, "scene.texels", none, bytemuck::cast_slice(&texels))?;
 
@@ -242,8 +262,18 @@ impl GpuScene {
             ),
             _ => (Vec::new(), Vec::new(), (0, 0)),
         };
-        let env_texel_buf = storage(ctx, "scene.env_texels", none, bytemuck::cast_slice(&env_texels))?;
-        let env_alias_buf = storage(ctx, "scene.env_alias", none, bytemuck::cast_slice(&env_alias))?;
+        let env_texel_buf = storage(
+            ctx,
+            "scene.env_texels",
+            none,
+            bytemuck::cast_slice(&env_texels),
+        )?;
+        let env_alias_buf = storage(
+            ctx,
+            "scene.env_alias",
+            none,
+            bytemuck::cast_slice(&env_alias),
+        )?;
 
         // One BLAS per mesh with triangles.
         let geoms: Vec<(usize, BlasGeometry<'_>)> = scene
@@ -341,7 +371,11 @@ impl GpuScene {
         .map(|b| b.size())
         .sum();
         let bounds = scene.bounds_over_range();
-        let diagonal = if bounds.is_empty() { 1.0 } else { bounds.size().length() };
+        let diagonal = if bounds.is_empty() {
+            1.0
+        } else {
+            bounds.size().length()
+        };
         Ok(GpuScene {
             plan,
             frame,
@@ -372,7 +406,11 @@ impl GpuScene {
             emitter_count: 0,
             emitter_power: 0.0,
             light_count: 0,
-            scene_scale: if diagonal.is_finite() && diagonal > 0.0 { diagonal } else { 1.0 },
+            scene_scale: if diagonal.is_finite() && diagonal > 0.0 {
+                diagonal
+            } else {
+                1.0
+            },
             stats,
         })
     }
@@ -547,7 +585,9 @@ impl GpuScene {
             })
             .collect();
         let tlas = &mut self.tlas;
-        rec.pass("scene.tlas", |rec| rec.build_tlas(ctx, tlas, &instances, update))?;
+        rec.pass("scene.tlas", |rec| {
+            rec.build_tlas(ctx, tlas, &instances, update)
+        })?;
         self.refits = match update {
             TlasUpdate::Rebuild => 0,
             TlasUpdate::Refit => self.refits + 1,
@@ -556,7 +596,14 @@ impl GpuScene {
     }
 
     /// Writes the frame constants for `view` at `width × height`.
-    pub fn set_view(&mut self, view: &CameraView, width: u32, height: u32, frame: u32, seed: u32) -> Result<()> {
+    pub fn set_view(
+        &mut self,
+        view: &CameraView,
+        width: u32,
+        height: u32,
+        frame: u32,
+        seed: u32,
+    ) -> Result<()> {
         let aspect = width as f32 / height.max(1) as f32;
         let clip_from_world =
             vulkan_clip_from_view(view.perspective.yfov, aspect, view.perspective.znear)

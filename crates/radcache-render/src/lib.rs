@@ -3,9 +3,11 @@
 //! - [`GpuScene`]: the scene's buffers, BLASes and TLAS at a time t, and the shader defines of its
 //!   plan (only the light sources the scene has are compiled in).
 //! - [`PathTracer`] and [`render_path`]: the unbiased reference path tracer.
+//! - [`AovPass`]: first-hit albedo, normal and depth.
 //! - [`EnvMap`]: an equirectangular environment map with its importance-sampling table.
 //! - [`bindings`]: the binding numbers shared with GLSL.
 
+mod aov;
 pub mod bindings;
 mod env_map;
 mod error;
@@ -13,6 +15,7 @@ mod gpu_scene;
 mod path_trace;
 mod render;
 
+pub use aov::{AovPass, Aovs};
 pub use env_map::{gpu_alias, texel_solid_angle, EnvMap};
 pub use error::{Error, Result};
 pub use gpu_scene::{vulkan_clip_from_view, GpuScene, UploadStats, REFITS_PER_REBUILD};

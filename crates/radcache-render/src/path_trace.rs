@@ -158,7 +158,8 @@ impl PathTracer {
     /// Reads the mean radiance per pixel (rows top to bottom). Non-finite values cannot occur (the
     /// shader drops non-finite samples); any that would are counted and replaced by black.
     pub fn read_mean(&self, ctx: &Context) -> Result<(Vec<[f32; 3]>, u64)> {
-        let sums: Vec<[f32; 4]> = ctx.read_buffer(&self.accum, (self.width * self.height) as usize)?;
+        let sums: Vec<[f32; 4]> =
+            ctx.read_buffer(&self.accum, (self.width * self.height) as usize)?;
         let mut bad = 0u64;
         let pixels = sums
             .iter()

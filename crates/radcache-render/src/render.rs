@@ -6,6 +6,7 @@ use std::time::Instant;
 use radcache_scene::Scene;
 use radcache_vk::{Context, ShaderCompiler};
 
+use crate::aov::{AovPass, Aovs};
 use crate::error::{Error, Result};
 use crate::gpu_scene::GpuScene;
 use crate::path_trace::PathTracer;
@@ -36,6 +37,8 @@ pub struct PathSettings {
     pub time: f32,
     /// Target duration of one submission, ms.
     pub chunk_target_ms: f64,
+    /// Also compute the albedo, normal and depth AOVs.
+    pub aovs: bool,
 }
 
 impl Default for PathSettings {
@@ -48,6 +51,7 @@ impl Default for PathSettings {
             frame: 1,
             time: 0.0,
             chunk_target_ms: 250.0,
+            aovs: false,
         }
     }
 }
@@ -82,6 +86,8 @@ pub struct FrameOutput {
     pub passes_ms: BTreeMap<String, f64>,
     /// Pixels whose value was non-finite and replaced by black (0 unless something is wrong).
     pub nonfinite_pixels: u64,
+    /// The AOVs, when asked for.
+    pub aovs: Option<Aovs>,
 }
 
 /// Renders `scene` at `settings.time` with the reference path tracer.
@@ -105,10 +111,23 @@ pub fn render_path(
     let mut passes_ms: BTreeMap<String, f64> = BTreeMap::new();
     let mut rays = 0u64;
 
+    let aov_pass = if settings.aovs {
+        Some(AovPass::new(ctx, shaders, w, h)?)
+    } else {
+        None
+    };
     let mut rec = ctx.begin("frame.setup")?;
     gpu.record_update(ctx, &mut rec)?;
     tracer.record_clear(&mut rec);
+    if let Some(pass) = &aov_pass {
+        pass.record(&mut rec, gpu)?;
+    }
     add_timings(&mut passes_ms, ctx.submit(rec)?.wait()?);
+    let aovs = match &aov_pass {
+        Some(pass) => Some(pass.read(ctx)?),
+        None => None,
+    };
+    drop(aov_pass);
 
     let target = match settings.budget {
         Budget::Samples(n) => n.max(1),
@@ -160,6 +179,7 @@ pub fn render_path(
         rays: ray_map,
         passes_ms,
         nonfinite_pixels,
+        aovs,
     })
 }
 

@@ -179,6 +179,29 @@ pub fn run(args: &[&str]) -> Result<()> {
     let ctx = Context::new()?;
     let info = ctx.info().clone();
     println!("device: {} ({}), {}", info.name, info.kind, info.driver);
+    let compiler = ShaderCompiler::new(crate::root().join("shaders"))?;
+    let m = measure(&ctx, &compiler, n)?;
+    report(&m, n, &format!("{} ({})", info.name, info.driver))
+}
+
+/// The raw incoherent ray-query rate of `ctx`'s device, rays/s (1M hemisphere rays).
+pub fn incoherent_rate(ctx: &Context, compiler: &ShaderCompiler) -> Result<f64> {
+    let n = 1_000_000;
+    let m = measure(ctx, compiler, n)?;
+    Ok(n as f64 / (m.incoherent_ms * 1e-3))
+}
+
+struct Measured {
+    stats: radcache_vk::BlasBuildStats,
+    blas_wall_ms: f64,
+    tlas_ms: f64,
+    instances: usize,
+    tris: usize,
+    coherent_ms: f64,
+    incoherent_ms: f64,
+}
+
+fn measure(ctx: &Context, compiler: &ShaderCompiler, n: usize) -> Result<Measured> {
     let s = scene();
     let input = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
         | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
@@ -208,7 +231,7 @@ pub fn run(args: &[&str]) -> Result<()> {
         geometry("bench.room_blas", &s.room, &rv, &ri),
     ])?;
     let blas_wall_ms = wall.elapsed().as_secs_f64() * 1e3;
-    let mut tlas = Tlas::new(&ctx, "bench.tlas", 8)?;
+    let mut tlas = Tlas::new(ctx, "bench.tlas", 8)?;
     let mut instances: Vec<TlasInstance<'_>> = s
         .transforms
         .iter()
@@ -227,24 +250,47 @@ pub fn run(args: &[&str]) -> Result<()> {
         mask: 0xff,
     });
     let mut rec = ctx.begin("bench.tlas")?;
-    rec.build_tlas(&ctx, &mut tlas, &instances, TlasUpdate::Rebuild)?;
+    rec.build_tlas(ctx, &mut tlas, &instances, TlasUpdate::Rebuild)?;
     let tlas_ms = ctx.submit(rec)?.wait()?[0].duration_ms;
 
-    let compiler = ShaderCompiler::new(crate::root().join("shaders"))?;
     let spirv = compiler.compile("tests/ray_query.comp", &[])?;
     let bindings = [
         BindingLayout::new(0, BindingKind::AccelerationStructure),
         BindingLayout::new(1, BindingKind::StorageBuffer),
         BindingLayout::new(2, BindingKind::StorageBuffer),
     ];
-    let pipe = Pipeline::compute(&ctx, "bench.ray_query", &spirv, &bindings, 16)?;
-    let coherent_ms = trace(&ctx, &pipe, &tlas, &camera_rays(n))?;
-    let incoherent_ms = trace(&ctx, &pipe, &tlas, &hemisphere_rays(&s, n))?;
-    let mrays = |ms: f64| n as f64 / (ms * 1e-3) / 1e6;
+    let pipe = Pipeline::compute(ctx, "bench.ray_query", &spirv, &bindings, 16)?;
+    let coherent_ms = trace(ctx, &pipe, &tlas, &camera_rays(n))?;
+    let incoherent_ms = trace(ctx, &pipe, &tlas, &hemisphere_rays(&s, n))?;
     let tris = s.sphere.triangle_count();
+    let count = instances.len();
+    drop(instances);
+    Ok(Measured {
+        stats,
+        blas_wall_ms,
+        tlas_ms,
+        instances: count,
+        tris,
+        coherent_ms,
+        incoherent_ms,
+    })
+}
+
+fn report(m: &Measured, n: usize, device: &str) -> Result<()> {
+    let Measured {
+        stats,
+        blas_wall_ms,
+        tlas_ms,
+        instances,
+        tris,
+        coherent_ms,
+        incoherent_ms,
+    } = m;
+    let (tlas_ms, coherent_ms, incoherent_ms) = (*tlas_ms, *coherent_ms, *incoherent_ms);
+    let mrays = |ms: f64| n as f64 / (ms * 1e-3) / 1e6;
     println!(
         "sphere BLAS: {tris} triangles; {} instances + room",
-        s.transforms.len()
+        instances - 1
     );
     println!(
         "BLAS build + compaction: {:.2} ms GPU ({:.2} + {:.2}), {:.1} ms wall; {} -> {} bytes",
@@ -257,8 +303,7 @@ pub fn run(args: &[&str]) -> Result<()> {
     );
     println!(
         "TLAS build ({} instances): {:.3} ms GPU",
-        instances.len(),
-        tlas_ms
+        instances, tlas_ms
     );
     println!(
         "coherent camera rays:     {n} rays in {coherent_ms:.1} ms = {:.2} Mrays/s",
@@ -271,7 +316,7 @@ pub fn run(args: &[&str]) -> Result<()> {
     let case = format!("sphere{}k_x4+room", tris / 1000);
     append(
         "rays",
-        &format!("{} ({})", info.name, info.driver),
+        device,
         &[
             Figure::new(&case, "coherent_mrays_per_s", mrays(coherent_ms), "Mrays/s"),
             Figure::new(
@@ -286,6 +331,5 @@ pub fn run(args: &[&str]) -> Result<()> {
             Figure::new(&case, "rays", n as f64, "rays"),
         ],
     )?;
-    drop(instances);
     Ok(())
 }

@@ -1,0 +1,187 @@
+//! The `radcache` binary end to end on lavapipe: render with metadata, AOVs and stats; compare
+//! with limits and JSON; info; bad input gives one clear error and no panic.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use radcache_image::read_exr;
+
+fn radcache(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_radcache"))
+        .args(args)
+        .output()
+        .expect("running radcache")
+}
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn cornell() -> String {
+    repo()
+        .join("assets/cornell/cornell.gltf")
+        .display()
+        .to_string()
+}
+
+fn out_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("radcache-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn text(p: &Path) -> String {
+    p.display().to_string()
+}
+
+fn assert_ok(out: &Output) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "radcache failed: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn render_writes_exr_with_metadata_aovs_png_and_stats() {
+    let dir = out_dir("render");
+    let exr = dir.join("frame_####.exr");
+    let stats = dir.join("stats.json");
+    let out = radcache(&[
+        "render",
+        &cornell(),
+        "-o",
+        &text(&exr),
+        "--resolution",
+        "24x16",
+        "--spp",
+        "3",
+        "--seed",
+        "5",
+        "--frame",
+        "7",
+        "--aov",
+        "--png",
+        "--stats",
+        &text(&stats),
+        "-q",
+    ]);
+    assert_ok(&out);
+    let written = dir.join("frame_0007.exr");
+    let (image, meta) = read_exr(&written).unwrap();
+    assert_eq!((image.width(), image.height()), (24, 16));
+    assert_eq!(meta.method.as_deref(), Some("path"));
+    assert_eq!(meta.spp, Some(3));
+    assert!(meta.render_time_s.is_some_and(|t| t > 0.0));
+    assert!(meta.scene_file.unwrap().ends_with("cornell.gltf"));
+    assert!(meta.world_from_camera.is_some() && meta.projection.is_some());
+    assert!(meta.radcache_version.is_some());
+    for layer in ["albedo", "normal", "depth"] {
+        assert!(image.layer(layer).is_some(), "missing AOV layer {layer}");
+    }
+    assert!(image
+        .pixels()
+        .all(|p| p.iter().all(|c| c.is_finite() && *c >= 0.0)));
+    assert!(dir.join("frame_0007.png").exists());
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    let frame = &json["frames"][0];
+    assert_eq!(frame["frame"], 7);
+    assert!(frame["time_s"].as_f64().unwrap() > 0.0);
+    // At least one camera ray per pixel sample.
+    assert!(frame["rays"]["path_trace"].as_u64().unwrap() >= 24 * 16 * 3);
+    assert!(frame["passes_ms"]["path_trace"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn compare_reports_json_and_enforces_limits() {
+    let dir = out_dir("compare");
+    let a = dir.join("a.exr");
+    let b = dir.join("b.exr");
+    for (path, seed) in [(&a, "1"), (&b, "2")] {
+        let out = radcache(&[
+            "render",
+            &cornell(),
+            "-o",
+            &text(path),
+            "--resolution",
+            "16x16",
+            "--spp",
+            "2",
+            "--seed",
+            seed,
+            "-q",
+        ]);
+        assert_ok(&out);
+    }
+    let same = radcache(&["compare", &text(&a), &text(&a), "--json", "--max-rmse", "0"]);
+    assert_ok(&same);
+    let json: serde_json::Value = serde_json::from_slice(&same.stdout).unwrap();
+    assert_eq!(json["metrics"]["rmse"].as_f64(), Some(0.0));
+    assert_eq!(json["exceeded"].as_array().map(Vec::len), Some(0));
+
+    let differ = radcache(&["compare", &text(&a), &text(&b), "--json", "--max-rmse", "0"]);
+    assert!(
+        !differ.status.success(),
+        "different seeds should exceed RMSE 0"
+    );
+    let json: serde_json::Value = serde_json::from_slice(&differ.stdout).unwrap();
+    assert!(json["metrics"]["rmse"].as_f64().unwrap() > 0.0);
+    assert_eq!(json["exceeded"].as_array().map(Vec::len), Some(1));
+}
+
+#[test]
+fn info_prints_the_plan() {
+    let out = radcache(&["info", &cornell()]);
+    assert_ok(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout).to_lowercase();
+    assert!(stdout.contains("triangles"), "{stdout}");
+    assert!(stdout.contains("emissive"), "{stdout}");
+    assert!(stdout.contains("plan"), "{stdout}");
+}
+
+#[test]
+fn bad_input_is_one_clear_error() {
+    let dir = out_dir("bad");
+    let missing = dir.join("nope.gltf");
+    let out = radcache(&[
+        "render",
+        &text(&missing),
+        "-o",
+        &text(&dir.join("x.exr")),
+        "-q",
+    ]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("nope.gltf") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+
+    let garbage = dir.join("garbage.gltf");
+    std::fs::write(&garbage, b"{ not json").unwrap();
+    let out = radcache(&[
+        "render",
+        &text(&garbage),
+        "-o",
+        &text(&dir.join("y.exr")),
+        "-q",
+    ]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("garbage.gltf") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+    assert!(!dir.join("y.exr").exists());
+
+    let out = radcache(&[
+        "render",
+        &cornell(),
+        "-o",
+        &text(&dir.join("z.exr")),
+        "--resolution",
+        "0x10",
+        "-q",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--resolution"));
+}
