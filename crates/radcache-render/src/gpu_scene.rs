@@ -9,19 +9,21 @@
 //! [`GpuScene::set_view`] only between submissions that read the scene.
 
 use glam::{Mat3, Mat4, Vec3};
-use radcache_scene::{CameraView, Environment, LightKind, Scene, ScenePlan};
+use radcache_scene::{CameraView, Environment, Scene, ScenePlan};
 use radcache_shared::gpu::{
-    FrameConstants, GpuAlias, GpuEmitter, GpuInstance, GpuLight, GpuMaterial, GpuMesh, GpuTexture,
-    GpuVertex,
+    FrameConstants, GpuAlias, GpuEmitter, GpuInstance, GpuLight, GpuMesh, GpuVertex,
 };
 use radcache_vk::{
-    vk, Blas, BlasBuildStats, BlasGeometry, Buffer, BufferDesc, Context, MemoryLocation, Recorder,
-    Resource, Tlas, TlasInstance, TlasUpdate,
+    vk, Blas, BlasBuildStats, BlasGeometry, Buffer, Context, Recorder, Resource, Tlas,
+    TlasInstance, TlasUpdate,
 };
 
 use crate::bindings as b;
 use crate::env_map::{gpu_alias, EnvMap};
 use crate::error::Result;
+use crate::scene_lights::{gpu_emitters, gpu_lights};
+use crate::scene_pack::{pack_geometry, pack_materials, PackedGeometry};
+use crate::upload::{cols, host_buffer, rows3x4, storage, vulkan_clip_from_view};
 
 /// A full TLAS rebuild after this many refits.
 pub const REFITS_PER_REBUILD: u32 = 16;
@@ -72,61 +74,6 @@ pub struct GpuScene {
     stats: UploadStats,
 }
 
-fn storage(ctx: &Context, name: &str, extra: vk::BufferUsageFlags, bytes: &[u8]) -> Result<Buffer> {
-    let usage = vk::BufferUsageFlags::STORAGE_BUFFER | extra;
-    if bytes.is_empty() {
-        // Vulkan has no empty buffers; an unused binding still needs a valid one.
-        return Ok(Buffer::new(
-            ctx,
-            &BufferDesc {
-                name,
-                size: 16,
-                usage,
-                location: MemoryLocation::GpuOnly,
-                alignment: 0,
-            },
-        )?);
-    }
-    Ok(ctx.create_buffer_init(name, usage, bytes)?)
-}
-
-fn host_buffer(
-    ctx: &Context,
-    name: &str,
-    usage: vk::BufferUsageFlags,
-    size: u64,
-) -> Result<Buffer> {
-    Ok(Buffer::new(
-        ctx,
-        &BufferDesc {
-            name,
-            size: size.max(16),
-            usage,
-            location: MemoryLocation::CpuToGpu,
-            alignment: 0,
-        },
-    )?)
-}
-
-fn cols(m: Mat4) -> [[f32; 4]; 4] {
-    m.to_cols_array_2d()
-}
-
-/// The upper three rows of `m`, row-major (the TLAS instance layout).
-fn rows3x4(m: Mat4) -> [f32; 12] {
-    let t = m.transpose().to_cols_array();
-    let mut out = [0.0; 12];
-    out.copy_from_slice(&t[..12]);
-    out
-}
-
-/// `clip_from_view` for radcache's rasterization and ray generation: a right-handed view looking
-/// down −Z, reversed depth (1 at the near plane, 0 at infinity) and Vulkan's y-down clip space.
-pub fn vulkan_clip_from_view(yfov: f32, aspect: f32, znear: f32) -> Mat4 {
-    let flip_y = Mat4::from_diagonal(glam::Vec4::new(1.0, -1.0, 1.0, 1.0));
-    flip_y * Mat4::perspective_infinite_reverse_rh(yfov, aspect, znear)
-}
-
 impl std::fmt::Debug for GpuScene {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("GpuScene")
@@ -144,30 +91,12 @@ impl GpuScene {
     pub fn new(ctx: &Context, scene: &Scene, env_map: Option<&EnvMap>) -> Result<GpuScene> {
         let plan = scene.plan();
         let mut stats = UploadStats::default();
-        let mut vertices = Vec::new();
-        let mut indices = Vec::new();
-        let mut tri_materials = Vec::new();
-        let mut meshes = Vec::with_capacity(scene.meshes.len());
-        for mesh in &scene.meshes {
-            meshes.push(GpuMesh {
-                ranges: [
-                    vertices.len() as u32,
-                    indices.len() as u32,
-                    tri_materials.len() as u32,
-                    mesh.triangle_count() as u32,
-                ],
-            });
-            for (i, p) in mesh.positions.iter().enumerate() {
-                let n = mesh.normals.get(i).copied().unwrap_or(Vec3::ZERO);
-                let uv = mesh.texcoords.get(i).copied().unwrap_or_default();
-                vertices.push(GpuVertex {
-                    position_u: [p.x, p.y, p.z, uv.x],
-                    normal_v: [n.x, n.y, n.z, uv.y],
-                });
-            }
-            indices.extend_from_slice(&mesh.indices);
-            tri_materials.extend_from_slice(&mesh.triangle_materials);
-        }
+        let PackedGeometry {
+            vertices,
+            indices,
+            tri_materials,
+            meshes,
+        } = pack_geometry(scene);
         let geometry_usage = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
             | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
         let none = vk::BufferUsageFlags::empty();
@@ -190,55 +119,7 @@ impl GpuScene {
             bytemuck::cast_slice(&tri_materials),
         )?;
 
-        // Materials and textures.
-        let materials: Vec<GpuMaterial> = scene
-            .materials
-            .iter()
-            .zip(&scene.material_emission)
-            .map(|(m, e)| GpuMaterial {
-                base_color: m.base_color.to_array(),
-                emission: [e.x, e.y, e.z, if m.double_sided { 1.0 } else { 0.0 }],
-                textures: [
-                    m.base_color_texture.map_or(-1, |t| t.texture as i32),
-                    m.emissive_texture.map_or(-1, |t| t.texture as i32),
-                    -1,
-                    -1,
-                ],
-                params: [m.metallic, m.roughness, 0.0, 0.0],
-            })
-            .collect();
-        let mut texels: Vec<u32> = Vec::new();
-        let mut image_offsets = Vec::with_capacity(scene.images.len());
-        for image in &scene.images {
-            image_offsets.push(texels.len() as u32);
-            texels.extend(
-                image
-                    .rgba8
-                    .chunks_exact(4)
-                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])),
-            );
-        }
-        let wrap = |w: radcache_scene::WrapMode| match w {
-            radcache_scene::WrapMode::Repeat => 0u32,
-            radcache_scene::WrapMode::ClampToEdge => 1,
-            radcache_scene::WrapMode::MirroredRepeat => 2,
-        };
-        let textures: Vec<GpuTexture> = scene
-            .textures
-            .iter()
-            .map(|t| {
-                let image = &scene.images[t.image];
-                let srgb = if image.srgb { 0x100 } else { 0 };
-                GpuTexture {
-                    info: [
-                        image_offsets[t.image],
-                        image.width,
-                        image.height,
-                        wrap(t.wrap_s) | (wrap(t.wrap_t) << 4) | srgb,
-                    ],
-                }
-            })
-            .collect();
+        let (materials, textures, texels) = pack_materials(scene);
         let material_buf = storage(
             ctx,
             "scene.materials",
@@ -483,43 +364,7 @@ impl GpuScene {
             return Ok(());
         }
         let table = scene.emitters_at(t);
-        let gpu: Vec<GpuEmitter> = table
-            .triangles
-            .iter()
-            .map(|tri| {
-                let mesh = &scene.meshes[tri.mesh];
-                let idx = &mesh.indices[3 * tri.triangle..3 * tri.triangle + 3];
-                let uv = |k: usize| {
-                    mesh.texcoords
-                        .get(idx[k] as usize)
-                        .copied()
-                        .unwrap_or_default()
-                };
-                let material = mesh.triangle_materials[tri.triangle];
-                let [p0, mut p1, mut p2] = tri.positions;
-                let (mut uv1, mut uv2) = (uv(1), uv(2));
-                // The shader takes the front side from the corner order: keep it equal to the
-                // CPU's normal (which accounts for mirroring transforms).
-                if (p1 - p0).cross(p2 - p0).dot(tri.normal) < 0.0 {
-                    std::mem::swap(&mut p1, &mut p2);
-                    std::mem::swap(&mut uv1, &mut uv2);
-                }
-                let uv0 = uv(0);
-                GpuEmitter {
-                    p0: [p0.x, p0.y, p0.z, tri.area],
-                    p1: [p1.x, p1.y, p1.z, 0.0],
-                    p2: [p2.x, p2.y, p2.z, 0.0],
-                    radiance: [
-                        tri.radiance.x,
-                        tri.radiance.y,
-                        tri.radiance.z,
-                        if tri.double_sided { 1.0 } else { 0.0 },
-                    ],
-                    uvs: [uv0.x, uv0.y, uv1.x, uv1.y],
-                    uv2_material: [uv2.x, uv2.y, material as f32, 0.0],
-                }
-            })
-            .collect();
+        let gpu = gpu_emitters(scene, &table);
         self.emitters.write(0, &gpu)?;
         self.emitter_alias.write(0, &gpu_alias(&table.table))?;
         self.emitter_count = gpu.len() as u32;
@@ -528,37 +373,7 @@ impl GpuScene {
     }
 
     fn write_lights(&mut self, scene: &Scene, t: f32) -> Result<()> {
-        let lights: Vec<GpuLight> = scene
-            .lights_at(t)
-            .iter()
-            .map(|l| {
-                let (kind, spot) = match l.kind {
-                    LightKind::Point => (0.0, [0.0; 4]),
-                    LightKind::Spot {
-                        inner_cone_angle,
-                        outer_cone_angle,
-                    } => {
-                        // glTF KHR_lights_punctual's recommended falloff.
-                        let scale =
-                            1.0 / (inner_cone_angle.cos() - outer_cone_angle.cos()).max(0.001);
-                        (1.0, [scale, -outer_cone_angle.cos() * scale, 0.0, 0.0])
-                    }
-                    LightKind::Directional => (2.0, [0.0; 4]),
-                };
-                let i = l.color * l.intensity;
-                GpuLight {
-                    position: [l.position.x, l.position.y, l.position.z, kind],
-                    direction: [
-                        l.direction.x,
-                        l.direction.y,
-                        l.direction.z,
-                        l.range.unwrap_or(0.0),
-                    ],
-                    intensity: [i.x, i.y, i.z, 0.0],
-                    spot,
-                }
-            })
-            .collect();
+        let lights = gpu_lights(&scene.lights_at(t));
         self.lights.write(0, &lights)?;
         self.light_count = lights.len() as u32;
         Ok(())

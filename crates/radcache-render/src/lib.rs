@@ -14,10 +14,14 @@ mod error;
 mod gpu_scene;
 mod path_trace;
 mod render;
+mod scene_lights;
+mod scene_pack;
+mod upload;
 
 pub use aov::{AovPass, Aovs};
 pub use env_map::{gpu_alias, texel_solid_angle, EnvMap};
 pub use error::{Error, Result};
-pub use gpu_scene::{vulkan_clip_from_view, GpuScene, UploadStats, REFITS_PER_REBUILD};
+pub use gpu_scene::{GpuScene, UploadStats, REFITS_PER_REBUILD};
 pub use path_trace::PathTracer;
 pub use render::{render_path, Budget, FrameOutput, PathSettings, Progress};
+pub use upload::vulkan_clip_from_view;

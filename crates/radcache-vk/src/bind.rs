@@ -4,12 +4,12 @@
 use ash::vk;
 use bytemuck::Pod;
 
-use crate::accel::Tlas;
 use crate::buffer::Buffer;
 use crate::commands::Recorder;
 use crate::error::{Error, Result};
 use crate::image::{Image, Sampler};
 use crate::pipeline::{BindingKind, BindingLayout, Pipeline};
+use crate::tlas::Tlas;
 
 /// The pipeline bound last, remembered for bindings and push constants.
 #[derive(Debug, Clone)]

@@ -20,9 +20,10 @@ mod profiler;
 pub mod select;
 mod shader;
 mod sync;
+mod tlas;
 mod transfer;
 
-pub use accel::{Blas, BlasBuildStats, BlasGeometry, Tlas, TlasInstance, TlasUpdate};
+pub use accel::{Blas, BlasBuildStats, BlasGeometry};
 pub use ash::vk;
 pub use bind::{ColorTarget, DepthTarget, Resource};
 pub use buffer::{Buffer, BufferDesc, MemoryLocation};
@@ -36,3 +37,4 @@ pub use profiler::PassTiming;
 pub use select::DeviceKind;
 pub use shader::{ShaderCompiler, ShaderStage};
 pub use sync::{Access, ImageUse};
+pub use tlas::{Tlas, TlasInstance, TlasUpdate};
