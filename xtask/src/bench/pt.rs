@@ -72,7 +72,6 @@ pub fn run(args: &[&str]) -> Result<()> {
     }
     drop(gpu);
     append("pt", &device, &figures)?;
-    println!("appended {} figures to bench/results.csv", figures.len());
     let report = ctx.shutdown();
     anyhow::ensure!(report.leaked.is_empty(), "leaked: {:?}", report.leaked);
     Ok(())
