@@ -61,4 +61,25 @@ struct FrameConstants {
     vec4 totals;
 };  // 208 bytes
 
+struct GpuRecord {
+    vec4 position_radius;
+    vec4 normal_rorig;
+    vec4 irradiance;
+    vec4 bounds;
+    vec4 grad_r_red;
+    vec4 grad_r_green;
+    vec4 grad_r_blue;
+    vec4 grad_t_red;
+    vec4 grad_t_green;
+    vec4 grad_t_blue;
+    uvec4 info;
+};  // 176 bytes
+
+struct IcCounters {
+    uvec4 counts;
+    uvec4 dispatch;
+    uvec4 draw;
+    uvec4 limits;
+};  // 64 bytes
+
 #endif

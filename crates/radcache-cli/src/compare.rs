@@ -66,9 +66,9 @@ pub fn run(args: &CompareArgs) -> Result<ExitCode> {
             "metrics": metrics,
             "exceeded": exceeded,
         });
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        crate::emit(&format!("{}\n", serde_json::to_string_pretty(&value)?))?;
     } else {
-        print!("{metrics}");
+        crate::emit(&metrics.to_string())?;
         for e in &exceeded {
             eprintln!("limit exceeded: {e}");
         }

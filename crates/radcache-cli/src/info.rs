@@ -26,9 +26,11 @@ pub fn run(args: &InfoArgs) -> Result<ExitCode> {
         env: args.env.to_override()?,
     };
     let (scene, warnings) = Scene::load(&args.scene, &opts)?;
+    let mut text = String::new();
     for w in &warnings {
-        println!("warning: {w}");
+        text.push_str(&format!("warning: {w}\n"));
     }
-    print!("{scene}");
+    text.push_str(&scene.to_string());
+    crate::emit(&text)?;
     Ok(ExitCode::SUCCESS)
 }

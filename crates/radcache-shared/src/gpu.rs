@@ -122,6 +122,51 @@ gpu_struct! {
     }
 }
 
+gpu_struct! {
+    /// An irradiance record (§4.1 of the IC reference), 176 bytes. Gradients are world-space
+    /// tangent vectors, one per colour channel.
+    pub struct GpuRecord {
+        /// Position `p_i` (xyz) and the radius used by the weight, `R_i = clamp(R_orig, R⁻, R⁺)` (w).
+        pub position_radius: [f32; 4] => "vec4",
+        /// Unit normal `n_i` (xyz) and the unclamped radius `R_orig` (w), kept for neighbour clamping.
+        pub normal_rorig: [f32; 4] => "vec4",
+        /// Irradiance `E_i` (rgb) and the translational-gradient attenuation `min(1, R/R⁻)` (w).
+        pub irradiance: [f32; 4] => "vec4",
+        /// `R⁻` (x), `R⁺` (y), pixel footprint at creation (z), harmonic-mean distance (w).
+        pub bounds: [f32; 4] => "vec4",
+        /// Rotational gradient of the red channel (xyz).
+        pub grad_r_red: [f32; 4] => "vec4",
+        /// Rotational gradient of the green channel (xyz).
+        pub grad_r_green: [f32; 4] => "vec4",
+        /// Rotational gradient of the blue channel (xyz).
+        pub grad_r_blue: [f32; 4] => "vec4",
+        /// Translational gradient of the red channel (xyz).
+        pub grad_t_red: [f32; 4] => "vec4",
+        /// Translational gradient of the green channel (xyz).
+        pub grad_t_green: [f32; 4] => "vec4",
+        /// Translational gradient of the blue channel (xyz).
+        pub grad_t_blue: [f32; 4] => "vec4",
+        /// Pixel index it was created at (x), creation level (y), sub-frame (z), flags (w).
+        pub info: [u32; 4] => "uvec4",
+    }
+}
+
+gpu_struct! {
+    /// Counters and indirect arguments of the irradiance cache, written by the GPU.
+    pub struct IcCounters {
+        /// Records in the record buffer (x), pending requests (y), first record of the pending
+        /// batch (z), hole pixels found by the last selection (w).
+        pub counts: [u32; 4] => "uvec4",
+        /// `VkDispatchIndirectCommand` of the record pass: one workgroup per request (xyz), unused (w).
+        pub dispatch: [u32; 4] => "uvec4",
+        /// `VkDrawIndirectCommand` of the splat pass: 6 vertices, one instance per record.
+        pub draw: [u32; 4] => "uvec4",
+        /// Record capacity (x), request capacity (y), requests dropped for lack of space (z),
+        /// records rejected as invalid (w).
+        pub limits: [u32; 4] => "uvec4",
+    }
+}
+
 /// Every shared struct's GLSL, in dependency order, with the generated-file header.
 pub fn generated_glsl() -> String {
     use crate::layout::glsl_struct;
@@ -139,6 +184,8 @@ pub fn generated_glsl() -> String {
         glsl_struct::<GpuAlias>(),
         glsl_struct::<GpuLight>(),
         glsl_struct::<FrameConstants>(),
+        glsl_struct::<GpuRecord>(),
+        glsl_struct::<IcCounters>(),
     ] {
         s.push_str(&text);
         s.push('\n');
@@ -164,6 +211,9 @@ mod tests {
         errors.extend(std430_violations::<GpuAlias>());
         errors.extend(std430_violations::<GpuLight>());
         errors.extend(std430_violations::<FrameConstants>());
+        errors.extend(std430_violations::<GpuRecord>());
+        errors.extend(std430_violations::<IcCounters>());
+        assert_eq!(std::mem::size_of::<GpuRecord>(), 176);
         assert!(errors.is_empty(), "{}", errors.join("\n"));
     }
 

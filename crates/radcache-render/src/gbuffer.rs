@@ -1,0 +1,123 @@
+//! The irradiance cache's G-buffer: the images every IC pass reads (layout in
+//! `shaders/common/gbuffer.glsl`), bound at `PASS_BASE + 0..5`.
+
+use radcache_vk::{vk, BindingKind, BindingLayout, Context, Image, ImageDesc, Resource};
+
+use crate::bindings::PASS_BASE;
+use crate::error::Result;
+
+/// Format of every G-buffer colour image.
+pub const GBUFFER_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+/// Format of the depth attachment (reversed Z: 1 at the near plane, cleared to 0).
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+/// Number of bindings the G-buffer occupies from `PASS_BASE` (the last is the direct light).
+pub const GBUFFER_BINDINGS: u32 = 6;
+
+/// The G-buffer images of one image size.
+pub struct GBuffer {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// World position (xyz), 1 on surfaces / 0 on the background (w).
+    pub position: Image,
+    /// Shading normal toward the camera (xyz), pixel footprint (w).
+    pub normal: Image,
+    /// Geometric normal toward the camera (xyz), material index (w).
+    pub geometric: Image,
+    /// Diffuse albedo (rgb).
+    pub albedo: Image,
+    /// Emitted radiance toward the camera (rgb).
+    pub emission: Image,
+    /// Direct light reflected toward the camera (rgb), written by the direct pass.
+    pub direct: Image,
+    /// Depth attachment of the rasterization.
+    pub depth: Image,
+}
+
+impl std::fmt::Debug for GBuffer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GBuffer")
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .finish_non_exhaustive()
+    }
+}
+
+impl GBuffer {
+    /// Allocates the images for `width × height`.
+    pub fn new(ctx: &Context, width: u32, height: u32) -> Result<GBuffer> {
+        let color = |name| {
+            Image::new(
+                ctx,
+                &ImageDesc {
+                    name,
+                    width,
+                    height,
+                    format: GBUFFER_FORMAT,
+                    usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE,
+                },
+            )
+        };
+        Ok(GBuffer {
+            width,
+            height,
+            position: color("gbuffer.position")?,
+            normal: color("gbuffer.normal")?,
+            geometric: color("gbuffer.geometric")?,
+            albedo: color("gbuffer.albedo")?,
+            emission: color("gbuffer.emission")?,
+            direct: color("gbuffer.direct")?,
+            depth: Image::new(
+                ctx,
+                &ImageDesc {
+                    name: "gbuffer.depth",
+                    width,
+                    height,
+                    format: DEPTH_FORMAT,
+                    usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+                },
+            )?,
+        })
+    }
+
+    /// The binding layout of the G-buffer images (storage images at `PASS_BASE + 0..5`).
+    pub fn layout() -> [BindingLayout; GBUFFER_BINDINGS as usize] {
+        std::array::from_fn(|i| BindingLayout::new(PASS_BASE + i as u32, BindingKind::StorageImage))
+    }
+
+    /// The images to push at `PASS_BASE + 0..5` (they must be in a storage-image layout).
+    pub fn bindings(&self) -> [(u32, Resource<'_>); GBUFFER_BINDINGS as usize] {
+        [
+            (PASS_BASE, Resource::StorageImage(&self.position)),
+            (PASS_BASE + 1, Resource::StorageImage(&self.normal)),
+            (PASS_BASE + 2, Resource::StorageImage(&self.geometric)),
+            (PASS_BASE + 3, Resource::StorageImage(&self.albedo)),
+            (PASS_BASE + 4, Resource::StorageImage(&self.emission)),
+            (PASS_BASE + 5, Resource::StorageImage(&self.direct)),
+        ]
+    }
+
+    /// The colour images in attachment order (position, normal, geometric, albedo, emission).
+    pub fn attachments(&self) -> [&Image; 5] {
+        [
+            &self.position,
+            &self.normal,
+            &self.geometric,
+            &self.albedo,
+            &self.emission,
+        ]
+    }
+
+    /// Every colour image, the direct-light image included.
+    pub fn images(&self) -> [&Image; 6] {
+        [
+            &self.position,
+            &self.normal,
+            &self.geometric,
+            &self.albedo,
+            &self.emission,
+            &self.direct,
+        ]
+    }
+}

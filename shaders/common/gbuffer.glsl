@@ -1,0 +1,58 @@
+// The irradiance cache's G-buffer as compute and fragment passes read it: storage images at
+// B_PASS_BASE + 0..5 (see crates/radcache-render/src/gbuffer.rs, which owns the layout).
+//
+//   +0 position   xyz world position of the first hit; w = 1 on a surface, 0 on the background
+//   +1 normal     xyz unit shading normal, turned toward the camera; w = pixel footprint (world
+//                 size of one pixel at the point, ircache_math.glsl `pixel_footprint`)
+//   +2 geometric  xyz unit geometric normal, turned toward the camera; w = material index
+//   +3 albedo     rgb diffuse albedo (base colour × (1 − metallic), textured); w = 0
+//   +4 emission   rgb radiance emitted toward the camera (front/back rule applied); w = 0
+//   +5 direct     rgb direct light reflected toward the camera (albedo/π × NEE, MIS); w = 0
+//
+// Pass-specific resources start at B_GBUFFER_END.
+#ifndef RADCACHE_GBUFFER_GLSL
+#define RADCACHE_GBUFFER_GLSL
+
+#include "../shared/bindings.glsl"
+
+#define B_GBUFFER_END (B_PASS_BASE + 6)
+
+#ifndef GBUFFER_DIRECT_ACCESS
+#define GBUFFER_DIRECT_ACCESS readonly
+#endif
+
+layout(binding = B_PASS_BASE + 0, rgba32f) readonly uniform image2D g_position;
+layout(binding = B_PASS_BASE + 1, rgba32f) readonly uniform image2D g_normal;
+layout(binding = B_PASS_BASE + 2, rgba32f) readonly uniform image2D g_geometric;
+layout(binding = B_PASS_BASE + 3, rgba32f) readonly uniform image2D g_albedo;
+layout(binding = B_PASS_BASE + 4, rgba32f) readonly uniform image2D g_emission;
+layout(binding = B_PASS_BASE + 5, rgba32f) GBUFFER_DIRECT_ACCESS uniform image2D g_direct;
+
+struct GSample {
+    bool surface;
+    vec3 position;
+    vec3 normal;       // shading, toward the camera
+    float footprint;   // world size of one pixel at `position`
+    vec3 geometric;    // toward the camera
+    uint material;
+    vec3 albedo;
+    vec3 emission;
+};
+
+GSample gbuffer_load(ivec2 pixel) {
+    vec4 p = imageLoad(g_position, pixel);
+    vec4 n = imageLoad(g_normal, pixel);
+    vec4 g = imageLoad(g_geometric, pixel);
+    GSample s;
+    s.surface = p.w > 0.5;
+    s.position = p.xyz;
+    s.normal = n.xyz;
+    s.footprint = n.w;
+    s.geometric = g.xyz;
+    s.material = uint(max(g.w, 0.0));
+    s.albedo = imageLoad(g_albedo, pixel).rgb;
+    s.emission = imageLoad(g_emission, pixel).rgb;
+    return s;
+}
+
+#endif
