@@ -1,0 +1,137 @@
+//! Irradiance splatting (`shaders/passes/splat.vert` + `splat.frag`): one instanced quad per
+//! record, drawn indirectly (the instance count is the GPU's record count), adding (w·Ẽ, w) into
+//! an RGBA32F target with (ONE, ONE) blending. No depth test: the G-buffer already resolved
+//! visibility, and the fragment rejects points outside the record's zone.
+
+use bytemuck::{Pod, Zeroable};
+use radcache_cache::{IcParams, WeightKind};
+use radcache_vk::{
+    vk, BindingKind, BindingLayout, Blend, ColorTarget, Context, GraphicsDesc, Image, ImageDesc,
+    ImageUse, Pipeline, Recorder, Resource, ShaderCompiler,
+};
+
+use crate::bindings::{FRAME, PASS_BASE};
+use crate::error::Result;
+use crate::gbuffer::{GBuffer, GBUFFER_BINDINGS};
+use crate::gpu_scene::GpuScene;
+use crate::ic_state::IcState;
+
+/// Binding of the record buffer (just after the G-buffer).
+pub const RECORDS: u32 = PASS_BASE + GBUFFER_BINDINGS;
+
+/// Weighting of one splat pass: the kind, its parameter, and the in-front tolerance.
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct SplatWeights {
+    /// `WEIGHT_WARD` or `WEIGHT_TL`.
+    pub kind: u32,
+    /// `a` (Ward) or `κ` (T&L).
+    pub param: f32,
+    /// Weights at or below this are rejected (0: the whole zone).
+    pub w_min: f32,
+    /// In-front tolerance in pixel footprints.
+    pub front_tol_px: f32,
+}
+
+impl SplatWeights {
+    /// The weighting `params` describe.
+    pub fn from_params(params: &IcParams) -> SplatWeights {
+        SplatWeights {
+            kind: params.weight_kind as u32,
+            param: params.weight_param(),
+            w_min: match params.weight_kind {
+                WeightKind::Ward => 0.0,
+                WeightKind::TabellionLamorlette => 0.0,
+            },
+            front_tol_px: params.front_tolerance_px,
+        }
+    }
+}
+
+/// The splat pipeline and its accumulation target.
+pub struct SplatPass {
+    pipeline: Pipeline,
+    /// Σ w·Ẽ (rgb) and Σ w (a) per pixel.
+    pub sum: Image,
+}
+
+impl std::fmt::Debug for SplatPass {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SplatPass").finish_non_exhaustive()
+    }
+}
+
+impl SplatPass {
+    /// Compiles the pass and allocates the `width × height` accumulation target.
+    pub fn new(ctx: &Context, shaders: &ShaderCompiler, width: u32, height: u32) -> Result<Self> {
+        let vertex = shaders.compile("passes/splat.vert", &[])?;
+        let fragment = shaders.compile("passes/splat.frag", &[])?;
+        let mut bindings = vec![BindingLayout::new(FRAME, BindingKind::UniformBuffer)];
+        bindings.extend(GBuffer::layout());
+        bindings.push(BindingLayout::new(RECORDS, BindingKind::StorageBuffer));
+        let format = vk::Format::R32G32B32A32_SFLOAT;
+        let pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                name: "splat",
+                vertex: &vertex,
+                fragment: &fragment,
+                bindings: &bindings,
+                push_constant_size: std::mem::size_of::<SplatWeights>() as u32,
+                color_formats: &[format],
+                depth: None,
+                blend: Blend::Additive,
+                cull: vk::CullModeFlags::NONE,
+                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            },
+        )?;
+        let sum = Image::new(
+            ctx,
+            &ImageDesc {
+                name: "splat.sum",
+                width,
+                height,
+                format,
+                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE,
+            },
+        )?;
+        Ok(SplatPass { pipeline, sum })
+    }
+
+    /// Records clearing the target and splatting every record with `weights`, in a profiler
+    /// scope named `name` (e.g. `splat` or `splat.coverage`).
+    pub fn record(
+        &self,
+        rec: &mut Recorder,
+        name: &str,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        state: &IcState,
+        weights: &SplatWeights,
+    ) -> Result<()> {
+        for image in gbuffer.images() {
+            rec.use_image(image, ImageUse::FragmentStorage);
+        }
+        rec.use_image(&self.sum, ImageUse::ColorAttachment);
+        let scene_bindings = scene.bindings();
+        let mut bindings = vec![scene_bindings[FRAME as usize]];
+        bindings.extend(gbuffer.bindings());
+        bindings.push((RECORDS, Resource::Buffer(&state.records)));
+        rec.pass(name, |rec| {
+            rec.begin_rendering(
+                &[ColorTarget {
+                    image: &self.sum,
+                    clear: Some([0.0; 4]),
+                }],
+                None,
+            );
+            rec.bind_pipeline(&self.pipeline);
+            rec.push_bindings(&bindings);
+            rec.push_constants(weights);
+            rec.draw_indirect(&state.counters, 32, 1);
+            rec.end_rendering();
+        });
+        rec.use_image(&self.sum, ImageUse::ComputeStorage);
+        Ok(())
+    }
+}

@@ -1,0 +1,37 @@
+// Irradiance splatting, per pixel (IC reference §10.3): the record's weight at the pixel's
+// G-buffer point (normal and in-front tests included), the gradient-extrapolated irradiance
+// clamped to [0, 4·E_i] (§16.2), and (w·Ẽ, w) added into the RGBA32F target by (ONE, ONE)
+// blending. Weights are bounded (T&L ≤ 1, Ward ≤ 1/10⁻³), so the float sums cannot overflow.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+
+#include "../shared/layouts.glsl"
+#include "../shared/bindings.glsl"
+#include "../common/gbuffer.glsl"
+#include "../common/ircache_math.glsl"
+#include "splat_common.glsl"
+
+layout(location = 0) flat in uint v_record;
+layout(location = 0) out vec4 o_sum;
+
+void main() {
+    GSample g = gbuffer_load(ivec2(gl_FragCoord.xy));
+    if (!g.surface) {
+        discard;
+    }
+    GpuRecord rec = records[v_record];
+    vec3 p_i = rec.position_radius.xyz;
+    vec3 n_i = rec.normal_rorig.xyz;
+    float r_i = record_radius(rec);
+    float tol = pc.front_tol_px * g.footprint;
+    float w = record_weight(pc.kind, g.position, g.normal, p_i, n_i, r_i, pc.param, tol);
+    if (!(w > pc.w_min)) {
+        discard;
+    }
+    float att = gradient_attenuation(rec.normal_rorig.w, rec.bounds.x);
+    vec3 e = extrapolate_irradiance(rec.irradiance.rgb, rec.grad_r_red.xyz, rec.grad_r_green.xyz,
+                                    rec.grad_r_blue.xyz, att * rec.grad_t_red.xyz,
+                                    att * rec.grad_t_green.xyz, att * rec.grad_t_blue.xyz,
+                                    g.position, g.normal, p_i, n_i);
+    o_sum = vec4(w * e, w);
+}
