@@ -3,6 +3,7 @@
 mod assets;
 mod bench;
 mod codegen;
+mod refs;
 mod results;
 mod shaders;
 mod test;
@@ -19,6 +20,7 @@ Tasks:
   shaders           compile every shader in shaders/ and run spirv-val on the output
   codegen [--check] write shaders/shared/*.glsl from the Rust layouts (--check: fail if stale)
   assets [--check]  write the bundled glTF scenes into assets/ (--check: fail if they differ)
+  refs              render the path-traced references of the cache tests into tests/refs/
   bench rays        raw ray-query throughput and BLAS/TLAS build times on the chosen device
   bench pt          path tracer on the Cornell box at 256² and 512²: samples/s and rays/s
   help              this text
@@ -54,6 +56,7 @@ fn try_main() -> Result<()> {
             assets::run(&rest.iter().map(|s| s.to_string()).collect::<Vec<_>>())
         }
         ["bench", rest @ ..] => bench::run(rest),
+        ["refs", rest @ ..] => refs::run(rest),
         [] | ["help"] | ["--help"] | ["-h"] => {
             print!("{HELP}");
             Ok(())

@@ -101,7 +101,7 @@ pub(crate) fn query_caps(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Re
     // SAFETY: the chain only holds structs the device's API version / extensions define.
     unsafe { instance.get_physical_device_features2(pd, &mut core) };
     let c = core.features;
-    let flags: [(&'static str, u32); 12] = [
+    let flags: [(&'static str, u32); 13] = [
         ("bufferDeviceAddress", f12.buffer_device_address),
         ("scalarBlockLayout", f12.scalar_block_layout),
         ("runtimeDescriptorArray", f12.runtime_descriptor_array),
@@ -116,6 +116,10 @@ pub(crate) fn query_caps(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Re
         ("dynamicRendering", f13.dynamic_rendering),
         ("synchronization2", f13.synchronization2),
         ("maintenance4", f13.maintenance4),
+        (
+            "shaderDemoteToHelperInvocation",
+            f13.shader_demote_to_helper_invocation,
+        ),
         ("accelerationStructure", fas.acceleration_structure),
         ("rayQuery", frq.ray_query),
         ("fragmentStoresAndAtomics", c.fragment_stores_and_atomics),
@@ -215,7 +219,8 @@ pub(crate) fn create_device(
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
         .dynamic_rendering(true)
         .synchronization2(true)
-        .maintenance4(true);
+        .maintenance4(true)
+        .shader_demote_to_helper_invocation(true);
     let mut fas =
         vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
     let mut frq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);

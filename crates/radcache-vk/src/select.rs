@@ -24,6 +24,7 @@ pub const REQUIRED_FEATURES: &[&str] = &[
     "dynamicRendering",
     "synchronization2",
     "maintenance4",
+    "shaderDemoteToHelperInvocation",
     "accelerationStructure",
     "rayQuery",
     "fragmentStoresAndAtomics",

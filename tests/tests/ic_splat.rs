@@ -1,0 +1,329 @@
+//! The cache's splat, hole-selection, counter and neighbour-clamping passes on lavapipe, against
+//! the CPU twins of radcache-cache, on a synthetic G-buffer (every pixel the same surface point),
+//! so each expected value is exact.
+
+use glam::Vec3;
+use radcache_cache::{extrapolate_irradiance, record_weight, IcParams, WeightKind};
+use radcache_render::{
+    GBuffer, GpuScene, HolePass, IcState, NeighbourPass, SplatPass, SplatWeights,
+};
+use radcache_scene::{LoadOptions, Scene};
+use radcache_shared::gpu::{GpuRecord, IcCounters};
+use radcache_tests::{context, finish, shaders};
+use radcache_vk::{Context, ImageUse, Recorder};
+
+const W: u32 = 32;
+const H: u32 = 24;
+const P: Vec3 = Vec3::new(0.3, 0.0, 0.3);
+const N: Vec3 = Vec3::Y;
+const FOOTPRINT: f32 = 1e-3;
+
+fn cornell() -> Scene {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../assets/cornell/cornell.gltf"
+    );
+    Scene::load(std::path::Path::new(path), &LoadOptions::default())
+        .unwrap()
+        .0
+}
+
+fn v4(v: Vec3, w: f32) -> [f32; 4] {
+    [v.x, v.y, v.z, w]
+}
+
+/// A record at `p` with normal `n`, irradiance `e`, radius `r` (R⁻ = R⁺ = r unless `bounds`).
+fn record(p: Vec3, n: Vec3, e: Vec3, r: f32, grad_r: [Vec3; 3]) -> GpuRecord {
+    GpuRecord {
+        position_radius: v4(p, r),
+        normal_rorig: v4(n, r),
+        irradiance: v4(e, 1.0),
+        bounds: [r, r, FOOTPRINT, r],
+        grad_r_red: v4(grad_r[0], 0.0),
+        grad_r_green: v4(grad_r[1], 0.0),
+        grad_r_blue: v4(grad_r[2], 0.0),
+        grad_t_red: [0.0; 4],
+        grad_t_green: [0.0; 4],
+        grad_t_blue: [0.0; 4],
+        info: [0; 4],
+    }
+}
+
+/// Fills every G-buffer pixel with the surface point (P, N).
+fn fill_gbuffer(rec: &mut Recorder, g: &GBuffer) {
+    let values = [
+        v4(P, 1.0),
+        v4(N, FOOTPRINT),
+        v4(N, 0.0),
+        [0.5, 0.5, 0.5, 0.0],
+        [0.0; 4],
+        [0.0; 4],
+    ];
+    for (image, value) in g.images().into_iter().zip(values) {
+        rec.use_image(image, ImageUse::TransferDst);
+        rec.clear_color(image, value);
+    }
+}
+
+fn set_state(rec: &mut Recorder, state: &IcState, records: &[GpuRecord], counters: IcCounters) {
+    if !records.is_empty() {
+        rec.update_buffer(&state.records, 0, records);
+    }
+    rec.update_buffer(&state.counters, 0, std::slice::from_ref(&counters));
+    rec.barrier(
+        radcache_vk::Access::TRANSFER_WRITE,
+        radcache_vk::Access::ALL,
+    );
+}
+
+fn counters(records: u32, batch_base: u32) -> IcCounters {
+    IcCounters {
+        counts: [records, 0, batch_base, 0],
+        dispatch: [records - batch_base, 1, 1, 0],
+        draw: [6, records, 0, 0],
+        limits: [64, 1024, 0, 0],
+    }
+}
+
+struct Fixture {
+    ctx: Context,
+    gpu: GpuScene,
+    gbuffer: GBuffer,
+    splat: SplatPass,
+    state: IcState,
+}
+
+fn fixture() -> Fixture {
+    let ctx = context();
+    let shaders = shaders();
+    let scene = cornell();
+    let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
+    gpu.set_time(&scene, 0.0).unwrap();
+    gpu.set_view(&scene.camera_at(0.0), W, H, 1, 0).unwrap();
+    let gbuffer = GBuffer::new(&ctx, W, H).unwrap();
+    let splat = SplatPass::new(&ctx, &shaders, W, H).unwrap();
+    let state = IcState::new(&ctx, &shaders, 64, 1024).unwrap();
+    Fixture {
+        ctx,
+        gpu,
+        gbuffer,
+        splat,
+        state,
+    }
+}
+
+fn end(f: Fixture) {
+    let Fixture {
+        ctx,
+        gpu,
+        gbuffer,
+        splat,
+        state,
+    } = f;
+    drop((gpu, gbuffer, splat, state));
+    finish(ctx);
+}
+
+#[test]
+fn splat_sums_match_the_cpu_weight_and_extrapolation() {
+    let f = fixture();
+    let params = IcParams::default();
+    let weights = SplatWeights::from_params(&params);
+    assert_eq!(params.weight_kind, WeightKind::TabellionLamorlette);
+    // A record exactly at the pixel's point, and one with a tilted normal and a rotational
+    // gradient; both have radii large enough that their splat covers the whole view.
+    let tilt = (N + Vec3::new(0.05, 0.0, 0.02)).normalize();
+    let grad = [
+        Vec3::new(0.0, 0.0, 0.4),
+        Vec3::new(0.3, 0.0, 0.0),
+        Vec3::ZERO,
+    ];
+    let r = 1.0e9;
+    let recs = [
+        record(P, N, Vec3::new(1.0, 2.0, 3.0), r, [Vec3::ZERO; 3]),
+        record(
+            P + Vec3::new(-0.01, 0.0, 0.0),
+            tilt,
+            Vec3::new(0.5, 0.25, 0.125),
+            r,
+            grad,
+        ),
+    ];
+    let mut rec = f.ctx.begin("test.splat").unwrap();
+    fill_gbuffer(&mut rec, &f.gbuffer);
+    set_state(&mut rec, &f.state, &recs, counters(2, 0));
+    f.splat
+        .record(&mut rec, "splat", &f.gpu, &f.gbuffer, &f.state, &weights)
+        .unwrap();
+    f.ctx.submit(rec).unwrap().wait().unwrap();
+    let sums: Vec<[f32; 4]> = f.ctx.read_image(&f.splat.sum).unwrap();
+
+    let mut expected = [0.0f64; 4];
+    for r in &recs {
+        let p_i = Vec3::from_slice(&r.position_radius[..3]);
+        let n_i = Vec3::from_slice(&r.normal_rorig[..3]);
+        let tol = params.front_tolerance_px * FOOTPRINT;
+        let w = record_weight(
+            params.weight_kind,
+            P,
+            N,
+            p_i,
+            n_i,
+            r.position_radius[3],
+            params.weight_param(),
+            tol,
+        );
+        assert!(w > 0.0, "the test records must contribute");
+        let g = |v: [f32; 4]| Vec3::from_slice(&v[..3]);
+        let e = extrapolate_irradiance(
+            g(r.irradiance),
+            &[g(r.grad_r_red), g(r.grad_r_green), g(r.grad_r_blue)],
+            &[Vec3::ZERO; 3],
+            P,
+            N,
+            p_i,
+            n_i,
+        );
+        for c in 0..3 {
+            expected[c] += f64::from(w * e[c]);
+        }
+        expected[3] += f64::from(w);
+    }
+    for (i, s) in sums.iter().enumerate() {
+        for c in 0..4 {
+            let got = f64::from(s[c]);
+            assert!(
+                (got - expected[c]).abs() <= 1e-5 * expected[c].abs().max(1.0),
+                "pixel {i} channel {c}: GPU {got}, CPU {}",
+                expected[c]
+            );
+        }
+    }
+    end(f);
+}
+
+#[test]
+fn holes_request_one_record_per_block_and_vanish_when_covered() {
+    let f = fixture();
+    let shaders = shaders();
+    let holes = HolePass::new(&f.ctx, &shaders).unwrap();
+    let weights = SplatWeights::from_params(&IcParams::default());
+    let spacing = 4;
+    // No records: every pixel is a hole, one request per 4×4 block.
+    let mut rec = f.ctx.begin("test.holes").unwrap();
+    fill_gbuffer(&mut rec, &f.gbuffer);
+    set_state(&mut rec, &f.state, &[], counters(0, 0));
+    f.splat
+        .record(&mut rec, "splat", &f.gpu, &f.gbuffer, &f.state, &weights)
+        .unwrap();
+    holes
+        .record(
+            &mut rec, &f.gbuffer, &f.splat, &f.state, spacing, 0.5, 7, false,
+        )
+        .unwrap();
+    f.state.record_begin_batch(&mut rec).unwrap();
+    f.ctx.submit(rec).unwrap().wait().unwrap();
+    let c = f.state.read_counters().unwrap();
+    assert_eq!(c.counts[3], W * H, "hole pixels");
+    let blocks = W.div_ceil(spacing) * H.div_ceil(spacing);
+    assert_eq!(c.counts[1], blocks, "one request per block");
+    assert_eq!(c.dispatch[0], blocks, "record pass dispatch");
+    let requests: Vec<u32> = f
+        .ctx
+        .read_buffer(&f.state.requests, blocks as usize)
+        .unwrap();
+    let mut seen = std::collections::BTreeSet::new();
+    for &r in &requests {
+        let (x, y) = (r % W, r / W);
+        assert!(r < W * H);
+        assert!(
+            seen.insert((x / spacing, y / spacing)),
+            "two requests in block of {r}"
+        );
+    }
+
+    // One record covering everything: no holes left.
+    let mut rec = f.ctx.begin("test.covered").unwrap();
+    let cover = record(P, N, Vec3::ONE, 1.0e9, [Vec3::ZERO; 3]);
+    set_state(&mut rec, &f.state, &[cover], counters(1, 0));
+    f.state.record_begin_level(&mut rec).unwrap();
+    f.splat
+        .record(&mut rec, "splat", &f.gpu, &f.gbuffer, &f.state, &weights)
+        .unwrap();
+    holes
+        .record(
+            &mut rec, &f.gbuffer, &f.splat, &f.state, spacing, 0.5, 7, false,
+        )
+        .unwrap();
+    f.ctx.submit(rec).unwrap().wait().unwrap();
+    let c = f.state.read_counters().unwrap();
+    assert_eq!((c.counts[1], c.counts[3]), (0, 0), "{c:?}");
+    drop(holes);
+    end(f);
+}
+
+#[test]
+fn counters_turn_requests_into_dispatches_within_capacity() {
+    let f = fixture();
+    let mut rec = f.ctx.begin("test.counters").unwrap();
+    f.state.record_reset(&mut rec).unwrap();
+    f.ctx.submit(rec).unwrap().wait().unwrap();
+    let c = f.state.read_counters().unwrap();
+    assert_eq!(c.counts, [0; 4]);
+    assert_eq!(c.limits[..2], [64, 1024]);
+
+    // 60 records exist, 10 are requested, room for 4.
+    let mut rec = f.ctx.begin("test.batch").unwrap();
+    let mut start = counters(60, 60);
+    start.counts[1] = 10;
+    set_state(&mut rec, &f.state, &[], start);
+    f.state.record_begin_batch(&mut rec).unwrap();
+    f.state.record_end_batch(&mut rec).unwrap();
+    f.ctx.submit(rec).unwrap().wait().unwrap();
+    let c = f.state.read_counters().unwrap();
+    assert_eq!(c.dispatch[0], 4);
+    assert_eq!(c.counts[2], 60, "batch base");
+    assert_eq!(c.counts[0], 64, "record count");
+    assert_eq!(c.draw, [6, 64, 0, 0]);
+    assert_eq!(c.limits[2], 6, "dropped requests");
+    end(f);
+}
+
+#[test]
+fn neighbour_clamping_shrinks_radii_to_neighbour_plus_distance() {
+    let f = fixture();
+    let shaders = shaders();
+    let pass = NeighbourPass::new(&f.ctx, &shaders).unwrap();
+    // Old record 0 (R 10) far from everything; new records 1 (R 1) and 2 (R 8) two units apart,
+    // record 3 (old, R 5) one unit from record 1.
+    let recs = [
+        record(
+            Vec3::new(100.0, 0.0, 0.0),
+            N,
+            Vec3::ONE,
+            10.0,
+            [Vec3::ZERO; 3],
+        ),
+        record(Vec3::ZERO, N, Vec3::ONE, 1.0, [Vec3::ZERO; 3]),
+        record(Vec3::new(2.0, 0.0, 0.0), N, Vec3::ONE, 8.0, [Vec3::ZERO; 3]),
+        record(Vec3::new(0.0, 1.0, 0.0), N, Vec3::ONE, 5.0, [Vec3::ZERO; 3]),
+    ];
+    let mut c = counters(4, 1);
+    c.dispatch[0] = 2; // records 1 and 2 are the new batch
+    let mut rec = f.ctx.begin("test.neighbours").unwrap();
+    set_state(&mut rec, &f.state, &recs, c);
+    pass.record(&mut rec, &f.state).unwrap();
+    f.ctx.submit(rec).unwrap().wait().unwrap();
+    let out: Vec<GpuRecord> = f.ctx.read_buffer(&f.state.records, 4).unwrap();
+    let r: Vec<f32> = out.iter().map(|r| r.normal_rorig[3]).collect();
+    // Record 0: 10 ≤ 1 + ~100, unchanged. Record 2: min(8, 1 + 2) = 3. Record 3: min(5, 1 + 1) = 2.
+    let expected = [10.0, 1.0, 3.0, 2.0];
+    for (got, want) in r.iter().zip(expected) {
+        assert!(
+            (got - want).abs() < 1e-5,
+            "radii {r:?}, expected {expected:?}"
+        );
+    }
+    drop(pass);
+    end(f);
+}
