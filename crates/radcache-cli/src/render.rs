@@ -6,10 +6,14 @@ use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
+use radcache_cache::{IcParams, Preset, WeightKind};
 use radcache_image::{
     png_beside, write_exr, write_png, ExrOptions, Image, Layer, Metadata, PngOptions, ToneMap,
 };
-use radcache_render::{render_path, vulkan_clip_from_view, Budget, EnvMap, GpuScene, PathSettings};
+use radcache_render::{
+    render_aovs, render_ic, render_path, vulkan_clip_from_view, Budget, EnvMap, GpuScene,
+    IcSettings, IcStats, PathSettings,
+};
 use radcache_scene::{EnvOverride, Environment, LoadOptions, Scene};
 use radcache_vk::{Context, ShaderCompiler};
 use serde_json::json;
@@ -69,8 +73,28 @@ fn parse_rgb(text: &str) -> Result<[f32; 3]> {
 pub enum Method {
     /// The unbiased reference path tracer.
     Path,
-    /// The irradiance cache (not available yet in this build).
+    /// The irradiance cache.
     Ic,
+}
+
+/// Cache quality preset.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Quality {
+    /// Fast previews (a = 0.3, 8×24 strata).
+    Draft,
+    /// The default (a = 0.15, 16×48 strata).
+    Default,
+    /// Offline quality (a = 0.1, 24×72 strata).
+    High,
+}
+
+/// Interpolation weight of the cache.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Weight {
+    /// Tabellion–Lamorlette (default): bounded, continuous at the zone's edge.
+    Tl,
+    /// Ward's split-sphere weight.
+    Ward,
 }
 
 #[derive(Args, Debug)]
@@ -84,8 +108,23 @@ pub struct RenderArgs {
     #[arg(long, value_name = "WxH")]
     resolution: Option<String>,
     /// Rendering method.
-    #[arg(long, value_enum, default_value_t = Method::Path)]
+    #[arg(long, value_enum, default_value_t = Method::Ic)]
     method: Method,
+    /// Cache quality preset (`--method ic`).
+    #[arg(long, value_enum, default_value_t = Quality::Default)]
+    quality: Quality,
+    /// Cache interpolation weight (`--method ic`).
+    #[arg(long, value_enum)]
+    weight: Option<Weight>,
+    /// Cache accuracy: Ward's a, or 1/κ for Tabellion–Lamorlette (smaller is more accurate).
+    #[arg(long)]
+    accuracy: Option<f32>,
+    /// Jittered sub-frames of the cache (anti-aliasing); default 4.
+    #[arg(long)]
+    sub_frames: Option<u32>,
+    /// Direct-lighting samples per pixel and sub-frame (`--method ic`); default 16.
+    #[arg(long)]
+    direct_samples: Option<u32>,
     /// Samples per pixel (path tracer).
     #[arg(long, conflicts_with = "time_budget")]
     spp: Option<u32>,
@@ -148,9 +187,6 @@ fn parse_resolution(text: &str) -> Result<(u32, u32)> {
 }
 
 pub fn run(args: &RenderArgs) -> Result<ExitCode> {
-    if args.method == Method::Ic {
-        bail!("--method ic: the irradiance cache is not part of this build yet; use --method path");
-    }
     let budget = match (args.spp, args.time_budget) {
         (_, Some(s)) if !(s.is_finite() && s > 0.0) => bail!("--time-budget must be positive"),
         (_, Some(s)) => Budget::Seconds(s),
@@ -193,21 +229,50 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let t_upload = Instant::now();
     let mut gpu = GpuScene::new(&ctx, &scene, env_map.as_ref())?;
     let upload_s = t_upload.elapsed().as_secs_f64();
-    let settings = PathSettings {
-        width,
-        height,
-        budget,
-        seed: args.seed,
-        frame: args.frame,
-        time: args.time,
-        aovs: args.aov,
-        ..PathSettings::default()
+    let (out, ic_stats) = match args.method {
+        Method::Path => {
+            let settings = PathSettings {
+                width,
+                height,
+                budget,
+                seed: args.seed,
+                frame: args.frame,
+                time: args.time,
+                aovs: args.aov,
+                ..PathSettings::default()
+            };
+            let mut bar = ProgressLine::new(format!("frame {}", args.frame), "spp", args.quiet);
+            let out = render_path(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |p| {
+                bar.update(p.done, p.total, p.elapsed_s)
+            })?;
+            bar.finish();
+            (out, None)
+        }
+        Method::Ic => {
+            let settings = IcSettings {
+                width,
+                height,
+                params: ic_params(args)?,
+                sub_frames: args.sub_frames.unwrap_or(4).max(1),
+                direct_samples: args.direct_samples.unwrap_or(16).max(1),
+                seed: args.seed,
+                frame: args.frame,
+                time: args.time,
+                ..IcSettings::default()
+            };
+            let mut bar =
+                ProgressLine::new(format!("frame {}", args.frame), "sub-frames", args.quiet);
+            let (mut out, stats) =
+                render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |p| {
+                    bar.update(p.done, p.total, p.elapsed_s)
+                })?;
+            bar.finish();
+            if args.aov {
+                out.aovs = Some(render_aovs(&ctx, &shaders, &gpu, width, height)?);
+            }
+            (out, Some(stats))
+        }
     };
-    let mut bar = ProgressLine::new(format!("frame {}", args.frame), "spp", args.quiet);
-    let out = render_path(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |p| {
-        bar.update(p.done, p.total, p.elapsed_s)
-    })?;
-    bar.finish();
     if out.nonfinite_pixels > 0 {
         log::warn!(
             "{} pixels were non-finite and written as black",
@@ -223,8 +288,20 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     }
     let aspect = width as f32 / height as f32;
     let mut meta = Metadata::new();
-    meta.method = Some("path".into());
+    let method = match args.method {
+        Method::Path => "path",
+        Method::Ic => "ic",
+    };
+    meta.method = Some(method.into());
     meta.spp = Some(out.spp);
+    if let Some(stats) = &ic_stats {
+        meta.extra.insert(
+            "quality".into(),
+            format!("{:?}", args.quality).to_lowercase(),
+        );
+        meta.extra
+            .insert("records".into(), stats.records.to_string());
+    }
     meta.render_time_s = Some(out.time_s);
     meta.scene_file = Some(args.scene.display().to_string());
     meta.world_from_camera = Some(view.world_from_camera.to_cols_array());
@@ -267,19 +344,17 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     }
     let write_s = t_write.elapsed().as_secs_f64();
     if let Some(path) = &args.stats {
-        write_stats(
-            path,
-            args,
-            &ctx,
-            &out,
-            (width, height),
-            [load_s, upload_s, write_s],
-        )?;
+        let run = RunInfo {
+            method,
+            size: (width, height),
+            cpu_s: [load_s, upload_s, write_s],
+        };
+        write_stats(path, args, &ctx, &out, ic_stats.as_ref(), &run)?;
     }
     if !args.quiet {
         let rays: u64 = out.rays.values().sum();
         eprintln!(
-            "wrote {} ({width}x{height}, {} spp, {:.2} s, {:.2} Mrays/s)",
+            "wrote {} ({width}x{height}, {method}, {} spp, {:.2} s, {:.2} Mrays/s)",
             output.display(),
             out.spp,
             out.time_s,
@@ -300,29 +375,68 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// What the stats file says about the run besides the frames.
+struct RunInfo {
+    method: &'static str,
+    size: (u32, u32),
+    cpu_s: [f64; 3],
+}
+
+fn ic_params(args: &RenderArgs) -> Result<IcParams> {
+    let mut params = IcParams::preset(match args.quality {
+        Quality::Draft => Preset::Draft,
+        Quality::Default => Preset::Default,
+        Quality::High => Preset::High,
+    });
+    if let Some(w) = args.weight {
+        params.weight_kind = match w {
+            Weight::Tl => WeightKind::TabellionLamorlette,
+            Weight::Ward => WeightKind::Ward,
+        };
+    }
+    if let Some(a) = args.accuracy {
+        if !(a.is_finite() && a > 0.0) {
+            bail!("--accuracy must be a positive number, got {a}");
+        }
+        params.accuracy = a;
+        params.kappa = 1.0 / a;
+    }
+    Ok(params)
+}
+
 fn write_stats(
     path: &Path,
     args: &RenderArgs,
     ctx: &Context,
     out: &radcache_render::FrameOutput,
-    (width, height): (u32, u32),
-    [load_s, upload_s, write_s]: [f64; 3],
+    ic: Option<&IcStats>,
+    run: &RunInfo,
 ) -> Result<()> {
+    let (width, height) = run.size;
+    let [load_s, upload_s, write_s] = run.cpu_s;
+    let mut frame = json!({
+        "frame": args.frame,
+        "time": args.time,
+        "time_s": out.time_s,
+        "spp": out.spp,
+        "rays": out.rays,
+        "passes_ms": out.passes_ms,
+        "nonfinite_pixels": out.nonfinite_pixels,
+    });
+    if let Some(ic) = ic {
+        frame["records"] = json!(ic.records);
+        frame["records_per_level"] = json!(ic.records_per_level);
+        frame["holes_left"] = json!(ic.holes_left);
+        frame["dropped_requests"] = json!(ic.dropped_requests);
+        frame["rejected_records"] = json!(ic.rejected_records);
+    }
     let value = json!({
         "scene": args.scene,
-        "method": "path",
+        "method": run.method,
         "device": ctx.info().name,
         "resolution": [width, height],
         "cpu_s": {"scene_load": load_s, "upload": upload_s, "write": write_s},
-        "frames": [{
-            "frame": args.frame,
-            "time": args.time,
-            "time_s": out.time_s,
-            "spp": out.spp,
-            "rays": out.rays,
-            "passes_ms": out.passes_ms,
-            "nonfinite_pixels": out.nonfinite_pixels,
-        }],
+        "frames": [frame],
     });
     let text = serde_json::to_string_pretty(&value)?;
     radcache_image::write_atomic(path, |w| {

@@ -116,3 +116,19 @@ impl AovPass {
         })
     }
 }
+
+/// Computes the AOVs of the current view of `scene` (after `GpuScene::set_view` for this size and
+/// a TLAS update) in one submission.
+pub fn render_aovs(
+    ctx: &Context,
+    shaders: &ShaderCompiler,
+    scene: &GpuScene,
+    width: u32,
+    height: u32,
+) -> Result<Aovs> {
+    let pass = AovPass::new(ctx, shaders, width, height)?;
+    let mut rec = ctx.begin("aov")?;
+    pass.record(&mut rec, scene)?;
+    ctx.submit(rec)?.wait()?;
+    pass.read(ctx)
+}

@@ -311,6 +311,18 @@ impl GpuScene {
         self.scene_scale
     }
 
+    /// `(custom index, triangle count)` of every instance that has triangles, for rasterization.
+    pub fn instance_draws(&self) -> Vec<(u32, u32)> {
+        self.instance_mesh
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &m)| {
+                let n = self.meshes[m].ranges[3];
+                (n > 0).then_some((i as u32, n))
+            })
+            .collect()
+    }
+
     /// Emissive triangles at the current time.
     pub fn emitter_count(&self) -> u32 {
         self.emitter_count

@@ -4,7 +4,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use radcache_vk::{
-    BindingKind, BindingLayout, Context, Pipeline, Recorder, Resource, ShaderCompiler,
+    BindingKind, BindingLayout, Context, ImageUse, Pipeline, Recorder, Resource, ShaderCompiler,
 };
 
 use crate::bindings::PASS_BASE;
@@ -73,6 +73,10 @@ impl HolePass {
             seed,
             count_only: u32::from(count_only),
         };
+        for image in gbuffer.images() {
+            rec.use_image(image, ImageUse::ComputeStorage);
+        }
+        rec.use_image(&splat.sum, ImageUse::ComputeStorage);
         let mut bindings = gbuffer.bindings().to_vec();
         bindings.push((BASE, Resource::StorageImage(&splat.sum)));
         bindings.push((BASE + 1, Resource::Buffer(&state.requests)));

@@ -9,7 +9,10 @@
 //!    (indirect dispatch), clamp radii against their neighbours. The CPU only loops over levels
 //!    and reads the counters for the statistics; it stops early when a level finds no hole.
 //! 3. **Splat** every record with the final weights and **composite**
-//!    `L = emission + direct + albedo/π · Σw·Ẽ / Σw` into the frame accumulator.
+//!    `L = direct + albedo/π · Σw·Ẽ / Σw` into the frame accumulator.
+//!
+//! Finally the **emission** pass adds the box-filtered emission (8×8 stratified rays at pixels
+//! near emitters, the sub-frames' samples elsewhere).
 //!
 //! Records persist across sub-frames (they are world-space), so later sub-frames mostly reuse
 //! the first one's records and only fill the holes their jitter uncovers.
@@ -23,6 +26,7 @@ use radcache_vk::{Context, PassTiming, ShaderCompiler};
 
 use crate::composite::CompositePass;
 use crate::direct::DirectPass;
+use crate::emission::EmissionPass;
 use crate::error::{Error, Result};
 use crate::gbuffer::GBuffer;
 use crate::gbuffer_pass::GBufferPass;
@@ -143,6 +147,7 @@ pub fn render_ic(
     let neighbours = NeighbourPass::new(ctx, shaders)?;
     let records = RecordPass::new(ctx, shaders, gpu, &params)?;
     let composite = CompositePass::new(ctx, shaders, gpu, w, h)?;
+    let emission = EmissionPass::new(ctx, shaders, gpu)?;
     let request_capacity = w.div_ceil(1) * h.div_ceil(1);
     let state = IcState::new(ctx, shaders, settings.record_capacity, request_capacity)?;
 
@@ -174,7 +179,14 @@ pub fn render_ic(
         for level in 0..params.levels {
             let mut rec = ctx.begin("ic.level")?;
             state.record_begin_level(&mut rec)?;
-            splat.record(&mut rec, "splat.coverage", gpu, &gbuffer, &state, &creation_weights)?;
+            splat.record(
+                &mut rec,
+                "splat.coverage",
+                gpu,
+                &gbuffer,
+                &state,
+                &creation_weights,
+            )?;
             holes.record(
                 &mut rec,
                 &gbuffer,
@@ -225,6 +237,10 @@ pub fn render_ic(
             elapsed_s: start.elapsed().as_secs_f64(),
         });
     }
+    let mut rec = ctx.begin("ic.emission")?;
+    emission.record(&mut rec, gpu, &composite)?;
+    add_timings(&mut passes_ms, ctx.submit(rec)?.wait()?);
+    *rays.entry("emission".into()).or_default() += emission.rays()?;
     let (pixels, nonfinite_pixels) = composite.read_mean(ctx)?;
     Ok((
         FrameOutput {

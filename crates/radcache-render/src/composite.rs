@@ -1,0 +1,157 @@
+//! Composite of the cache's sub-frames (`shaders/passes/composite.comp`): emission + direct +
+//! albedo/π × the normalised splat sum on surfaces, the environment elsewhere, accumulated over
+//! jittered sub-frames into a float buffer whose mean is the image.
+
+use bytemuck::{Pod, Zeroable};
+use radcache_vk::{
+    vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, ImageUse, MemoryLocation,
+    Pipeline, Recorder, Resource, ShaderCompiler,
+};
+
+use crate::bindings::{with_scene, PASS_BASE};
+use crate::error::Result;
+use crate::gbuffer::{GBuffer, GBUFFER_BINDINGS};
+use crate::gpu_scene::GpuScene;
+use crate::splat::SplatPass;
+
+const BASE: u32 = PASS_BASE + GBUFFER_BINDINGS;
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Push {
+    jitter: [f32; 2],
+    pad: [u32; 2],
+}
+
+/// The composite pipeline and the frame accumulator.
+pub struct CompositePass {
+    pipeline: Pipeline,
+    pub(crate) accum: Buffer,
+    pub(crate) emission_accum: Buffer,
+    nonfinite: Buffer,
+    width: u32,
+    height: u32,
+}
+
+impl std::fmt::Debug for CompositePass {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CompositePass")
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .finish_non_exhaustive()
+    }
+}
+
+impl CompositePass {
+    /// Compiles the pass for `scene`'s plan and allocates the `width × height` accumulator.
+    pub fn new(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        scene: &GpuScene,
+        width: u32,
+        height: u32,
+    ) -> Result<CompositePass> {
+        let spirv = shaders.compile("passes/composite.comp", &scene.defines())?;
+        let mut pass = GBuffer::layout().to_vec();
+        pass.push(BindingLayout::new(BASE, BindingKind::StorageImage));
+        pass.push(BindingLayout::new(BASE + 1, BindingKind::StorageBuffer));
+        pass.push(BindingLayout::new(BASE + 2, BindingKind::StorageBuffer));
+        pass.push(BindingLayout::new(BASE + 3, BindingKind::StorageBuffer));
+        let pipeline = Pipeline::compute(
+            ctx,
+            "composite",
+            &spirv,
+            &with_scene(&pass),
+            std::mem::size_of::<Push>() as u32,
+        )?;
+        let buffer = |name, size, location| {
+            Buffer::new(
+                ctx,
+                &BufferDesc {
+                    name,
+                    size,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                    location,
+                    alignment: 0,
+                },
+            )
+        };
+        let pixels = u64::from(width) * u64::from(height);
+        Ok(CompositePass {
+            pipeline,
+            accum: buffer("composite.accum", pixels * 16, MemoryLocation::GpuOnly)?,
+            emission_accum: buffer("composite.emission", pixels * 16, MemoryLocation::GpuOnly)?,
+            nonfinite: buffer("composite.nonfinite", 16, MemoryLocation::GpuToCpu)?,
+            width,
+            height,
+        })
+    }
+
+    /// Records zeroing the accumulator and the non-finite counter.
+    pub fn record_clear(&self, rec: &mut Recorder) {
+        rec.fill_buffer(&self.accum, 0, vk::WHOLE_SIZE, 0);
+        rec.fill_buffer(&self.emission_accum, 0, vk::WHOLE_SIZE, 0);
+        rec.fill_buffer(&self.nonfinite, 0, vk::WHOLE_SIZE, 0);
+        rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
+    }
+
+    /// Records adding the sub-frame rendered with `jitter` to the accumulator.
+    pub fn record(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        splat: &SplatPass,
+        jitter: [f32; 2],
+    ) -> Result<()> {
+        for image in gbuffer.images() {
+            rec.use_image(image, ImageUse::ComputeStorage);
+        }
+        rec.use_image(&splat.sum, ImageUse::ComputeStorage);
+        let mut bindings = scene.bindings();
+        bindings.extend(gbuffer.bindings());
+        bindings.push((BASE, Resource::StorageImage(&splat.sum)));
+        bindings.push((BASE + 1, Resource::Buffer(&self.accum)));
+        bindings.push((BASE + 2, Resource::Buffer(&self.nonfinite)));
+        bindings.push((BASE + 3, Resource::Buffer(&self.emission_accum)));
+        let push = Push {
+            jitter,
+            pad: [0; 2],
+        };
+        let (w, h) = (self.width, self.height);
+        rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
+        rec.pass("composite", |rec| {
+            rec.bind_pipeline(&self.pipeline);
+            rec.push_bindings(&bindings);
+            rec.push_constants(&push);
+            rec.dispatch(w.div_ceil(8), h.div_ceil(8), 1)
+        })?;
+        rec.barrier(
+            Access::COMPUTE_WRITE,
+            Access::COMPUTE_READ_WRITE
+                .union(Access::TRANSFER_READ)
+                .union(Access::HOST_READ),
+        );
+        Ok(())
+    }
+
+    /// Width and height of the accumulator.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// The mean over the accumulated sub-frames, and the number of non-finite values dropped.
+    pub fn read_mean(&self, ctx: &Context) -> Result<(Vec<[f32; 3]>, u64)> {
+        let sums: Vec<[f32; 4]> =
+            ctx.read_buffer(&self.accum, (self.width * self.height) as usize)?;
+        let dropped = u64::from(self.nonfinite.read::<u32>(1)?[0]);
+        let pixels = sums
+            .iter()
+            .map(|s| {
+                let n = s[3].max(1.0);
+                [s[0] / n, s[1] / n, s[2] / n]
+            })
+            .collect();
+        Ok((pixels, dropped))
+    }
+}

@@ -1,0 +1,81 @@
+//! Box-filtered emission (`shaders/passes/emission.comp`): after the sub-frames, pixels at or next
+//! to emitters get their emission from 8×8 stratified camera rays, so emitter edges are filtered
+//! like the reference's instead of being quantised by the few sub-frame jitters.
+
+use radcache_vk::{
+    vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, MemoryLocation, Pipeline,
+    Recorder, Resource, ShaderCompiler,
+};
+
+use crate::bindings::{with_scene, PASS_BASE};
+use crate::composite::CompositePass;
+use crate::error::Result;
+use crate::gpu_scene::GpuScene;
+
+/// The emission pipeline and its ray counter.
+pub struct EmissionPass {
+    pipeline: Pipeline,
+    rays: Buffer,
+}
+
+impl std::fmt::Debug for EmissionPass {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EmissionPass").finish_non_exhaustive()
+    }
+}
+
+impl EmissionPass {
+    /// Compiles the pass.
+    pub fn new(ctx: &Context, shaders: &ShaderCompiler, scene: &GpuScene) -> Result<EmissionPass> {
+        let spirv = shaders.compile("passes/emission.comp", &scene.defines())?;
+        let pass = [
+            BindingLayout::new(PASS_BASE, BindingKind::StorageBuffer),
+            BindingLayout::new(PASS_BASE + 1, BindingKind::StorageBuffer),
+            BindingLayout::new(PASS_BASE + 2, BindingKind::StorageBuffer),
+        ];
+        let pipeline = Pipeline::compute(ctx, "emission", &spirv, &with_scene(&pass), 0)?;
+        let rays = Buffer::new(
+            ctx,
+            &BufferDesc {
+                name: "emission.ray_count",
+                size: 16,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::GpuToCpu,
+                alignment: 0,
+            },
+        )?;
+        Ok(EmissionPass { pipeline, rays })
+    }
+
+    /// Records adding the box-filtered emission to `composite`'s accumulator (once, after the
+    /// last sub-frame; the scene's view must be the unjittered one of this image).
+    pub fn record(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        composite: &CompositePass,
+    ) -> Result<()> {
+        rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
+        rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
+        let mut bindings = scene.bindings();
+        bindings.push((PASS_BASE, Resource::Buffer(&composite.accum)));
+        bindings.push((PASS_BASE + 1, Resource::Buffer(&composite.emission_accum)));
+        bindings.push((PASS_BASE + 2, Resource::Buffer(&self.rays)));
+        let (w, h) = composite.size();
+        rec.pass("emission", |rec| {
+            rec.bind_pipeline(&self.pipeline);
+            rec.push_bindings(&bindings);
+            rec.dispatch(w.div_ceil(8), h.div_ceil(8), 1)
+        })?;
+        rec.barrier(
+            Access::COMPUTE_WRITE,
+            Access::TRANSFER_READ.union(Access::HOST_READ),
+        );
+        Ok(())
+    }
+
+    /// Ray queries of the last submitted pass.
+    pub fn rays(&self) -> Result<u64> {
+        Ok(u64::from(self.rays.read::<u32>(1)?[0]))
+    }
+}

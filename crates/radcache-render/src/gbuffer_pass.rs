@@ -1,0 +1,113 @@
+//! G-buffer rasterization (`shaders/passes/gbuffer.vert` + `gbuffer.frag`): one draw per instance
+//! with vertex pulling, reversed-Z depth (cleared to 0, GREATER), no culling (both sides are drawn;
+//! the emission rule decides what a back face emits), and a sub-pixel jitter per sub-frame.
+
+use bytemuck::{Pod, Zeroable};
+use radcache_vk::{
+    vk, ColorTarget, Context, DepthState, DepthTarget, GraphicsDesc, ImageUse, Pipeline, Recorder,
+    ShaderCompiler,
+};
+
+use crate::bindings::SCENE;
+use crate::error::Result;
+use crate::gbuffer::{GBuffer, DEPTH_FORMAT, GBUFFER_FORMAT};
+use crate::gpu_scene::GpuScene;
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Push {
+    instance: u32,
+    pad: u32,
+    jitter: [f32; 2],
+}
+
+/// The G-buffer pipeline.
+pub struct GBufferPass {
+    pipeline: Pipeline,
+}
+
+impl std::fmt::Debug for GBufferPass {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GBufferPass").finish_non_exhaustive()
+    }
+}
+
+impl GBufferPass {
+    /// Compiles the pass.
+    pub fn new(ctx: &Context, shaders: &ShaderCompiler) -> Result<GBufferPass> {
+        let vertex = shaders.compile("passes/gbuffer.vert", &[])?;
+        let fragment = shaders.compile("passes/gbuffer.frag", &[])?;
+        let pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                name: "gbuffer",
+                vertex: &vertex,
+                fragment: &fragment,
+                bindings: &SCENE,
+                push_constant_size: std::mem::size_of::<Push>() as u32,
+                color_formats: &[GBUFFER_FORMAT; 5],
+                depth: Some(DepthState {
+                    format: DEPTH_FORMAT,
+                    compare: vk::CompareOp::GREATER,
+                    write: true,
+                }),
+                blend: radcache_vk::Blend::None,
+                cull: vk::CullModeFlags::NONE,
+                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            },
+        )?;
+        Ok(GBufferPass { pipeline })
+    }
+
+    /// Records the G-buffer of `scene`'s current view with sub-pixel `jitter` (pixels, each in
+    /// [−0.5, 0.5]), clearing everything first; the images are left ready for compute reads, the
+    /// direct-light image zeroed.
+    pub fn record(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        jitter: [f32; 2],
+    ) -> Result<()> {
+        for image in gbuffer.attachments() {
+            rec.use_image(image, ImageUse::ColorAttachment);
+        }
+        rec.use_image(&gbuffer.depth, ImageUse::DepthAttachment);
+        let targets: Vec<ColorTarget<'_>> = gbuffer
+            .attachments()
+            .into_iter()
+            .map(|image| ColorTarget {
+                image,
+                clear: Some([0.0; 4]),
+            })
+            .collect();
+        let bindings = scene.bindings();
+        let draws = scene.instance_draws();
+        rec.pass("gbuffer", |rec| {
+            rec.begin_rendering(
+                &targets,
+                Some(DepthTarget {
+                    image: &gbuffer.depth,
+                    clear: Some(0.0),
+                }),
+            );
+            rec.bind_pipeline(&self.pipeline);
+            rec.push_bindings(&bindings);
+            for &(instance, triangles) in &draws {
+                rec.push_constants(&Push {
+                    instance,
+                    pad: 0,
+                    jitter,
+                });
+                rec.draw(3 * triangles, 1);
+            }
+            rec.end_rendering();
+        });
+        rec.use_image(&gbuffer.direct, ImageUse::TransferDst);
+        rec.clear_color(&gbuffer.direct, [0.0; 4]);
+        for image in gbuffer.images() {
+            rec.use_image(image, ImageUse::ComputeStorage);
+        }
+        Ok(())
+    }
+}

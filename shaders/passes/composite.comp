@@ -1,0 +1,54 @@
+// Composite of one sub-frame (IC reference §10.3 normalisation): on surfaces
+// L = direct + albedo/π · Σw·Ẽ / Σw (0 where no record reaches the pixel), on the background the
+// environment along the camera ray; added with weight 1 to the frame accumulator (a = sub-frames
+// so far). The emission seen at the sub-frame's sample goes to a separate accumulator: the
+// emission pass replaces it by a finely supersampled box filter where emitters have edges.
+// A non-finite value is dropped and counted.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+
+#include "../common/path.glsl"
+#include "../common/gbuffer.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = B_GBUFFER_END, rgba32f) readonly uniform image2D splat_sum;
+layout(binding = B_GBUFFER_END + 1, std430) buffer Accum { vec4 accum[]; };
+layout(binding = B_GBUFFER_END + 2, std430) buffer Bad { uint nonfinite; };
+layout(binding = B_GBUFFER_END + 3, std430) buffer EmissionAccum { vec4 emission_accum[]; };
+
+layout(push_constant) uniform Push {
+    vec2 jitter;
+    uint pad0;
+    uint pad1;
+} pc;
+
+void main() {
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(pixel, ivec2(frame.resolution.xy)))) {
+        return;
+    }
+    uint index = uint(pixel.y) * frame.resolution.x + uint(pixel.x);
+    GSample g = gbuffer_load(pixel);
+    vec3 l;
+    vec3 emitted = vec3(0.0);
+    if (g.surface) {
+        vec4 s = imageLoad(splat_sum, pixel);
+        vec3 e = s.a > 0.0 ? s.rgb / s.a : vec3(0.0);
+        l = imageLoad(g_direct, pixel).rgb + g.albedo * INV_PI * e;
+        emitted = g.emission;
+    } else {
+        Ray r = camera_ray(uvec2(pixel), vec2(0.5) + pc.jitter);
+        l = environment_radiance(r.dir);
+    }
+    if (any(isnan(l)) || any(isinf(l))) {
+        l = vec3(0.0);
+        atomicAdd(nonfinite, 1u);
+    }
+    if (any(isnan(emitted)) || any(isinf(emitted))) {
+        emitted = vec3(0.0);
+        atomicAdd(nonfinite, 1u);
+    }
+    accum[index] += vec4(l, 1.0);
+    emission_accum[index] += vec4(emitted, 1.0);
+}

@@ -1,0 +1,62 @@
+// Box-filtered emission of the cache's frame. Emission is the brightest thing in most images, so
+// a handful of jittered sub-frames leaves its edges visibly stepped (all pixels of a sub-frame
+// share one jitter, so the errors along an edge are correlated and survive block averaging).
+// Where a pixel or one of its 8 neighbours saw emission in any sub-frame, the pixel's emission is
+// recomputed from GRID×GRID stratified camera rays over the pixel (the reference's box filter);
+// elsewhere the sub-frames' mean is kept (it is 0 or exact). The result, times the sub-frame
+// count, is added to the frame accumulator, whose mean is the image.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+
+#include "../common/path.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = B_PASS_BASE, std430) buffer Accum { vec4 accum[]; };
+layout(binding = B_PASS_BASE + 1, std430) readonly buffer EmissionAccum { vec4 emission_accum[]; };
+layout(binding = B_PASS_BASE + 2, std430) buffer RayCount { uint ray_count; };
+
+const uint GRID = 8u;
+
+void main() {
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = ivec2(frame.resolution.xy);
+    if (any(greaterThanEqual(pixel, size))) {
+        return;
+    }
+    uint index = uint(pixel.y * size.x + pixel.x);
+    vec4 own = emission_accum[index];
+    float subframes = max(own.a, 1.0);
+    bool near_emitter = false;
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            ivec2 q = clamp(pixel + ivec2(dx, dy), ivec2(0), size - 1);
+            near_emitter = near_emitter || any(greaterThan(emission_accum[q.y * size.x + q.x].rgb, vec3(0.0)));
+        }
+    }
+    vec3 e = own.rgb / subframes;
+    if (near_emitter) {
+        vec3 sum = vec3(0.0);
+        for (uint k = 0u; k < GRID * GRID; ++k) {
+            vec2 jitter = (vec2(k % GRID, k / GRID) + 0.5) / float(GRID);
+            Ray r = camera_ray(uvec2(pixel), jitter);
+            rays_traced++;
+            rayQueryEXT q;
+            rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, r.origin, 0.0, r.dir, 1e30);
+            while (rayQueryProceedEXT(q)) {
+            }
+            if (rayQueryGetIntersectionTypeEXT(q, true) == gl_RayQueryCommittedIntersectionTriangleEXT) {
+                Surface s = surface_at(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)),
+                                       uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
+                                       rayQueryGetIntersectionBarycentricsEXT(q, true), r.dir);
+                sum += material_emission(s.material, s.uv, s.front_face);
+            }
+        }
+        e = sum / float(GRID * GRID);
+        atomicAdd(ray_count, rays_traced);
+    }
+    if (any(isnan(e)) || any(isinf(e))) {
+        e = vec3(0.0);
+    }
+    accum[index].rgb += e * subframes;
+}

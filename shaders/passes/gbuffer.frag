@@ -1,0 +1,59 @@
+// G-buffer rasterization, fragment stage: the five attachments of shaders/common/gbuffer.glsl.
+// The geometric normal comes from the triangle's world-space corners (mirroring instances flip
+// it, as glTF's winding rule says); both normals are turned toward the camera, and the front
+// face (for the emission rule) is the side the camera sees. The pixel footprint is the square
+// root of the world-space area one pixel covers (from screen-space derivatives).
+#version 460
+#extension GL_GOOGLE_include_directive : require
+
+#include "../common/scene.glsl"
+#include "../common/ircache_math.glsl"
+#include "gbuffer_push.glsl"
+
+layout(location = 0) in vec3 v_position;
+layout(location = 1) in vec3 v_normal;
+layout(location = 2) in vec2 v_uv;
+layout(location = 3) flat in uint v_triangle;
+
+layout(location = 0) out vec4 o_position;
+layout(location = 1) out vec4 o_normal;
+layout(location = 2) out vec4 o_geometric;
+layout(location = 3) out vec4 o_albedo;
+layout(location = 4) out vec4 o_emission;
+
+void main() {
+    GpuInstance inst = instances[pc.instance];
+    uint first = inst.mesh.z + 3u * v_triangle;
+    vec3 p0 = vertices[indices[first] + inst.mesh.y].position_u.xyz;
+    vec3 p1 = vertices[indices[first + 1u] + inst.mesh.y].position_u.xyz;
+    vec3 p2 = vertices[indices[first + 2u] + inst.mesh.y].position_u.xyz;
+    vec3 e1 = (inst.world_from_object * vec4(p1 - p0, 0.0)).xyz;
+    vec3 e2 = (inst.world_from_object * vec4(p2 - p0, 0.0)).xyz;
+    vec3 ng = cross(e1, e2);
+    float len = length(ng);
+    ng = len > 0.0 ? ng / len : vec3(0.0, 0.0, 1.0);
+    if (inst.normal_to_world[3][3] < 0.0) {
+        ng = -ng;
+    }
+    vec3 to_camera = frame.camera_position.xyz - v_position;
+    bool front = dot(ng, to_camera) >= 0.0;
+    if (!front) {
+        ng = -ng;
+    }
+    vec3 ns = v_normal;
+    float ns_len = length(ns);
+    ns = (ns_len > 0.0 && !isnan(ns_len)) ? ns / ns_len : ng;
+    if (!front) {
+        ns = -ns;
+    }
+    if (dot(ns, ng) <= 0.0) {
+        ns = ng;
+    }
+    uint material = tri_materials[inst.mesh.w + v_triangle];
+    float footprint = pixel_footprint_from_differentials(dFdx(v_position), dFdy(v_position));
+    o_position = vec4(v_position, 1.0);
+    o_normal = vec4(ns, footprint);
+    o_geometric = vec4(ng, float(material));
+    o_albedo = vec4(material_albedo(material, v_uv), 0.0);
+    o_emission = vec4(material_emission(material, v_uv, front), 0.0);
+}

@@ -1,0 +1,27 @@
+// G-buffer rasterization, vertex stage: vertex pulling from the scene buffers, one draw per TLAS
+// instance (push constant), the instance transform, the frame's projection and a sub-pixel
+// jitter (in pixels, (0, 0) = pixel centre) for anti-aliasing by jittered sub-frames.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+
+#include "../common/scene.glsl"
+#include "gbuffer_push.glsl"
+
+layout(location = 0) out vec3 v_position;
+layout(location = 1) out vec3 v_normal;
+layout(location = 2) out vec2 v_uv;
+layout(location = 3) flat out uint v_triangle;
+
+void main() {
+    GpuInstance inst = instances[pc.instance];
+    uint index = indices[inst.mesh.z + uint(gl_VertexIndex)] + inst.mesh.y;
+    GpuVertex v = vertices[index];
+    vec4 world = inst.world_from_object * vec4(v.position_u.xyz, 1.0);
+    v_position = world.xyz;
+    v_normal = (inst.normal_to_world * vec4(v.normal_v.xyz, 0.0)).xyz;
+    v_uv = vec2(v.position_u.w, v.normal_v.w);
+    v_triangle = uint(gl_VertexIndex) / 3u;
+    vec4 clip = frame.clip_from_world * world;
+    clip.xy += 2.0 * pc.jitter / vec2(frame.resolution.xy) * clip.w;
+    gl_Position = clip;
+}
