@@ -22,6 +22,7 @@ Tasks:
   assets [--check]  write the bundled glTF scenes into assets/ (--check: fail if they differ)
   refs              render the path-traced references of the cache tests into tests/refs/
   bench rays        raw ray-query throughput and BLAS/TLAS build times on the chosen device
+  bench ic          the cache on the Cornell box: time, records, rays, error, speed-up over the path tracer
   bench pt          path tracer on the Cornell box at 256² and 512²: samples/s and rays/s
   help              this text
 

@@ -90,6 +90,8 @@ pub struct IcStats {
     pub dropped_requests: u64,
     /// Records whose irradiance was invalid (stored as black).
     pub rejected_records: u64,
+    /// Wall time of the hole-filling submissions (splat, holes, records, neighbours), s.
+    pub hole_filling_s: f64,
 }
 
 /// The sub-pixel jitter of sub-frame `k` in pixels: the centre first, then the R2 sequence
@@ -177,6 +179,7 @@ pub fn render_ic(
         *rays.entry("direct".into()).or_default() += direct.rays()?;
 
         for level in 0..params.levels {
+            let level_start = Instant::now();
             let mut rec = ctx.begin("ic.level")?;
             state.record_begin_level(&mut rec)?;
             splat.record(
@@ -202,6 +205,8 @@ pub fn render_ic(
             state.record_end_batch(&mut rec)?;
             neighbours.record(&mut rec, &state)?;
             add_timings(&mut passes_ms, ctx.submit(rec)?.wait()?);
+            // Wall time of hole filling (lavapipe's timestamps miss asynchronous compute work).
+            stats.hole_filling_s += level_start.elapsed().as_secs_f64();
             *rays.entry("records".into()).or_default() += records.rays()?;
             let c = state.read_counters()?;
             let created = c.dispatch[0];

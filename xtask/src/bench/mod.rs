@@ -3,6 +3,7 @@
 //! Benchmarks run with validation off (it costs CPU time per call) unless `RADCACHE_VALIDATION` is
 //! set, and on the device `RADCACHE_DEVICE` names (the preferred one otherwise).
 
+mod ic;
 mod pt;
 mod rays;
 
@@ -15,6 +16,7 @@ pub fn run(args: &[&str]) -> Result<()> {
     match args {
         ["rays", rest @ ..] => rays::run(rest),
         ["pt", rest @ ..] => pt::run(rest),
-        _ => bail!("usage: cargo xtask bench rays [--rays N] | pt [--spp N]"),
+        ["ic", rest @ ..] => ic::run(rest),
+        _ => bail!("usage: cargo xtask bench rays [--rays N] | pt [--spp N] | ic"),
     }
 }

@@ -1,0 +1,233 @@
+//! Small scenes written with `GltfBuilder` for the GPU correctness tests, and the statistics the
+//! tests compare with (mean and standard error over independent per-pixel estimates).
+
+use std::path::{Path, PathBuf};
+
+use glam::{Quat, Vec3};
+use radcache_scene::writer::{BufferLayout, GltfBuilder, NodeDesc, PrimitiveDesc};
+use radcache_scene::{LoadOptions, Scene};
+
+/// A fresh folder under the system temp dir, unique to this process and `tag`.
+pub fn temp_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("radcache-tests-{}-{tag}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("creating {}: {e}", dir.display()));
+    dir
+}
+
+/// Loads a scene with the default options (panics on error).
+pub fn load(path: &Path) -> Scene {
+    Scene::load(path, &LoadOptions::default())
+        .unwrap_or_else(|e| panic!("loading {}: {e}", path.display()))
+        .0
+}
+
+/// Writes `builder` as `dir/<name>.gltf` with the buffer embedded and loads it.
+pub fn write_and_load(builder: &GltfBuilder, dir: &Path, name: &str) -> Scene {
+    let path = dir.join(format!("{name}.gltf"));
+    builder
+        .write(&path, BufferLayout::Embedded)
+        .unwrap_or_else(|e| panic!("writing {}: {e}", path.display()));
+    load(&path)
+}
+
+/// Mean and standard error of the mean of independent estimates.
+#[derive(Debug, Clone, Copy)]
+pub struct MeanSe {
+    /// Sample mean.
+    pub mean: f64,
+    /// Standard error of the mean: sample standard deviation / √n.
+    pub se: f64,
+    /// Number of estimates.
+    pub n: usize,
+}
+
+/// Mean and standard error of `values` (at least two).
+pub fn mean_se(values: &[f64]) -> MeanSe {
+    let n = values.len();
+    assert!(n >= 2, "need at least two estimates, got {n}");
+    let mean = values.iter().sum::<f64>() / n as f64;
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+    MeanSe {
+        mean,
+        se: (var / n as f64).sqrt(),
+        n,
+    }
+}
+
+/// A horizontal square of half-size `half` at height `y`, facing +Y (counter-clockwise seen from
+/// above), with +Y vertex normals.
+pub fn plane_y(half: f32, y: f32, material: usize) -> PrimitiveDesc {
+    PrimitiveDesc::triangles(
+        vec![
+            [-half, y, -half],
+            [-half, y, half],
+            [half, y, half],
+            [half, y, -half],
+        ],
+        Some(vec![[0.0, 1.0, 0.0]; 4]),
+        vec![0, 1, 2, 0, 2, 3],
+        Some(material),
+    )
+}
+
+/// The corners of an axis-aligned cube of half-size `half` centred at the origin.
+pub fn cube_corners(half: f32) -> Vec<Vec3> {
+    (0..8)
+        .map(|i| {
+            let s = |bit: u32| if i & (1 << bit) != 0 { half } else { -half };
+            Vec3::new(s(0), s(1), s(2))
+        })
+        .collect()
+}
+
+/// An axis-aligned cube of half-size `half` centred at the origin, faces outward (flat normals,
+/// counter-clockwise seen from outside).
+pub fn cube(half: f32, material: usize) -> PrimitiveDesc {
+    let (mut positions, mut normals, mut indices) = (Vec::new(), Vec::new(), Vec::new());
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let mut n = Vec3::ZERO;
+            n[axis] = sign;
+            let u = Vec3::AXES[(axis + 1) % 3] * half;
+            let v = Vec3::AXES[(axis + 2) % 3] * half;
+            let c = n * half;
+            let mut quad = [c - u - v, c + u - v, c + u + v, c - u + v];
+            if (quad[1] - quad[0]).cross(quad[2] - quad[0]).dot(n) < 0.0 {
+                quad.swap(1, 3);
+            }
+            let base = positions.len() as u32;
+            for p in quad {
+                positions.push(p.to_array());
+                normals.push(n.to_array());
+            }
+            indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+        }
+    }
+    PrimitiveDesc::triangles(positions, Some(normals), indices, Some(material))
+}
+
+/// Adds a perspective camera node (aspect ratio left to the image) at `position` with
+/// `rotation`; returns the node index.
+pub fn camera_node(b: &mut GltfBuilder, position: Vec3, rotation: Quat, yfov: f32) -> usize {
+    let cam = b.add_perspective_camera("camera", yfov, None, 0.05, None);
+    b.add_node(&NodeDesc {
+        name: Some("camera".into()),
+        translation: Some(position.to_array()),
+        rotation: Some(rotation.normalize().to_array()),
+        camera: Some(cam),
+        ..NodeDesc::default()
+    })
+}
+
+/// Image-space position (pixels, x right, y down, origin at the top-left corner) of NDC point
+/// `(x, y)` with y up, for a `width × height` image.
+pub fn ndc_to_pixel(x: f32, y: f32, width: u32, height: u32) -> (f64, f64) {
+    (
+        (f64::from(x) + 1.0) * 0.5 * f64::from(width),
+        (1.0 - f64::from(y)) * 0.5 * f64::from(height),
+    )
+}
+
+/// NDC point (x right, y up) of image-space position `(px, py)` (pixels, y down).
+pub fn pixel_to_ndc(px: f64, py: f64, width: u32, height: u32) -> (f32, f32) {
+    (
+        (px / f64::from(width) * 2.0 - 1.0) as f32,
+        (1.0 - py / f64::from(height) * 2.0) as f32,
+    )
+}
+
+/// A polygon in image space (pixels, x right, y down), vertices ordered so that its
+/// [`signed_area`] is positive.
+pub type Polygon = Vec<(f64, f64)>;
+
+/// Signed area of a polygon (shoelace).
+pub fn signed_area(p: &[(f64, f64)]) -> f64 {
+    let n = p.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (p[i], p[(i + 1) % n]);
+            a.0 * b.1 - b.0 * a.1
+        })
+        .sum::<f64>()
+        * 0.5
+}
+
+/// The convex hull (Andrew's monotone chain) of `points`, with positive signed area.
+pub fn convex_hull(points: &[(f64, f64)]) -> Polygon {
+    let mut pts = points.to_vec();
+    pts.sort_by(|a, b| a.partial_cmp(b).expect("finite points"));
+    pts.dedup();
+    if pts.len() < 3 {
+        return pts;
+    }
+    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let mut hull: Vec<(f64, f64)> = Vec::new();
+    let backward: Vec<(f64, f64)> = pts.iter().rev().copied().collect();
+    for chain in [&pts, &backward] {
+        let start = hull.len();
+        for &p in chain {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+/// Signed distance-like test of `p` against every edge of the convex polygon `poly` (positive
+/// area): the smallest distance from `p` to an edge line, positive inside.
+pub fn inside_margin(poly: &[(f64, f64)], p: (f64, f64)) -> f64 {
+    let n = poly.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            let (ex, ey) = (b.0 - a.0, b.1 - a.1);
+            let len = (ex * ex + ey * ey).sqrt();
+            (ex * (p.1 - a.1) - ey * (p.0 - a.0)) / len
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Clips the convex polygon `subject` by the convex polygon `clip` (both with positive area;
+/// Sutherland–Hodgman).
+pub fn clip_convex(subject: &[(f64, f64)], clip: &[(f64, f64)]) -> Polygon {
+    let mut out = subject.to_vec();
+    let n = clip.len();
+    for i in 0..n {
+        if out.is_empty() {
+            break;
+        }
+        let (a, b) = (clip[i], clip[(i + 1) % n]);
+        let side = |p: (f64, f64)| (b.0 - a.0) * (p.1 - a.1) - (b.1 - a.1) * (p.0 - a.0);
+        let input = std::mem::take(&mut out);
+        for j in 0..input.len() {
+            let (p, q) = (input[j], input[(j + 1) % input.len()]);
+            let (sp, sq) = (side(p), side(q));
+            if sp >= 0.0 {
+                out.push(p);
+            }
+            if (sp >= 0.0) != (sq >= 0.0) {
+                let t = sp / (sp - sq);
+                out.push((p.0 + t * (q.0 - p.0), p.1 + t * (q.1 - p.1)));
+            }
+        }
+    }
+    out
+}
+
+/// The unit square of pixel `(x, y)` as a polygon with positive signed area.
+pub fn pixel_square(x: u32, y: u32) -> Polygon {
+    let (x0, y0) = (f64::from(x), f64::from(y));
+    vec![
+        (x0, y0),
+        (x0 + 1.0, y0),
+        (x0 + 1.0, y0 + 1.0),
+        (x0, y0 + 1.0),
+    ]
+}
