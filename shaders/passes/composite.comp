@@ -16,10 +16,13 @@ layout(binding = B_GBUFFER_END, rgba32f) readonly uniform image2D splat_sum;
 layout(binding = B_GBUFFER_END + 1, std430) buffer Accum { vec4 accum[]; };
 layout(binding = B_GBUFFER_END + 2, std430) buffer Bad { uint nonfinite; };
 layout(binding = B_GBUFFER_END + 3, std430) buffer EmissionAccum { vec4 emission_accum[]; };
+// Debug AOVs, two vec4 per pixel: indirect radiance (rgb) and Σw (a); records per pixel (x).
+layout(binding = B_GBUFFER_END + 4, std430) buffer DebugAccum { vec4 debug_accum[]; };
+layout(binding = B_GBUFFER_END + 5, r32f) readonly uniform image2D splat_count;
 
 layout(push_constant) uniform Push {
     vec2 jitter;
-    uint pad0;
+    uint debug;  // accumulate the debug AOVs
     uint pad1;
 } pc;
 
@@ -35,8 +38,13 @@ void main() {
     if (g.surface) {
         vec4 s = imageLoad(splat_sum, pixel);
         vec3 e = s.a > 0.0 ? s.rgb / s.a : vec3(0.0);
-        l = imageLoad(g_direct, pixel).rgb + g.albedo * INV_PI * e;
+        vec3 indirect = g.albedo * INV_PI * e;
+        l = imageLoad(g_direct, pixel).rgb + indirect;
         emitted = g.emission;
+        if (pc.debug != 0u && !any(isnan(indirect)) && !any(isinf(indirect))) {
+            debug_accum[2u * index] += vec4(indirect, s.a);
+            debug_accum[2u * index + 1u].x += imageLoad(splat_count, pixel).r;
+        }
     } else {
         Ray r = camera_ray(uvec2(pixel), vec2(0.5) + pc.jitter);
         l = environment_radiance(r.dir);

@@ -1,7 +1,7 @@
 // Irradiance splatting, per pixel (IC reference §10.3): the record's weight at the pixel's
 // G-buffer point (normal and in-front tests included), the gradient-extrapolated irradiance
 // clamped to [0, 4·E_i] (§16.2), and (w·Ẽ, w) added into the RGBA32F target by (ONE, ONE)
-// blending. Weights are bounded (T&L ≤ 1, Ward ≤ 1/10⁻³), so the float sums cannot overflow.
+// blending (and 1 into the record-count target). Weights are bounded (T&L ≤ 1, Ward ≤ 1/10⁻³), so the float sums cannot overflow.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -13,6 +13,7 @@
 
 layout(location = 0) flat in uint v_record;
 layout(location = 0) out vec4 o_sum;
+layout(location = 1) out float o_count;  // records reaching the pixel (debug AOV)
 
 void main() {
     GSample g = gbuffer_load(ivec2(gl_FragCoord.xy));
@@ -34,4 +35,5 @@ void main() {
                                     att * rec.grad_t_green.xyz, att * rec.grad_t_blue.xyz,
                                     g.position, g.normal, p_i, n_i);
     o_sum = vec4(w * e, w);
+    o_count = 1.0;
 }

@@ -101,9 +101,24 @@ fn the_plan_leaves_out_unneeded_passes() {
         params: IcParams::draft(),
         sub_frames: 1,
         direct_samples: 1,
+        debug_aovs: true,
         ..IcSettings::default()
     };
-    let (out, _) = render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {}).unwrap();
+    let (out, stats) = render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {}).unwrap();
+    // The debug AOVs are consistent: a record reaches a pixel exactly where the weight sum is
+    // positive, indirect light is finite and non-negative, and the marked record positions are
+    // at most the records created (several may share a pixel).
+    let d = stats.debug.as_ref().expect("debug AOVs");
+    for (w, c) in d.weight_sum.iter().zip(&d.records_per_pixel) {
+        assert_eq!(*w > 0.0, *c > 0.0, "weight {w}, records {c}");
+    }
+    assert!(d.indirect.iter().all(|v| v.is_finite() && *v >= 0.0));
+    let marked = d.record_positions.iter().filter(|v| **v > 0.0).count() as u64;
+    assert!(
+        marked >= 1 && marked <= stats.records,
+        "{marked} of {}",
+        stats.records
+    );
     let passes: Vec<&str> = out.passes_ms.keys().map(String::as_str).collect();
     for needed in ["gbuffer", "direct", "records", "splat", "composite"] {
         assert!(passes.contains(&needed), "{needed} missing from {passes:?}");

@@ -154,6 +154,10 @@ pub struct RenderArgs {
     /// Add albedo, normal and depth layers to the EXR.
     #[arg(long)]
     aov: bool,
+    /// Add the cache's debug layers to the EXR: `ic_indirect` (indirect radiance only),
+    /// `ic_weight` (Σw), `ic_records` (records per pixel), `ic_positions` (record positions).
+    #[arg(long)]
+    debug_aov: bool,
     /// Also write a PNG preview beside the EXR.
     #[arg(long)]
     png: bool,
@@ -258,6 +262,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
                 seed: args.seed,
                 frame: args.frame,
                 time: args.time,
+                debug_aovs: args.debug_aov,
                 ..IcSettings::default()
             };
             let mut bar =
@@ -285,6 +290,22 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         image.add_layer(Layer::albedo(aovs.albedo.clone()))?;
         image.add_layer(Layer::normal(aovs.normal.clone()))?;
         image.add_layer(Layer::depth(aovs.depth.clone()))?;
+    }
+    if let Some(debug) = ic_stats.as_ref().and_then(|s| s.debug.as_ref()) {
+        let rgb = || vec!["R".to_string(), "G".to_string(), "B".to_string()];
+        let y = || vec!["Y".to_string()];
+        image.add_layer(Layer::new("ic_indirect", rgb(), debug.indirect.clone())?)?;
+        image.add_layer(Layer::new("ic_weight", y(), debug.weight_sum.clone())?)?;
+        image.add_layer(Layer::new(
+            "ic_records",
+            y(),
+            debug.records_per_pixel.clone(),
+        )?)?;
+        image.add_layer(Layer::new(
+            "ic_positions",
+            y(),
+            debug.record_positions.clone(),
+        )?)?;
     }
     let aspect = width as f32 / height as f32;
     let mut meta = Metadata::new();

@@ -20,7 +20,8 @@ const BASE: u32 = PASS_BASE + GBUFFER_BINDINGS;
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct Push {
     jitter: [f32; 2],
-    pad: [u32; 2],
+    debug: u32,
+    pad: u32,
 }
 
 /// The composite pipeline and the frame accumulator.
@@ -28,6 +29,7 @@ pub struct CompositePass {
     pipeline: Pipeline,
     pub(crate) accum: Buffer,
     pub(crate) emission_accum: Buffer,
+    debug_accum: Buffer,
     nonfinite: Buffer,
     width: u32,
     height: u32,
@@ -57,6 +59,8 @@ impl CompositePass {
         pass.push(BindingLayout::new(BASE + 1, BindingKind::StorageBuffer));
         pass.push(BindingLayout::new(BASE + 2, BindingKind::StorageBuffer));
         pass.push(BindingLayout::new(BASE + 3, BindingKind::StorageBuffer));
+        pass.push(BindingLayout::new(BASE + 4, BindingKind::StorageBuffer));
+        pass.push(BindingLayout::new(BASE + 5, BindingKind::StorageImage));
         let pipeline = Pipeline::compute(
             ctx,
             "composite",
@@ -81,6 +85,7 @@ impl CompositePass {
             pipeline,
             accum: buffer("composite.accum", pixels * 16, MemoryLocation::GpuOnly)?,
             emission_accum: buffer("composite.emission", pixels * 16, MemoryLocation::GpuOnly)?,
+            debug_accum: buffer("composite.debug", pixels * 32, MemoryLocation::GpuOnly)?,
             nonfinite: buffer("composite.nonfinite", 16, MemoryLocation::GpuToCpu)?,
             width,
             height,
@@ -91,6 +96,7 @@ impl CompositePass {
     pub fn record_clear(&self, rec: &mut Recorder) {
         rec.fill_buffer(&self.accum, 0, vk::WHOLE_SIZE, 0);
         rec.fill_buffer(&self.emission_accum, 0, vk::WHOLE_SIZE, 0);
+        rec.fill_buffer(&self.debug_accum, 0, vk::WHOLE_SIZE, 0);
         rec.fill_buffer(&self.nonfinite, 0, vk::WHOLE_SIZE, 0);
         rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
     }
@@ -103,20 +109,25 @@ impl CompositePass {
         gbuffer: &GBuffer,
         splat: &SplatPass,
         jitter: [f32; 2],
+        debug: bool,
     ) -> Result<()> {
         for image in gbuffer.images() {
             rec.use_image(image, ImageUse::ComputeStorage);
         }
         rec.use_image(&splat.sum, ImageUse::ComputeStorage);
+        rec.use_image(&splat.count, ImageUse::ComputeStorage);
         let mut bindings = scene.bindings();
         bindings.extend(gbuffer.bindings());
         bindings.push((BASE, Resource::StorageImage(&splat.sum)));
         bindings.push((BASE + 1, Resource::Buffer(&self.accum)));
         bindings.push((BASE + 2, Resource::Buffer(&self.nonfinite)));
         bindings.push((BASE + 3, Resource::Buffer(&self.emission_accum)));
+        bindings.push((BASE + 4, Resource::Buffer(&self.debug_accum)));
+        bindings.push((BASE + 5, Resource::StorageImage(&splat.count)));
         let push = Push {
             jitter,
-            pad: [0; 2],
+            debug: u32::from(debug),
+            pad: 0,
         };
         let (w, h) = (self.width, self.height);
         rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
@@ -133,6 +144,26 @@ impl CompositePass {
                 .union(Access::HOST_READ),
         );
         Ok(())
+    }
+
+    /// The debug AOVs averaged over `sub_frames`: indirect radiance (RGB), Σw, records per pixel.
+    pub fn read_debug(
+        &self,
+        ctx: &Context,
+        sub_frames: u32,
+    ) -> Result<(Vec<f32>, Vec<f32>, Vec<f32>)> {
+        let n = (self.width * self.height) as usize;
+        let raw: Vec<[f32; 4]> = ctx.read_buffer(&self.debug_accum, 2 * n)?;
+        let k = sub_frames.max(1) as f32;
+        let mut indirect = Vec::with_capacity(3 * n);
+        let mut weight = Vec::with_capacity(n);
+        let mut count = Vec::with_capacity(n);
+        for px in raw.chunks_exact(2) {
+            indirect.extend(px[0][..3].iter().map(|v| v / k));
+            weight.push(px[0][3] / k);
+            count.push(px[1][0] / k);
+        }
+        Ok((indirect, weight, count))
     }
 
     /// Width and height of the accumulator.

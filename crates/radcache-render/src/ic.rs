@@ -22,6 +22,7 @@ use std::time::Instant;
 
 use radcache_cache::IcParams;
 use radcache_scene::Scene;
+use radcache_shared::gpu::GpuRecord;
 use radcache_vk::{Context, PassTiming, ShaderCompiler};
 
 use crate::composite::CompositePass;
@@ -59,6 +60,8 @@ pub struct IcSettings {
     pub time: f32,
     /// Largest number of records (memory: 176 bytes each).
     pub record_capacity: u32,
+    /// Also produce the debug AOVs ([`IcDebug`]).
+    pub debug_aovs: bool,
 }
 
 impl Default for IcSettings {
@@ -73,6 +76,7 @@ impl Default for IcSettings {
             frame: 1,
             time: 0.0,
             record_capacity: 1 << 18,
+            debug_aovs: false,
         }
     }
 }
@@ -92,6 +96,21 @@ pub struct IcStats {
     pub rejected_records: u64,
     /// Wall time of the hole-filling submissions (splat, holes, records, neighbours), s.
     pub hole_filling_s: f64,
+    /// The debug AOVs, when asked for.
+    pub debug: Option<IcDebug>,
+}
+
+/// Debug AOVs of a cache frame (rows top to bottom, averaged over the sub-frames).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct IcDebug {
+    /// Indirect radiance albedo/π·E only (RGB interleaved).
+    pub indirect: Vec<f32>,
+    /// Σw of the final splat.
+    pub weight_sum: Vec<f32>,
+    /// Records whose zone reaches the pixel.
+    pub records_per_pixel: Vec<f32>,
+    /// 1 at the pixels where records were created, 0 elsewhere (record positions).
+    pub record_positions: Vec<f32>,
 }
 
 /// The sub-pixel jitter of sub-frame `k` in pixels: the centre first, then the R2 sequence
@@ -229,7 +248,7 @@ pub fn render_ic(
             0,
             true,
         )?;
-        composite.record(&mut rec, gpu, &gbuffer, &splat, jitter)?;
+        composite.record(&mut rec, gpu, &gbuffer, &splat, jitter, settings.debug_aovs)?;
         add_timings(&mut passes_ms, ctx.submit(rec)?.wait()?);
         let c = state.read_counters()?;
         stats.holes_left += u64::from(c.counts[3]);
@@ -247,6 +266,22 @@ pub fn render_ic(
     add_timings(&mut passes_ms, ctx.submit(rec)?.wait()?);
     *rays.entry("emission".into()).or_default() += emission.rays()?;
     let (pixels, nonfinite_pixels) = composite.read_mean(ctx)?;
+    if settings.debug_aovs {
+        let (indirect, weight_sum, records_per_pixel) = composite.read_debug(ctx, sub_frames)?;
+        let mut record_positions = vec![0.0f32; (w * h) as usize];
+        let all: Vec<GpuRecord> = ctx.read_buffer(&state.records, stats.records as usize)?;
+        for r in &all {
+            if let Some(p) = record_positions.get_mut(r.info[0] as usize) {
+                *p = 1.0;
+            }
+        }
+        stats.debug = Some(IcDebug {
+            indirect,
+            weight_sum,
+            records_per_pixel,
+            record_positions,
+        });
+    }
     Ok((
         FrameOutput {
             width: w,

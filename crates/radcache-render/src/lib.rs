@@ -41,7 +41,7 @@ pub use gbuffer::{GBuffer, DEPTH_FORMAT, GBUFFER_BINDINGS, GBUFFER_FORMAT};
 pub use gbuffer_pass::GBufferPass;
 pub use gpu_scene::{GpuScene, UploadStats, REFITS_PER_REBUILD};
 pub use holes::HolePass;
-pub use ic::{render_ic, sub_frame_jitter, IcSettings, IcStats};
+pub use ic::{render_ic, sub_frame_jitter, IcDebug, IcSettings, IcStats};
 pub use ic_state::IcState;
 pub use neighbours::NeighbourPass;
 pub use path_trace::PathTracer;

@@ -16,6 +16,9 @@ use crate::gbuffer::{GBuffer, GBUFFER_BINDINGS};
 use crate::gpu_scene::GpuScene;
 use crate::ic_state::IcState;
 
+/// Format of the record-count target.
+const COUNT_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+
 /// Binding of the record buffer (just after the G-buffer).
 pub const RECORDS: u32 = PASS_BASE + GBUFFER_BINDINGS;
 
@@ -53,6 +56,8 @@ pub struct SplatPass {
     pipeline: Pipeline,
     /// Σ w·Ẽ (rgb) and Σ w (a) per pixel.
     pub sum: Image,
+    /// Number of records that reach each pixel (R32F).
+    pub count: Image,
 }
 
 impl std::fmt::Debug for SplatPass {
@@ -78,7 +83,7 @@ impl SplatPass {
                 fragment: &fragment,
                 bindings: &bindings,
                 push_constant_size: std::mem::size_of::<SplatWeights>() as u32,
-                color_formats: &[format],
+                color_formats: &[format, COUNT_FORMAT],
                 depth: None,
                 blend: Blend::Additive,
                 cull: vk::CullModeFlags::NONE,
@@ -95,7 +100,21 @@ impl SplatPass {
                 usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE,
             },
         )?;
-        Ok(SplatPass { pipeline, sum })
+        let count = Image::new(
+            ctx,
+            &ImageDesc {
+                name: "splat.count",
+                width,
+                height,
+                format: COUNT_FORMAT,
+                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE,
+            },
+        )?;
+        Ok(SplatPass {
+            pipeline,
+            sum,
+            count,
+        })
     }
 
     /// Records clearing the target and splatting every record with `weights`, in a profiler
@@ -113,16 +132,23 @@ impl SplatPass {
             rec.use_image(image, ImageUse::FragmentStorage);
         }
         rec.use_image(&self.sum, ImageUse::ColorAttachment);
+        rec.use_image(&self.count, ImageUse::ColorAttachment);
         let scene_bindings = scene.bindings();
         let mut bindings = vec![scene_bindings[FRAME as usize]];
         bindings.extend(gbuffer.bindings());
         bindings.push((RECORDS, Resource::Buffer(&state.records)));
         rec.pass(name, |rec| {
             rec.begin_rendering(
-                &[ColorTarget {
-                    image: &self.sum,
-                    clear: Some([0.0; 4]),
-                }],
+                &[
+                    ColorTarget {
+                        image: &self.sum,
+                        clear: Some([0.0; 4]),
+                    },
+                    ColorTarget {
+                        image: &self.count,
+                        clear: Some([0.0; 4]),
+                    },
+                ],
                 None,
             );
             rec.bind_pipeline(&self.pipeline);
@@ -132,6 +158,7 @@ impl SplatPass {
             rec.end_rendering();
         });
         rec.use_image(&self.sum, ImageUse::ComputeStorage);
+        rec.use_image(&self.count, ImageUse::ComputeStorage);
         Ok(())
     }
 }
