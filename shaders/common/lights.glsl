@@ -85,9 +85,9 @@ bool sample_environment(vec3 u, out vec3 dir, out vec3 radiance, out float pdf) 
 // Area pdf (per m²) of sampling a point on an emissive triangle with radiance factor `emission`
 // and sidedness `two_sided`: the table is power-proportional, power = Y(Le)·A·π·sides, and the
 // point is uniform on the triangle, so pdf_area = Y(Le)·π·sides / total power.
-float emitter_area_pdf(vec3 emission, bool two_sided) {
+float emitter_area_pdf(float mean_luminance, bool two_sided) {
     float total = frame.totals.x;
-    return total > 0.0 ? luminance(emission) * PI * (two_sided ? 2.0 : 1.0) / total : 0.0;
+    return total > 0.0 ? mean_luminance * PI * (two_sided ? 2.0 : 1.0) / total : 0.0;
 }
 
 // Samples a point on an emissive triangle as seen from p. On success: unit direction to the
@@ -144,10 +144,10 @@ vec3 punctual_incident(GpuLight l, vec3 p, out vec3 dir, out float dist) {
     vec3 e = l.intensity.rgb / d2;
     float range = l.direction.w;
     if (range > 0.0) {
-        // The extension's recommended window: clamp(1 − (d/range)⁴, 0, 1)² / d² (the 1/d² above).
+        // The extension's recommended window: clamp(1 − (d/range)⁴, 0, 1) / d² (the 1/d² above).
         float r4 = (d2 / (range * range)) * (d2 / (range * range));
         float win = clamp(1.0 - r4, 0.0, 1.0);
-        e *= win * win;
+        e *= win;
     }
     if (kind == 1u) {
         float cd = dot(l.direction.xyz, -dir);

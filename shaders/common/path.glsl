@@ -125,7 +125,7 @@ vec3 trace_path_from(Ray ray, float bsdf_pdf, bool count_first_segment, inout Rn
                 GpuMaterial m = materials[s.material];
                 float t = rayQueryGetIntersectionTEXT(q, true);
                 float cos_l = abs(dot(s.geometric_normal, ray.dir));
-                float pdf_light = emitter_area_pdf(m.emission.rgb, m.emission.w != 0.0) * t * t /
+                float pdf_light = emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t /
                                   max(cos_l, 1e-8);
                 w = power_heuristic(bsdf_pdf, pdf_light);
             }

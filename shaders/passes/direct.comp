@@ -52,7 +52,7 @@ vec3 bsdf_sample(Surface s, vec3 origin, inout Rng rng) {
     GpuMaterial m = materials[h.material];
     float t = rayQueryGetIntersectionTEXT(q, true);
     float cos_l = abs(dot(h.geometric_normal, dir));
-    float pdf_light = emitter_area_pdf(m.emission.rgb, m.emission.w != 0.0) * t * t / max(cos_l, 1e-8);
+    float pdf_light = emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t / max(cos_l, 1e-8);
     w = power_heuristic(pdf, pdf_light);
 #endif
     return le * w * PI;

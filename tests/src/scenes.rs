@@ -54,30 +54,20 @@ pub fn mean_se(values: &[f64]) -> MeanSe {
     }
 }
 
-/// A horizontal square of half-size `half` at height `y`, facing +Y (counter-clockwise seen from
-/// above), with +Y vertex normals.
-pub fn plane_y(half: f32, y: f32, material: usize) -> PrimitiveDesc {
+/// A horizontal rectangle `[x0, x1] × [z0, z1]` at height `y`, facing +Y (counter-clockwise seen
+/// from above), with +Y vertex normals.
+pub fn plane_y(x: [f32; 2], z: [f32; 2], y: f32, material: usize) -> PrimitiveDesc {
     PrimitiveDesc::triangles(
         vec![
-            [-half, y, -half],
-            [-half, y, half],
-            [half, y, half],
-            [half, y, -half],
+            [x[0], y, z[0]],
+            [x[0], y, z[1]],
+            [x[1], y, z[1]],
+            [x[1], y, z[0]],
         ],
         Some(vec![[0.0, 1.0, 0.0]; 4]),
         vec![0, 1, 2, 0, 2, 3],
         Some(material),
     )
-}
-
-/// The corners of an axis-aligned cube of half-size `half` centred at the origin.
-pub fn cube_corners(half: f32) -> Vec<Vec3> {
-    (0..8)
-        .map(|i| {
-            let s = |bit: u32| if i & (1 << bit) != 0 { half } else { -half };
-            Vec3::new(s(0), s(1), s(2))
-        })
-        .collect()
 }
 
 /// An axis-aligned cube of half-size `half` centred at the origin, faces outward (flat normals,
@@ -230,4 +220,54 @@ pub fn pixel_square(x: u32, y: u32) -> Polygon {
         (x0 + 1.0, y0 + 1.0),
         (x0, y0 + 1.0),
     ]
+}
+
+/// How far apart two convex polygons (positive area) are: the largest gap between their
+/// projections over the edge normals of both (separating axis theorem). Positive: disjoint, with
+/// at least that distance between them; zero or negative: they touch or overlap.
+pub fn separation(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
+    let mut best = f64::NEG_INFINITY;
+    for poly in [a, b] {
+        let n = poly.len();
+        for i in 0..n {
+            let (p, q) = (poly[i], poly[(i + 1) % n]);
+            let (ex, ey) = (q.0 - p.0, q.1 - p.1);
+            let len = (ex * ex + ey * ey).sqrt();
+            let axis = (ey / len, -ex / len);
+            let range = |s: &[(f64, f64)]| {
+                s.iter()
+                    .map(|v| v.0 * axis.0 + v.1 * axis.1)
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                        (lo.min(x), hi.max(x))
+                    })
+            };
+            let (ra, rb) = (range(a), range(b));
+            best = best.max((rb.0 - ra.1).max(ra.0 - rb.1));
+        }
+    }
+    best
+}
+
+/// Where pixel `(x, y)` lies relative to a convex image-space region.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Coverage {
+    /// The whole pixel is inside (every corner at least `eps` inside).
+    Inside,
+    /// The whole pixel is outside (separated by more than `eps`).
+    Outside,
+    /// The region covers this fraction of the pixel's area.
+    Partial(f64),
+}
+
+/// Coverage of pixel `(x, y)` by the convex polygon `poly` (positive area), with a margin of
+/// `eps` pixels for the two exact cases.
+pub fn pixel_coverage(poly: &[(f64, f64)], x: u32, y: u32, eps: f64) -> Coverage {
+    let square = pixel_square(x, y);
+    if square.iter().all(|&c| inside_margin(poly, c) > eps) {
+        Coverage::Inside
+    } else if separation(poly, &square) > eps {
+        Coverage::Outside
+    } else {
+        Coverage::Partial(signed_area(&clip_convex(&square, poly)).max(0.0))
+    }
 }

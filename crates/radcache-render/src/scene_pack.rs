@@ -59,14 +59,19 @@ pub(crate) fn pack_materials(scene: &Scene) -> (Vec<GpuMaterial>, Vec<GpuTexture
         .zip(&scene.material_emission)
         .map(|(m, e)| GpuMaterial {
             base_color: m.base_color.to_array(),
-            emission: [e.x, e.y, e.z, if m.double_sided { 1.0 } else { 0.0 }],
+            emission: [
+                m.emissive.x,
+                m.emissive.y,
+                m.emissive.z,
+                if m.double_sided { 1.0 } else { 0.0 },
+            ],
             textures: [
                 m.base_color_texture.map_or(-1, |t| t.texture as i32),
                 m.emissive_texture.map_or(-1, |t| t.texture as i32),
                 -1,
                 -1,
             ],
-            params: [m.metallic, m.roughness, 0.0, 0.0],
+            params: [m.metallic, m.roughness, radcache_scene::luminance(*e), 0.0],
         })
         .collect();
     let mut texels: Vec<u32> = Vec::new();

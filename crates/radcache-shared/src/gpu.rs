@@ -43,7 +43,8 @@ gpu_struct! {
         pub emission: [f32; 4] => "vec4",
         /// Texture indices: base colour, emissive (−1 for none), unused, unused.
         pub textures: [i32; 4] => "ivec4",
-        /// Metallic, roughness, unused, unused.
+        /// Metallic, roughness, luminance of the mean emitted radiance (texture mean included; the
+        /// emitter sampling table is built from it, so light-sampling pdfs use it), unused.
         pub params: [f32; 4] => "vec4",
     }
 }
