@@ -1,14 +1,36 @@
-// Irradiance records (IC reference §3, §6, §7): one workgroup per requested pixel. The M×N
-// stratified cosine-weighted gather rays (one jittered direction per cell of equal projected solid
-// angle, in the frame of the shading normal) are traced in parallel; each returns the full
-// indirect radiance arriving along it: NEE at its first hit plus the path continued from there
-// (MIS, Russian roulette), without the emission of the first hit and without the environment on a
-// first-segment miss, which the direct pass accounts for at the shading point. A direction that
-// falls below the geometric surface is mirrored into it. One invocation then forms the record
-// exactly as the CPU twin `radcache_cache::compute_record` does (E, rotational and Křivánek's
-// translational gradients, harmonic-mean and restricted minimum distances), applies the
-// gradient limit and the screen-space clamp [R⁻, R⁺] (`finalize_radius`; neighbour clamping is
-// a separate pass) and writes the record. Invalid irradiance is stored as black and counted.
+// Irradiance records (IC reference §3, §4, §6, §7, §16): one workgroup per requested pixel,
+// dispatched indirectly from IcCounters.dispatch (crates/radcache-render/src/records.rs).
+//
+// Request i (gl_WorkGroupID.x) exists when i < min(counts.y, limits.y); it creates record
+// counts.z + i, or, past the record capacity limits.x, is dropped and counted in limits.z.
+//
+// Gather (§3.1, §3.3): the M×N stratified cosine-weighted directions (stratum_direction_local with
+// the deterministic jitter stratum_jitter(record_seed, j·N + k), record_seed = ircache_hash(pixel ^
+// ircache_hash(seed)), in the frame basis_from_normal of the SHADING normal) are traced in
+// parallel from offset_ray_origin(p, n_geo). A direction below the geometric surface (possible
+// only where the shading normal differs from the geometric one) is mirrored about the geometric
+// tangent plane, so it stays above both (§3.3 folds them like pbrt's Faceforward; the mirror keeps
+// the azimuth); it still counts for its stratum. Each ray returns the full indirect radiance
+// arriving along it: next-event estimation at its first hit plus the path continued from there
+// (MIS, Russian roulette, common/path.glsl), WITHOUT the emission of the first hit and WITHOUT the
+// environment on a first-segment miss (the direct pass accounts for both at the shading point).
+// r_jk is the first hit's distance, IC_FAR on a miss. A non-finite sample counts as 0.
+//
+// Record (§4.1, §6, §7): one invocation sums the strata exactly as the CPU twin
+// radcache_cache::compute_record does (E, rotational and Křivánek's translational gradients,
+// harmonic-mean and elevation-restricted minimum distances; the same per-stratum functions of
+// ircache_math.glsl, in the same order), takes R = max(R_harm, R_min_restricted), then
+// finalize_radius with no neighbour (IC_FAR; the neighbour pass clamps later) and
+// [R⁻, R⁺] = radius_bounds(footprint, min_px, max_px, v_scale). The translational gradient is
+// stored unattenuated, its attenuation min(1, R_orig/R⁻) in irradiance.w.
+//
+// Guards (§16): irradiance that is not storable (irradiance_is_valid) or a requested pixel without
+// a surface gives a REJECTED record: E = 0, no gradients, zero normal (every weight's normal test
+// fails), R_orig = IC_FAR (it clamps no neighbour) and R⁻ = R⁺ = R_FLOOR (its splat is empty);
+// it is flagged and counted in limits.w. No field is ever NaN or Inf.
+//
+// Optional sample dump (tests): when the buffer bound at B_GBUFFER_END + 4 holds at least
+// (i + 1)·M·N vec4, request i writes (L_jk, r_jk) of its strata at i·M·N + j·N + k.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -19,22 +41,30 @@
 #define MAX_STRATA 1728u
 #define GROUP 64u
 
+// info.w flags (records.rs RECORD_FLAG_*).
+const uint FLAG_INVALID_IRRADIANCE = 1u;
+const uint FLAG_NO_SURFACE = 2u;
+const uint FLAG_CLAMPED_UP = 4u;
+const uint FLAG_CLAMPED_DOWN = 8u;
+const uint FLAG_FOLDED = 16u;
+
 layout(local_size_x = 64) in;
 
 layout(binding = B_GBUFFER_END, std430) readonly buffer Requests { uint requests[]; };
 layout(binding = B_GBUFFER_END + 1, std430) buffer Counters { IcCounters counters; };
-layout(binding = B_GBUFFER_END + 2, std430) buffer Records { GpuRecord records[]; };
+layout(binding = B_GBUFFER_END + 2, std430) writeonly buffer Records { GpuRecord records[]; };
 layout(binding = B_GBUFFER_END + 3, std430) buffer RayCount { uint ray_count; };
+layout(binding = B_GBUFFER_END + 4, std430) writeonly buffer Samples { vec4 samples[]; };
 
 layout(push_constant) uniform Push {
     uint m;
     uint n;
     uint seed;
     uint level_subframe;   // level (low 16 bits), sub-frame (high 16 bits)
-    float min_px;
-    float max_px;
-    float v_scale;
-    float r_eps_rel;       // r_eps = r_eps_rel × scene scale
+    float min_px;          // R⁻ as a validity radius in pixel footprints
+    float max_px;          // R⁺ likewise
+    float v_scale;         // validity radius / R (IcParams::validity_scale)
+    float r_eps_rel;       // r_eps = r_eps_rel × scene scale (frame.camera_position.w)
 } pc;
 
 // Radiance per stratum as three float arrays (vec3 arrays would pad to 16 bytes: 1728 strata
@@ -44,87 +74,143 @@ shared float s_lg[MAX_STRATA];
 shared float s_lb[MAX_STRATA];
 shared float s_r[MAX_STRATA];
 shared uint s_rays;
+shared uint s_folded;
 
 vec3 stratum_l(uint i) {
     return vec3(s_lr[i], s_lg[i], s_lb[i]);
 }
 
+uvec4 record_info(uint pixel_index, uint flags) {
+    return uvec4(pixel_index, pc.level_subframe & 0xffffu, pc.level_subframe >> 16u, flags);
+}
+
+// A record that can never weigh anything (see the header), counted in limits.w.
+void write_rejected(uint index, vec3 position, float footprint, uint pixel_index, uint flags) {
+    GpuRecord rec;
+    rec.position_radius = vec4(position, R_FLOOR);
+    rec.normal_rorig = vec4(0.0, 0.0, 0.0, IC_FAR);
+    rec.irradiance = vec4(0.0);
+    rec.bounds = vec4(R_FLOOR, R_FLOOR, footprint, IC_FAR);
+    rec.grad_r_red = vec4(0.0);
+    rec.grad_r_green = vec4(0.0);
+    rec.grad_r_blue = vec4(0.0);
+    rec.grad_t_red = vec4(0.0);
+    rec.grad_t_green = vec4(0.0);
+    rec.grad_t_blue = vec4(0.0);
+    rec.info = record_info(pixel_index, flags);
+    records[index] = rec;
+    atomicAdd(counters.limits.w, 1u);
+}
+
+// Indirect radiance arriving at the shading point along `dir` from `origin`, and the first hit's
+// distance (IC_FAR on a miss).
+vec3 gather(vec3 origin, vec3 dir, Rng rng, out float r) {
+    r = IC_FAR;
+    rays_traced++;
+    rayQueryEXT q;
+    rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, origin, 0.0, dir, 1e30);
+    while (rayQueryProceedEXT(q)) {
+    }
+    if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
+        return vec3(0.0);
+    }
+    r = min(rayQueryGetIntersectionTEXT(q, true), IC_FAR);
+    Surface h = surface_at(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)),
+                           uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
+                           rayQueryGetIntersectionBarycentricsEXT(q, true), dir);
+    vec3 albedo = material_albedo(h.material, h.uv);
+    if (!any(greaterThan(albedo, vec3(0.0)))) {
+        return vec3(0.0);
+    }
+    // Radiance reflected at the hit: albedo/π · (NEE + π · one cosine-sampled continuation).
+    vec3 nee = direct_light(h, rng);
+    Ray bounce;
+    bounce.dir = sample_cosine_around(h.shading_normal, rng_next2(rng));
+    bounce.origin = offset_ray_origin(h.position, h.geometric_normal);
+    vec3 further = vec3(0.0);
+    if (dot(bounce.dir, h.geometric_normal) > 0.0) {
+        float pdf = dot(bounce.dir, h.shading_normal) * INV_PI;
+        further = trace_path_from(bounce, pdf, true, rng);
+    }
+    vec3 l = albedo * (INV_PI * nee + further);
+    return (any(isnan(l)) || any(isinf(l))) ? vec3(0.0) : l;
+}
+
 void main() {
+    uint lid = gl_LocalInvocationID.x;
     uint request = gl_WorkGroupID.x;
+    // Everything up to the barrier is uniform over the workgroup.
+    if (request >= min(counters.counts.y, counters.limits.y)) {
+        return;
+    }
     uint index = counters.counts.z + request;
-    if (request >= counters.dispatch.x || index >= counters.limits.x) {
+    if (index >= counters.limits.x) {
+        if (lid == 0u) {
+            atomicAdd(counters.limits.z, 1u);
+        }
         return;
     }
     uint pixel_index = requests[request];
-    uint width = frame.resolution.x;
-    ivec2 pixel = ivec2(pixel_index % width, pixel_index / width);
-    GSample g = gbuffer_load(pixel);
+    ivec2 size = imageSize(g_position);
+    uint width = uint(max(size.x, 1));
+    uint row = pixel_index / width;
+    if (row >= uint(max(size.y, 0))) {
+        if (lid == 0u) {
+            write_rejected(index, vec3(0.0), 0.0, pixel_index, FLAG_NO_SURFACE);
+        }
+        return;
+    }
+    GSample g = gbuffer_load(ivec2(pixel_index % width, row));
+    if (!g.surface) {
+        if (lid == 0u) {
+            write_rejected(index, g.position, g.footprint, pixel_index, FLAG_NO_SURFACE);
+        }
+        return;
+    }
+
     uint m = clamp(pc.m, 1u, MAX_STRATA / 3u);
     uint n = clamp(pc.n, 3u, MAX_STRATA / m);
     uint count = m * n;
     vec3 nn = normalize_or_z(g.normal);
+    vec3 ng = dot(g.geometric, g.geometric) > 0.0 ? normalize(g.geometric) : nn;
     vec3 t, b;
     basis_from_normal(nn, t, b);
-    vec3 origin = offset_ray_origin(g.position, g.geometric);
+    vec3 origin = offset_ray_origin(g.position, ng);
     uint record_seed = ircache_hash(pixel_index ^ ircache_hash(pc.seed));
-    if (gl_LocalInvocationID.x == 0u) {
+    bool dump = uint(samples.length()) >= (request + 1u) * count;
+    if (lid == 0u) {
         s_rays = 0u;
+        s_folded = 0u;
     }
     barrier();
 
-    for (uint i = gl_LocalInvocationID.x; i < count; i += GROUP) {
-        uint j = i / n;
-        uint k = i % n;
+    for (uint i = lid; i < count; i += GROUP) {
         float xi, psi;
         stratum_jitter(record_seed, i, xi, psi);
-        vec3 dir = frame_to_world(stratum_direction_local(j, k, m, n, xi, psi), t, b, nn);
-        float below = dot(dir, g.geometric);
+        vec3 dir = frame_to_world(stratum_direction_local(i / n, i % n, m, n, xi, psi), t, b, nn);
+        float below = dot(dir, ng);
         if (below <= 0.0) {
-            dir = normalize(dir - 2.0 * below * g.geometric);
+            dir = normalize(dir - 2.0 * below * ng);
+            atomicOr(s_folded, 1u);
         }
-        vec3 l = vec3(0.0);
-        float r = IC_FAR;
-        rays_traced++;
-        rayQueryEXT q;
-        rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, origin, 0.0, dir, 1e30);
-        while (rayQueryProceedEXT(q)) {
-        }
-        if (rayQueryGetIntersectionTypeEXT(q, true) == gl_RayQueryCommittedIntersectionTriangleEXT) {
-            r = rayQueryGetIntersectionTEXT(q, true);
-            Surface h = surface_at(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)),
-                                   uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
-                                   rayQueryGetIntersectionBarycentricsEXT(q, true), dir);
-            vec3 albedo = material_albedo(h.material, h.uv);
-            if (any(greaterThan(albedo, vec3(0.0)))) {
-                Rng rng = rng_init(record_seed, i, pc.seed);
-                vec3 nee = direct_light(h, rng);
-                Ray bounce;
-                bounce.dir = sample_cosine_around(h.shading_normal, rng_next2(rng));
-                bounce.origin = offset_ray_origin(h.position, h.geometric_normal);
-                vec3 further = vec3(0.0);
-                if (dot(bounce.dir, h.geometric_normal) > 0.0) {
-                    float pdf = dot(bounce.dir, h.shading_normal) * INV_PI;
-                    further = trace_path_from(bounce, pdf, true, rng);
-                }
-                l = albedo * (INV_PI * nee + further);
-            }
-        }
-        if (any(isnan(l)) || any(isinf(l))) {
-            l = vec3(0.0);
-        }
+        float r;
+        vec3 l = gather(origin, dir, rng_init(record_seed, i, pc.seed), r);
         s_lr[i] = l.r;
         s_lg[i] = l.g;
         s_lb[i] = l.b;
         s_r[i] = r;
+        if (dump) {
+            samples[request * count + i] = vec4(l, r);
+        }
     }
     atomicAdd(s_rays, rays_traced);
     barrier();
-    if (gl_LocalInvocationID.x != 0u) {
+    if (lid != 0u) {
         return;
     }
     atomicAdd(ray_count, s_rays);
 
-    // The record, as radcache_cache::compute_record.
+    // The sums, as radcache_cache::compute_record (same functions, same order).
     float r_eps = pc.r_eps_rel * frame.camera_position.w;
     vec3 sum_l = vec3(0.0);
     vec3 gr[3] = vec3[](vec3(0.0), vec3(0.0), vec3(0.0));
@@ -156,8 +242,7 @@ void main() {
                 trans[1] = cw * d.y;
                 trans[2] = cw * d.z;
             }
-            uint kp = k == 0u ? n - 1u : k - 1u;
-            uint ip = stratum_index(j, kp, n);
+            uint ip = stratum_index(j, k == 0u ? n - 1u : k - 1u, n);
             vec3 d = wall_term(lc, stratum_l(ip), rc, s_r[ip], r_eps);
             vec3 ca = frame_to_world(azimuthal_wall_coeff(j, k, m, n), t, b, nn);
             for (int c = 0; c < 3; ++c) {
@@ -167,20 +252,21 @@ void main() {
         }
     }
     vec3 e = sum_l * stratum_projected_solid_angle(m, n);
-    uint flags = 0u;
+    uint flags = s_folded != 0u ? FLAG_FOLDED : 0u;
     if (!irradiance_is_valid(e)) {
-        e = vec3(0.0);
-        gr[0] = gr[1] = gr[2] = vec3(0.0);
-        gt[0] = gt[1] = gt[2] = vec3(0.0);
-        flags |= 1u;
-        atomicAdd(counters.limits.w, 1u);
+        write_rejected(index, g.position, g.footprint, pixel_index, flags | FLAG_INVALID_IRRADIANCE);
+        return;
     }
+
+    // Radius (§7.7 steps 3, 5-7; step 4, neighbour clamping, is the neighbour pass).
     float r_harm = harmonic_mean_distance(sum_inv, float(valid));
     float r_raw = max(r_harm, min(r_min_restricted, IC_FAR));
     float r_lo, r_hi;
     radius_bounds(g.footprint, pc.min_px, pc.max_px, pc.v_scale, r_lo, r_hi);
     float r_orig, r_used, lo, hi, att;
     finalize_radius(r_raw, e, gt[0], gt[1], gt[2], IC_FAR, r_lo, r_hi, r_orig, r_used, lo, hi, att);
+    flags |= r_orig < lo ? FLAG_CLAMPED_UP : 0u;
+    flags |= r_orig > hi ? FLAG_CLAMPED_DOWN : 0u;
 
     GpuRecord rec;
     rec.position_radius = vec4(g.position, r_used);
@@ -193,6 +279,6 @@ void main() {
     rec.grad_t_red = vec4(gt[0], 0.0);
     rec.grad_t_green = vec4(gt[1], 0.0);
     rec.grad_t_blue = vec4(gt[2], 0.0);
-    rec.info = uvec4(pixel_index, pc.level_subframe & 0xffffu, pc.level_subframe >> 16u, flags);
+    rec.info = record_info(pixel_index, flags);
     records[index] = rec;
 }

@@ -220,7 +220,17 @@ pub fn render_ic(
                 false,
             )?;
             state.record_begin_batch(&mut rec)?;
-            records.record(&mut rec, gpu, &gbuffer, &state, level, k, seed)?;
+            records.record(
+                &mut rec,
+                gpu,
+                &gbuffer,
+                &state.requests,
+                &state.counters,
+                &state.records,
+                level,
+                k,
+                seed,
+            )?;
             state.record_end_batch(&mut rec)?;
             neighbours.record(&mut rec, &state)?;
             add_timings(&mut passes_ms, ctx.submit(rec)?.wait()?);

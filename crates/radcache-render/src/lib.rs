@@ -45,6 +45,11 @@ pub use ic::{render_ic, sub_frame_jitter, IcDebug, IcSettings, IcStats};
 pub use ic_state::IcState;
 pub use neighbours::NeighbourPass;
 pub use path_trace::PathTracer;
+pub use records::{
+    record_seed, DISPATCH_OFFSET, RECORD_BINDINGS_BASE, RECORD_FLAG_CLAMPED_DOWN,
+    RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED, RECORD_FLAG_INVALID_IRRADIANCE,
+    RECORD_FLAG_NO_SURFACE,
+};
 pub use records::{RecordPass, MAX_STRATA, R_EPS_REL};
 pub use render::{render_path, Budget, FrameOutput, PathSettings, Progress};
 pub use splat::{SplatPass, SplatWeights};
