@@ -4,8 +4,10 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec3};
+use radcache_render::{render_path, Budget, FrameOutput, GpuScene, PathSettings};
 use radcache_scene::writer::{BufferLayout, GltfBuilder, NodeDesc, PrimitiveDesc};
 use radcache_scene::{LoadOptions, Scene};
+use radcache_vk::{Context, ShaderCompiler};
 
 /// A fresh folder under the system temp dir, unique to this process and `tag`.
 pub fn temp_dir(tag: &str) -> PathBuf {
@@ -270,4 +272,44 @@ pub fn pixel_coverage(poly: &[(f64, f64)], x: u32, y: u32, eps: f64) -> Coverage
     } else {
         Coverage::Partial(signed_area(&clip_convex(&square, poly)).max(0.0))
     }
+}
+
+/// Relative float slack for f32 accumulation and camera-matrix round-off (far below any
+/// statistical tolerance used here).
+pub const FLOAT_SLACK: f64 = 1e-5;
+
+/// Renders with the path tracer and checks the output is complete, finite and non-negative.
+pub fn render(
+    ctx: &Context,
+    shaders: &ShaderCompiler,
+    scene: &Scene,
+    gpu: &mut GpuScene,
+    size: (u32, u32),
+    spp: u32,
+    seed: u32,
+) -> FrameOutput {
+    let settings = PathSettings {
+        width: size.0,
+        height: size.1,
+        budget: Budget::Samples(spp),
+        seed,
+        chunk_target_ms: 200.0,
+        ..PathSettings::default()
+    };
+    let out = render_path(ctx, shaders, scene, gpu, &settings, &mut |_| {}).unwrap();
+    assert_eq!(out.spp, spp);
+    assert_eq!(out.pixels.len(), (size.0 * size.1) as usize);
+    assert_eq!(out.nonfinite_pixels, 0, "non-finite pixels");
+    for (i, p) in out.pixels.iter().enumerate() {
+        assert!(
+            p.iter().all(|c| c.is_finite() && *c >= 0.0),
+            "pixel {i} is {p:?}"
+        );
+    }
+    out
+}
+
+/// One channel of every pixel, as f64.
+pub fn channel(out: &FrameOutput, c: usize) -> Vec<f64> {
+    out.pixels.iter().map(|p| f64::from(p[c])).collect()
 }

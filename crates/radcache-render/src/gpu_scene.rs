@@ -9,21 +9,22 @@
 //! [`GpuScene::set_view`] only between submissions that read the scene.
 
 use glam::{Mat3, Mat4, Vec3};
-use radcache_scene::{CameraView, Environment, Scene, ScenePlan};
+use radcache_scene::{Environment, Scene, ScenePlan};
 use radcache_shared::gpu::{
     FrameConstants, GpuAlias, GpuEmitter, GpuInstance, GpuLight, GpuMesh, GpuVertex,
 };
 use radcache_vk::{
-    vk, Blas, BlasBuildStats, BlasGeometry, Buffer, Context, Recorder, Resource, Tlas,
-    TlasInstance, TlasUpdate,
+    vk, Blas, BlasBuildStats, BlasGeometry, Buffer, Context, Recorder, Tlas, TlasInstance,
+    TlasUpdate,
 };
 
-use crate::bindings as b;
 use crate::env_map::{gpu_alias, EnvMap};
 use crate::error::Result;
 use crate::scene_lights::{gpu_emitters, gpu_lights};
 use crate::scene_pack::{pack_geometry, pack_materials, PackedGeometry};
-use crate::upload::{cols, host_buffer, rows3x4, storage, vulkan_clip_from_view};
+use crate::upload::{cols, host_buffer, rows3x4, storage};
+
+mod view;
 
 /// A full TLAS rebuild after this many refits.
 pub const REFITS_PER_REBUILD: u32 = 16;
@@ -420,86 +421,5 @@ impl GpuScene {
             TlasUpdate::Refit => self.refits + 1,
         };
         Ok(())
-    }
-
-    /// Writes the frame constants for `view` at `width × height`.
-    pub fn set_view(
-        &mut self,
-        view: &CameraView,
-        width: u32,
-        height: u32,
-        frame: u32,
-        seed: u32,
-    ) -> Result<()> {
-        let aspect = width as f32 / height.max(1) as f32;
-        let clip_from_world =
-            vulkan_clip_from_view(view.perspective.yfov, aspect, view.perspective.znear)
-                * view.view_from_world();
-        let world_from_clip = clip_from_world.inverse();
-        let p = view.position;
-        self.constants = FrameConstants {
-            clip_from_world: cols(clip_from_world),
-            world_from_clip: cols(world_from_clip),
-            camera_position: [p.x, p.y, p.z, self.scene_scale],
-            environment: [
-                self.env_constant.x,
-                self.env_constant.y,
-                self.env_constant.z,
-                self.env_scale,
-            ],
-            resolution: [width, height, frame, seed],
-            counts: [
-                self.emitter_count,
-                self.light_count,
-                self.transforms.len() as u32,
-                self.env_size.0,
-            ],
-            totals: [self.emitter_power, self.env_size.1 as f32, 0.0, 0.0],
-        };
-        self.frame.write(0, std::slice::from_ref(&self.constants))?;
-        Ok(())
-    }
-
-    /// The frame constants last written.
-    pub fn constants(&self) -> &FrameConstants {
-        &self.constants
-    }
-
-    /// Shader defines that compile in only the light sources the scene has.
-    pub fn defines(&self) -> Vec<(&'static str, &'static str)> {
-        let mut d = Vec::new();
-        if self.plan.has_emissive() {
-            d.push(("HAS_EMITTERS", "1"));
-        }
-        if self.plan.has_punctual_lights() {
-            d.push(("HAS_LIGHTS", "1"));
-        }
-        if self.env_constant.max_element() > 0.0 {
-            d.push(("HAS_ENV_CONSTANT", "1"));
-        }
-        if self.env_size.0 > 0 {
-            d.push(("HAS_ENV_MAP", "1"));
-        }
-        d
-    }
-
-    /// The scene's binding table (bindings 0–13), to prefix a pass's own bindings.
-    pub fn bindings(&self) -> Vec<(u32, Resource<'_>)> {
-        vec![
-            (b::FRAME, Resource::Buffer(&self.frame)),
-            (b::TLAS, Resource::Tlas(&self.tlas)),
-            (b::VERTICES, Resource::Buffer(&self.vertices)),
-            (b::INDICES, Resource::Buffer(&self.indices)),
-            (b::INSTANCES, Resource::Buffer(&self.instances)),
-            (b::TRI_MATERIALS, Resource::Buffer(&self.tri_materials)),
-            (b::MATERIALS, Resource::Buffer(&self.materials)),
-            (b::TEXTURES, Resource::Buffer(&self.textures)),
-            (b::TEXELS, Resource::Buffer(&self.texels)),
-            (b::EMITTERS, Resource::Buffer(&self.emitters)),
-            (b::EMITTER_ALIAS, Resource::Buffer(&self.emitter_alias)),
-            (b::LIGHTS, Resource::Buffer(&self.lights)),
-            (b::ENV_TEXELS, Resource::Buffer(&self.env_texels)),
-            (b::ENV_ALIAS, Resource::Buffer(&self.env_alias)),
-        ]
     }
 }
