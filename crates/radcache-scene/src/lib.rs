@@ -1,4 +1,4 @@
-//! radcache-scene: glTF 2.0 scene loading for radcache (CPU side; no GPU, no `unsafe`).
+//! radcache-scene: glTF 2.0 scene loading for radcache (CPU side only: no GPU code).
 //!
 //! [`Scene::load`] reads a `.gltf`/`.glb` file into plain data: one merged triangle [`Mesh`] per
 //! glTF mesh (per-triangle material ids), metallic-roughness [`Material`]s with sRGB textures,
