@@ -5,8 +5,9 @@
 // At each diffuse vertex: next-event estimation of emissive triangles (MIS with BSDF sampling,
 // power heuristic), punctual lights (no MIS: delta lights) and the environment map (MIS);
 // emission hit by BSDF sampling is counted with the complementary MIS weight, so every light path
-// is counted once. Russian roulette from the fourth vertex on, with continuation probability the
-// throughput's largest component capped at 0.99; a safety cap of 4096 vertices (reached with
+// is counted once. Russian roulette from the fourth vertex on (camera paths; the cache's gather
+// paths from their second vertex), with continuation probability the throughput's largest
+// component capped at 0.99; a safety cap of 4096 vertices (reached with
 // probability < 0.99^4093, invisible).
 #ifndef RADCACHE_PATH_GLSL
 #define RADCACHE_PATH_GLSL
@@ -85,84 +86,129 @@ vec3 direct_light(Surface s, inout Rng rng) {
     return sum;
 }
 
+// A path in flight, advanced one vertex at a time by path_step (so a caller can start a new path
+// in an invocation whose path ended while others go on: see passes/record.comp).
+struct PathState {
+    Ray ray;
+    vec3 radiance;
+    vec3 throughput;
+    float bsdf_pdf;       // solid-angle pdf of ray.dir under the BSDF (0: no MIS on this segment)
+    uint depth;           // vertex about to be found (0 = the first hit of the initial ray)
+    uint rr_start;        // Russian roulette from this vertex on
+    bool count_first;     // count sources found by the first segment
+    bool done;
+    float first_t;        // distance to the first hit, IC_PATH_MISS on a miss
+};
+
+const float IC_PATH_MISS = 1.0e30;
+
+PathState path_begin(Ray ray, float bsdf_pdf, bool count_first_segment, uint rr_start) {
+    PathState st;
+    st.ray = ray;
+    st.radiance = vec3(0.0);
+    st.throughput = vec3(1.0);
+    st.bsdf_pdf = bsdf_pdf;
+    st.depth = 0u;
+    st.rr_start = rr_start;
+    st.count_first = count_first_segment;
+    st.done = false;
+    st.first_t = IC_PATH_MISS;
+    return st;
+}
+
+// Traces st.ray and handles the vertex it finds (or the miss); sets st.done when the path ends.
+void path_step(inout PathState st, inout Rng rng) {
+    bool count_sources = st.depth > 0u || st.count_first;
+    rays_traced++;
+    rayQueryEXT q;
+    rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, st.ray.origin, 0.0, st.ray.dir, 1e30);
+    while (rayQueryProceedEXT(q)) {
+    }
+    if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
+        if (count_sources) {
+            vec3 le = environment_radiance(st.ray.dir);
+            float w = 1.0;
+#ifdef HAS_ENV_MAP
+            if (st.bsdf_pdf > 0.0) {
+                w = power_heuristic(st.bsdf_pdf, environment_pdf(st.ray.dir));
+            }
+#endif
+            st.radiance += st.throughput * le * w;
+        }
+        st.done = true;
+        return;
+    }
+    float t = rayQueryGetIntersectionTEXT(q, true);
+    if (st.depth == 0u) {
+        st.first_t = t;
+    }
+    Surface s = surface_at(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)),
+                           uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
+                           rayQueryGetIntersectionBarycentricsEXT(q, true), st.ray.dir);
+    vec3 le = count_sources ? material_emission(s.material, s.uv, s.front_face) : vec3(0.0);
+    if (any(greaterThan(le, vec3(0.0)))) {
+        float w = 1.0;
+#ifdef HAS_EMITTERS
+        if (st.bsdf_pdf > 0.0) {
+            GpuMaterial m = materials[s.material];
+            float cos_l = abs(dot(s.geometric_normal, st.ray.dir));
+            float pdf_light =
+                emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t / max(cos_l, 1e-8);
+            w = power_heuristic(st.bsdf_pdf, pdf_light);
+        }
+#endif
+        st.radiance += st.throughput * le * w;
+    }
+    vec3 albedo = material_albedo(s.material, s.uv);
+    st.radiance += st.throughput * albedo * INV_PI * direct_light(s, rng);
+
+    st.throughput *= albedo;
+    uint depth = st.depth;
+    st.depth++;
+    if (depth >= st.rr_start) {
+        float p = min(max(st.throughput.r, max(st.throughput.g, st.throughput.b)), 0.99);
+        if (rng_next(rng) >= p) {
+            st.done = true;
+            return;
+        }
+        st.throughput /= p;
+    }
+    if (all(equal(st.throughput, vec3(0.0))) || st.depth >= MAX_VERTICES) {
+        st.done = true;
+        return;
+    }
+    st.ray.dir = sample_cosine_around(s.shading_normal, rng_next2(rng));
+    if (dot(st.ray.dir, s.geometric_normal) <= 0.0) {
+        st.done = true;  // the shading normal sent the sample below the surface: no contribution
+        return;
+    }
+    st.bsdf_pdf = dot(st.ray.dir, s.shading_normal) * INV_PI;
+    st.ray.origin = offset_ray_origin(s.position, s.geometric_normal);
+}
+
+// The radiance a finished path gathered; a non-finite sample is dropped (guard at the source).
+vec3 path_radiance(PathState st) {
+    return (any(isnan(st.radiance)) || any(isinf(st.radiance))) ? vec3(0.0) : st.radiance;
+}
+
 // Radiance arriving along `ray`. With `count_first_segment` false, light that arrives along the
 // first segment straight from a source (emission at the first hit, the environment on a miss) is
 // left out: that is the indirect radiance a gather ray must return when the shading point's direct
 // light is computed separately. `bsdf_pdf` is the solid-angle pdf with which `ray` was sampled by
-// the BSDF (0 for camera rays: no MIS on the first segment).
-vec3 trace_path_from(Ray ray, float bsdf_pdf, bool count_first_segment, inout Rng rng) {
-    vec3 radiance = vec3(0.0);
-    vec3 throughput = vec3(1.0);
-    for (uint depth = 0u; depth < MAX_VERTICES; ++depth) {
-        bool count_sources = depth > 0u || count_first_segment;
-        rays_traced++;
-        rayQueryEXT q;
-        rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, ray.origin, 0.0, ray.dir, 1e30);
-        while (rayQueryProceedEXT(q)) {
-        }
-        if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
-            if (!count_sources) {
-                break;
-            }
-            vec3 le = environment_radiance(ray.dir);
-            float w = 1.0;
-#ifdef HAS_ENV_MAP
-            if (bsdf_pdf > 0.0) {
-                w = power_heuristic(bsdf_pdf, environment_pdf(ray.dir));
-            }
-#endif
-            radiance += throughput * le * w;
-            break;
-        }
-        Surface s = surface_at(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)),
-                               uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
-                               rayQueryGetIntersectionBarycentricsEXT(q, true), ray.dir);
-        vec3 le = count_sources ? material_emission(s.material, s.uv, s.front_face) : vec3(0.0);
-        if (any(greaterThan(le, vec3(0.0)))) {
-            float w = 1.0;
-#ifdef HAS_EMITTERS
-            if (bsdf_pdf > 0.0) {
-                GpuMaterial m = materials[s.material];
-                float t = rayQueryGetIntersectionTEXT(q, true);
-                float cos_l = abs(dot(s.geometric_normal, ray.dir));
-                float pdf_light = emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t /
-                                  max(cos_l, 1e-8);
-                w = power_heuristic(bsdf_pdf, pdf_light);
-            }
-#endif
-            radiance += throughput * le * w;
-        }
-        vec3 albedo = material_albedo(s.material, s.uv);
-        radiance += throughput * albedo * INV_PI * direct_light(s, rng);
-
-        throughput *= albedo;
-        if (depth >= RR_START) {
-            float p = min(max(throughput.r, max(throughput.g, throughput.b)), 0.99);
-            if (rng_next(rng) >= p) {
-                break;
-            }
-            throughput /= p;
-        }
-        if (all(equal(throughput, vec3(0.0)))) {
-            break;
-        }
-        ray.dir = sample_cosine_around(s.shading_normal, rng_next2(rng));
-        if (dot(ray.dir, s.geometric_normal) <= 0.0) {
-            break;  // the shading normal sent the sample below the surface: no contribution
-        }
-        bsdf_pdf = dot(ray.dir, s.shading_normal) * INV_PI;
-        ray.origin = offset_ray_origin(s.position, s.geometric_normal);
+// the BSDF (0 for camera rays: no MIS on the first segment). Russian roulette starts at vertex
+// `rr_start` (0 = the first hit of `ray`).
+vec3 trace_path_from(Ray ray, float bsdf_pdf, bool count_first_segment, uint rr_start,
+                     inout Rng rng) {
+    PathState st = path_begin(ray, bsdf_pdf, count_first_segment, rr_start);
+    while (!st.done) {
+        path_step(st, rng);
     }
-    // Guard at the source: a non-finite sample is dropped, never accumulated.
-    if (any(isnan(radiance)) || any(isinf(radiance))) {
-        return vec3(0.0);
-    }
-    return radiance;
+    return path_radiance(st);
 }
 
 // Radiance arriving along a camera ray (everything counted).
 vec3 trace_path(Ray ray, inout Rng rng) {
-    return trace_path_from(ray, 0.0, true, rng);
+    return trace_path_from(ray, 0.0, true, RR_START, rng);
 }
 
 #endif

@@ -1,8 +1,15 @@
 // Direct lighting of the cache's frame (compute, ray queries): per surface pixel, `samples`
-// next-event estimates (emissive triangles and the environment map with MIS, punctual lights)
-// plus, per sample, one cosine-sampled BSDF ray that finds emission and the environment with the
-// complementary MIS weight (weight 1 for a constant environment, which has no light sampling).
-// Written: albedo/π × the mean estimate (emission itself is in the G-buffer's emission image).
+// one-sample-MIS estimates of the light arriving straight from emissive triangles and the
+// environment (see one_sample), plus the punctual lights once (they need no sampling). Written:
+// albedo/π × the estimate (emission itself is in the G-buffer's emission image).
+//
+// Sample g of a pixel (g = first_sample + k; sub-frames continue the sequence) draws its random
+// numbers from Kronecker sequences (Roberts 2018, the R_d sequences: point g is fract(shift + g·α),
+// α the powers of 1/φ_d, φ_d the real root of x^(d+1) = x + 1; d = 1 is the golden ratio): R1 for
+// the technique, R3 for the light sample, R2 for the BSDF direction, each with a random per-pixel
+// shift (Cranley–Patterson rotation). Every sample is therefore uniform (the estimate is
+// unbiased) while a pixel's samples stay evenly spread for any count (stratification), which
+// makes direct noise fall faster than with independent samples.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -17,28 +24,107 @@ layout(binding = B_GBUFFER_END, std430) buffer RayCount { uint ray_count; };
 layout(push_constant) uniform Push {
     uint samples;
     uint seed;
-    uint pad0;
-    uint pad1;
+    uint first_sample;
+    uint pad;
 } pc;
 
-// Emission or environment found by a cosine-sampled ray from s, MIS-weighted; times cos/pdf = π.
-vec3 bsdf_sample(Surface s, vec3 origin, inout Rng rng) {
-    vec3 dir = sample_cosine_around(s.shading_normal, rng_next2(rng));
-    if (dot(dir, s.geometric_normal) <= 0.0) {
+const float ONE_MINUS_EPS = 0.99999994;
+
+vec3 kronecker3(uint g, vec3 shift) {
+    const vec3 alpha = vec3(0.8191725134, 0.6710436067, 0.5497004779);
+    return min(fract(shift + float(g) * alpha), vec3(ONE_MINUS_EPS));
+}
+
+vec2 kronecker2(uint g, vec2 shift) {
+    const vec2 alpha = vec2(0.7548776662, 0.5698402910);
+    return min(fract(shift + float(g) * alpha), vec2(ONE_MINUS_EPS));
+}
+
+// One-sample MIS (Veach 1997, §9.2.4, balance heuristic): each sample picks ONE technique (a
+// point on an emitter, a direction of the environment map, or a cosine-distributed BSDF
+// direction) with probability c_t and casts one ray; its contribution f(x) / Σ_t c_t·p_t(x)
+// (sum over the techniques that can produce x for that source) is unbiased and costs one ray per
+// sample instead of one per technique. Probabilities are fixed by the plan: light sampling gets
+// weight 1 per source kind, BSDF sampling 0.25 (1 when a constant environment, which only BSDF
+// sampling finds, is present), normalized.
+#ifdef HAS_EMITTERS
+const float W_EMITTER = 1.0;
+#else
+const float W_EMITTER = 0.0;
+#endif
+#ifdef HAS_ENV_MAP
+const float W_ENV = 1.0;
+#else
+const float W_ENV = 0.0;
+#endif
+#ifdef HAS_ENV_CONSTANT
+const float W_BSDF = 1.0;
+#else
+const float W_BSDF = 0.25;
+#endif
+// Without emitters or an environment there is nothing to sample (punctual lights only).
+#if defined(HAS_EMITTERS) || defined(HAS_ENV_MAP) || defined(HAS_ENV_CONSTANT)
+#define HAS_SAMPLED_SOURCES
+#endif
+const float C_EMITTER = W_EMITTER / (W_EMITTER + W_ENV + W_BSDF);
+const float C_ENV = W_ENV / (W_EMITTER + W_ENV + W_BSDF);
+const float C_BSDF = W_BSDF / (W_EMITTER + W_ENV + W_BSDF);
+
+// Solid-angle pdf of the environment-map technique for direction d (0 without a map).
+float env_technique_pdf(vec3 d) {
+#ifdef HAS_ENV_MAP
+    return environment_pdf(d);
+#else
+    return 0.0;
+#endif
+}
+
+// One sample of the irradiance-like estimate Σ L·cos/pdf: `u_pick` chooses the technique, `u3`
+// drives light sampling, `u2` the BSDF direction.
+vec3 one_sample(Surface s, vec3 origin, float u_pick, vec3 u3, vec2 u2) {
+#ifdef HAS_EMITTERS
+    if (u_pick < C_EMITTER) {
+        vec3 dir, le;
+        float dist, pdf;
+        if (!sample_emitter(s.position, u3, dir, dist, le, pdf)) {
+            return vec3(0.0);
+        }
+        float cos_s = dot(s.shading_normal, dir);
+        if (cos_s <= 0.0 || dot(s.geometric_normal, dir) <= 0.0 ||
+            !unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+            return vec3(0.0);
+        }
+        return le * cos_s / (C_EMITTER * pdf + C_BSDF * cos_s * INV_PI);
+    }
+#endif
+#ifdef HAS_ENV_MAP
+    if (u_pick < C_EMITTER + C_ENV) {
+        vec3 dir, le;
+        float pdf;
+        if (!sample_environment(u3, dir, le, pdf)) {
+            return vec3(0.0);
+        }
+        float cos_s = dot(s.shading_normal, dir);
+        if (cos_s <= 0.0 || dot(s.geometric_normal, dir) <= 0.0 || !unoccluded(origin, dir, 1e30)) {
+            return vec3(0.0);
+        }
+        return environment_radiance(dir) * cos_s / (C_ENV * pdf + C_BSDF * cos_s * INV_PI);
+    }
+#endif
+    vec3 dir = sample_cosine_around(s.shading_normal, u2);
+    float cos_s = dot(s.shading_normal, dir);
+    if (cos_s <= 0.0 || dot(dir, s.geometric_normal) <= 0.0) {
         return vec3(0.0);
     }
-    float pdf = dot(dir, s.shading_normal) * INV_PI;
+    float pdf_bsdf = cos_s * INV_PI;
     rays_traced++;
     rayQueryEXT q;
     rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, origin, 0.0, dir, 1e30);
     while (rayQueryProceedEXT(q)) {
     }
     if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
-        float w = 1.0;
-#ifdef HAS_ENV_MAP
-        w = power_heuristic(pdf, environment_pdf(dir));
-#endif
-        return environment_radiance(dir) * w * PI;
+        return environment_radiance(dir) * cos_s /
+               (C_ENV * env_technique_pdf(dir) + C_BSDF * pdf_bsdf);
     }
     Surface h = surface_at(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)),
                            uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
@@ -47,15 +133,32 @@ vec3 bsdf_sample(Surface s, vec3 origin, inout Rng rng) {
     if (all(equal(le, vec3(0.0)))) {
         return vec3(0.0);
     }
-    float w = 1.0;
+    float pdf_light = 0.0;
 #ifdef HAS_EMITTERS
     GpuMaterial m = materials[h.material];
     float t = rayQueryGetIntersectionTEXT(q, true);
     float cos_l = abs(dot(h.geometric_normal, dir));
-    float pdf_light = emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t / max(cos_l, 1e-8);
-    w = power_heuristic(pdf, pdf_light);
+    pdf_light = emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t / max(cos_l, 1e-8);
 #endif
-    return le * w * PI;
+    return le * cos_s / (C_EMITTER * pdf_light + C_BSDF * pdf_bsdf);
+}
+
+// Punctual lights (delta lights: no sampling, one shadow ray each, the same for every sample).
+vec3 punctual(Surface s, vec3 origin) {
+    vec3 sum = vec3(0.0);
+#ifdef HAS_LIGHTS
+    for (uint i = 0u; i < frame.counts.y; ++i) {
+        vec3 dir;
+        float dist;
+        vec3 e = punctual_incident(lights[i], s.position, dir, dist);
+        float cos_s = dot(s.shading_normal, dir);
+        if (cos_s > 0.0 && dot(s.geometric_normal, dir) > 0.0 && any(greaterThan(e, vec3(0.0))) &&
+            unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+            sum += e * cos_s;
+        }
+    }
+#endif
+    return sum;
 }
 
 void main() {
@@ -79,13 +182,25 @@ void main() {
     uint index = uint(pixel.y) * frame.resolution.x + uint(pixel.x);
     vec3 sum = vec3(0.0);
     uint n = max(pc.samples, 1u);
+    Rng rng = rng_init(index, 0xffffffffu, pc.seed);
+    float shift_pick = rng_next(rng);
+    vec3 shift_light = vec3(rng_next(rng), rng_next2(rng));
+    vec2 shift_bsdf = rng_next2(rng);
+#ifdef HAS_SAMPLED_SOURCES
     for (uint k = 0u; k < n; ++k) {
-        Rng rng = rng_init(index, k, pc.seed);
-        vec3 e = direct_light(s, rng) + bsdf_sample(s, origin, rng);
+        uint g = pc.first_sample + k;
+        // The technique from the golden-ratio sequence, so each pixel's picks are stratified too.
+        float u_pick = min(fract(shift_pick + float(g) * 0.6180339887), ONE_MINUS_EPS);
+        vec3 e = one_sample(s, origin, u_pick, kronecker3(g, shift_light), kronecker2(g, shift_bsdf));
         if (!any(isnan(e)) && !any(isinf(e))) {
             sum += e;
         }
     }
-    imageStore(g_direct, pixel, vec4(g.albedo * INV_PI * sum / float(n), 0.0));
+#endif
+    vec3 e = sum / float(n) + punctual(s, origin);
+    if (any(isnan(e)) || any(isinf(e))) {
+        e = vec3(0.0);
+    }
+    imageStore(g_direct, pixel, vec4(g.albedo * INV_PI * e, 0.0));
     atomicAdd(ray_count, rays_traced);
 }

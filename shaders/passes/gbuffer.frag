@@ -1,8 +1,9 @@
 // G-buffer rasterization, fragment stage: the five attachments of shaders/common/gbuffer.glsl.
 // The geometric normal comes from the triangle's world-space corners (mirroring instances flip
 // it, as glTF's winding rule says); both normals are turned toward the camera, and the front
-// face (for the emission rule) is the side the camera sees. The pixel footprint is the square
-// root of the world-space area one pixel covers (from screen-space derivatives).
+// face (for the emission rule) is the side the camera sees. The pixel footprint is the pinhole
+// `pixel_footprint` of ircache_math.glsl (its cosine clamp keeps grazing surfaces bounded, where
+// screen-space derivatives would grow without limit).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -50,7 +51,14 @@ void main() {
         ns = ng;
     }
     uint material = tri_materials[inst.mesh.w + v_triangle];
-    float footprint = pixel_footprint_from_differentials(dFdx(v_position), dFdy(v_position));
+    // View depth = clip w = 1 / gl_FragCoord.w. The y row of clip_from_world is the projection's
+    // ±1/tan(fov_y/2) times a row of the view rotation (a unit vector).
+    vec3 row_y = vec3(frame.clip_from_world[0][1], frame.clip_from_world[1][1],
+                      frame.clip_from_world[2][1]);
+    float dist = length(to_camera);
+    float cos_view = dist > 0.0 ? dot(ng, to_camera) / dist : 1.0;
+    float footprint = pixel_footprint(1.0 / gl_FragCoord.w, 1.0 / length(row_y),
+                                      float(frame.resolution.y), cos_view);
     o_position = vec4(v_position, 1.0);
     o_normal = vec4(ns, footprint);
     o_geometric = vec4(ng, float(material));

@@ -1,6 +1,11 @@
 // G-buffer rasterization, vertex stage: vertex pulling from the scene buffers, one draw per TLAS
 // instance (push constant), the instance transform, the frame's projection and a sub-pixel
 // jitter (in pixels, (0, 0) = pixel centre) for anti-aliasing by jittered sub-frames.
+//
+// The jitter is where the pixel's sample lies: the G-buffer at pixel p describes the camera ray
+// `camera_ray(p, 0.5 + jitter)` of path.glsl (the composite shades the background along that ray).
+// The rasterizer samples at pixel centres, so the image is moved by −jitter: the point that was
+// at centre + jitter lands on the centre.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -22,6 +27,6 @@ void main() {
     v_uv = vec2(v.position_u.w, v.normal_v.w);
     v_triangle = uint(gl_VertexIndex) / 3u;
     vec4 clip = frame.clip_from_world * world;
-    clip.xy += 2.0 * pc.jitter / vec2(frame.resolution.xy) * clip.w;
+    clip.xy -= 2.0 * pc.jitter / vec2(frame.resolution.xy) * clip.w;
     gl_Position = clip;
 }

@@ -12,7 +12,8 @@
 // tangent plane, so it stays above both (§3.3 folds them like pbrt's Faceforward; the mirror keeps
 // the azimuth); it still counts for its stratum. Each ray returns the full indirect radiance
 // arriving along it: next-event estimation at its first hit plus the path continued from there
-// (MIS, Russian roulette, common/path.glsl), WITHOUT the emission of the first hit and WITHOUT the
+// (MIS, Russian roulette from the path's second vertex: a record averages M·N paths, so early
+// roulette costs little variance per ray saved; common/path.glsl, with path regeneration), WITHOUT the emission of the first hit and WITHOUT the
 // environment on a first-segment miss (the direct pass accounts for both at the shading point).
 // r_jk is the first hit's distance, IC_FAR on a miss. A non-finite sample counts as 0.
 //
@@ -102,38 +103,26 @@ void write_rejected(uint index, vec3 position, float footprint, uint pixel_index
     atomicAdd(counters.limits.w, 1u);
 }
 
-// Indirect radiance arriving at the shading point along `dir` from `origin`, and the first hit's
-// distance (IC_FAR on a miss).
-vec3 gather(vec3 origin, vec3 dir, Rng rng, out float r) {
-    r = IC_FAR;
-    rays_traced++;
-    rayQueryEXT q;
-    rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, origin, 0.0, dir, 1e30);
-    while (rayQueryProceedEXT(q)) {
+// Stratum i's gather path: its direction (folded above the geometric surface when the shading
+// normal sends it below) from `origin`, with its own random stream. The path is
+// trace_path_from's with nothing counted on its first segment and Russian roulette from its second
+// vertex on: next-event estimation at the first hit plus the continuation, i.e. the full indirect
+// radiance arriving along the ray.
+PathState begin_stratum(uint i, uint n, uint m, vec3 origin, vec3 t, vec3 b, vec3 nn, vec3 ng,
+                        uint record_seed, out Rng rng) {
+    float xi, psi;
+    stratum_jitter(record_seed, i, xi, psi);
+    vec3 dir = frame_to_world(stratum_direction_local(i / n, i % n, m, n, xi, psi), t, b, nn);
+    float below = dot(dir, ng);
+    if (below <= 0.0) {
+        dir = normalize(dir - 2.0 * below * ng);
+        atomicOr(s_folded, 1u);
     }
-    if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
-        return vec3(0.0);
-    }
-    r = min(rayQueryGetIntersectionTEXT(q, true), IC_FAR);
-    Surface h = surface_at(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)),
-                           uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
-                           rayQueryGetIntersectionBarycentricsEXT(q, true), dir);
-    vec3 albedo = material_albedo(h.material, h.uv);
-    if (!any(greaterThan(albedo, vec3(0.0)))) {
-        return vec3(0.0);
-    }
-    // Radiance reflected at the hit: albedo/π · (NEE + π · one cosine-sampled continuation).
-    vec3 nee = direct_light(h, rng);
-    Ray bounce;
-    bounce.dir = sample_cosine_around(h.shading_normal, rng_next2(rng));
-    bounce.origin = offset_ray_origin(h.position, h.geometric_normal);
-    vec3 further = vec3(0.0);
-    if (dot(bounce.dir, h.geometric_normal) > 0.0) {
-        float pdf = dot(bounce.dir, h.shading_normal) * INV_PI;
-        further = trace_path_from(bounce, pdf, true, rng);
-    }
-    vec3 l = albedo * (INV_PI * nee + further);
-    return (any(isnan(l)) || any(isinf(l))) ? vec3(0.0) : l;
+    rng = rng_init(record_seed, i, pc.seed);
+    Ray ray;
+    ray.origin = origin;
+    ray.dir = dir;
+    return path_begin(ray, 0.0, false, 1u);
 }
 
 void main() {
@@ -184,23 +173,30 @@ void main() {
     }
     barrier();
 
-    for (uint i = lid; i < count; i += GROUP) {
-        float xi, psi;
-        stratum_jitter(record_seed, i, xi, psi);
-        vec3 dir = frame_to_world(stratum_direction_local(i / n, i % n, m, n, xi, psi), t, b, nn);
-        float below = dot(dir, ng);
-        if (below <= 0.0) {
-            dir = normalize(dir - 2.0 * below * ng);
-            atomicOr(s_folded, 1u);
-        }
-        float r;
-        vec3 l = gather(origin, dir, rng_init(record_seed, i, pc.seed), r);
-        s_lr[i] = l.r;
-        s_lg[i] = l.g;
-        s_lb[i] = l.b;
-        s_r[i] = r;
-        if (dump) {
-            samples[request * count + i] = vec4(l, r);
+    // Path regeneration: an invocation whose path ends starts its next stratum at once, so the
+    // invocations of a SIMD group stay busy although their paths have different lengths.
+    uint i = lid;
+    Rng rng;
+    PathState st;
+    if (i < count) {
+        st = begin_stratum(i, n, m, origin, t, b, nn, ng, record_seed, rng);
+    }
+    while (i < count) {
+        path_step(st, rng);
+        if (st.done) {
+            vec3 l = path_radiance(st);
+            float r = min(st.first_t, IC_FAR);
+            s_lr[i] = l.r;
+            s_lg[i] = l.g;
+            s_lb[i] = l.b;
+            s_r[i] = r;
+            if (dump) {
+                samples[request * count + i] = vec4(l, r);
+            }
+            i += GROUP;
+            if (i < count) {
+                st = begin_stratum(i, n, m, origin, t, b, nn, ng, record_seed, rng);
+            }
         }
     }
     atomicAdd(s_rays, rays_traced);

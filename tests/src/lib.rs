@@ -5,6 +5,7 @@
 //! hand); a missing layer fails the test instead of silently running unvalidated.
 
 pub mod geometry;
+pub mod ic_fixture;
 pub mod scenes;
 pub mod shader_check;
 

@@ -134,6 +134,7 @@ fn the_plan_leaves_out_unneeded_passes() {
         "holes",
         "records",
         "neighbours",
+        "neighbours.grid",
         "splat",
         "composite",
         "emission",

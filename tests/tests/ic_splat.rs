@@ -312,7 +312,8 @@ fn neighbour_clamping_shrinks_radii_to_neighbour_plus_distance() {
     c.dispatch[0] = 2; // records 1 and 2 are the new batch
     let mut rec = f.ctx.begin("test.neighbours").unwrap();
     set_state(&mut rec, &f.state, &recs, c);
-    pass.record(&mut rec, &f.state).unwrap();
+    pass.record_rebuild(&mut rec, &f.state, 200.0).unwrap();
+    pass.record(&mut rec, &f.state, 200.0).unwrap();
     f.ctx.submit(rec).unwrap().wait().unwrap();
     let out: Vec<GpuRecord> = f.ctx.read_buffer(&f.state.records, 4).unwrap();
     let r: Vec<f32> = out.iter().map(|r| r.normal_rorig[3]).collect();

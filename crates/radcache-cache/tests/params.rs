@@ -24,7 +24,8 @@ fn presets_are_valid_and_ordered() {
             n.temporal_accuracy,
             n.max_age_frames
         ),
-        (2.0, 20.0, 0.05, 30.0)
+        (4.0, 20.0, 0.05, 30.0),
+        "R⁻ measured (params.rs), the rest §19"
     );
     assert_eq!((d.strata_m, d.strata_n), (8, 24), "§3.2 interactive");
     assert!(d.sample_count() < n.sample_count() && n.sample_count() < h.sample_count());
@@ -51,7 +52,8 @@ fn derived_quantities() {
     let (lo, hi) = p.radius_bounds(s);
     let vr = |r| splat_radius(p.weight_kind, r, p.weight_param(), 0.0);
     assert!(
-        (vr(lo) - 2.0 * s).abs() < 1e-6 && (vr(hi) - 20.0 * s).abs() < 1e-6,
+        (vr(lo) - p.min_spacing_px * s).abs() < 1e-6
+            && (vr(hi) - p.max_spacing_px * s).abs() < 1e-6,
         "validity radius in pixels"
     );
     assert!((p.front_tolerance(s) - 0.5 * s).abs() < 1e-9);

@@ -1,6 +1,7 @@
 //! `radcache`: render glTF scenes with global illumination, inspect them, compare images.
 
 mod compare;
+mod ic_args;
 mod info;
 mod progress;
 mod render;

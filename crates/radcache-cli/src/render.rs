@@ -6,7 +6,6 @@ use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
-use radcache_cache::{IcParams, Preset, WeightKind};
 use radcache_image::{
     png_beside, write_exr, write_png, ExrOptions, Image, Layer, Metadata, PngOptions, ToneMap,
 };
@@ -18,6 +17,7 @@ use radcache_scene::{EnvOverride, Environment, LoadOptions, Scene};
 use radcache_vk::{Context, ShaderCompiler};
 use serde_json::json;
 
+use crate::ic_args::IcArgs;
 use crate::progress::ProgressLine;
 
 /// Environment overrides shared by `render` and `info`.
@@ -77,26 +77,6 @@ pub enum Method {
     Ic,
 }
 
-/// Cache quality preset.
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Quality {
-    /// Fast previews (a = 0.3, 8×24 strata).
-    Draft,
-    /// The default (a = 0.15, 16×48 strata).
-    Default,
-    /// Offline quality (a = 0.1, 24×72 strata).
-    High,
-}
-
-/// Interpolation weight of the cache.
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Weight {
-    /// Tabellion–Lamorlette (default): bounded, continuous at the zone's edge.
-    Tl,
-    /// Ward's split-sphere weight.
-    Ward,
-}
-
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// The glTF scene (.gltf or .glb).
@@ -110,21 +90,8 @@ pub struct RenderArgs {
     /// Rendering method.
     #[arg(long, value_enum, default_value_t = Method::Ic)]
     method: Method,
-    /// Cache quality preset (`--method ic`).
-    #[arg(long, value_enum, default_value_t = Quality::Default)]
-    quality: Quality,
-    /// Cache interpolation weight (`--method ic`).
-    #[arg(long, value_enum)]
-    weight: Option<Weight>,
-    /// Cache accuracy: Ward's a, or 1/κ for Tabellion–Lamorlette (smaller is more accurate).
-    #[arg(long)]
-    accuracy: Option<f32>,
-    /// Jittered sub-frames of the cache (anti-aliasing); default 4.
-    #[arg(long)]
-    sub_frames: Option<u32>,
-    /// Direct-lighting samples per pixel and sub-frame (`--method ic`); default 16.
-    #[arg(long)]
-    direct_samples: Option<u32>,
+    #[command(flatten)]
+    ic: IcArgs,
     /// Samples per pixel (path tracer).
     #[arg(long, conflicts_with = "time_budget")]
     spp: Option<u32>,
@@ -256,9 +223,17 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
             let settings = IcSettings {
                 width,
                 height,
-                params: ic_params(args)?,
-                sub_frames: args.sub_frames.unwrap_or(4).max(1),
-                direct_samples: args.direct_samples.unwrap_or(16).max(1),
+                params: args.ic.params()?,
+                sub_frames: args
+                    .ic
+                    .sub_frames
+                    .unwrap_or(IcSettings::default().sub_frames)
+                    .max(1),
+                direct_samples: args
+                    .ic
+                    .direct_samples
+                    .unwrap_or(IcSettings::default().direct_samples)
+                    .max(1),
                 seed: args.seed,
                 frame: args.frame,
                 time: args.time,
@@ -318,7 +293,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     if let Some(stats) = &ic_stats {
         meta.extra.insert(
             "quality".into(),
-            format!("{:?}", args.quality).to_lowercase(),
+            format!("{:?}", args.ic.quality).to_lowercase(),
         );
         meta.extra
             .insert("records".into(), stats.records.to_string());
@@ -403,28 +378,6 @@ struct RunInfo {
     cpu_s: [f64; 3],
 }
 
-fn ic_params(args: &RenderArgs) -> Result<IcParams> {
-    let mut params = IcParams::preset(match args.quality {
-        Quality::Draft => Preset::Draft,
-        Quality::Default => Preset::Default,
-        Quality::High => Preset::High,
-    });
-    if let Some(w) = args.weight {
-        params.weight_kind = match w {
-            Weight::Tl => WeightKind::TabellionLamorlette,
-            Weight::Ward => WeightKind::Ward,
-        };
-    }
-    if let Some(a) = args.accuracy {
-        if !(a.is_finite() && a > 0.0) {
-            bail!("--accuracy must be a positive number, got {a}");
-        }
-        params.accuracy = a;
-        params.kappa = 1.0 / a;
-    }
-    Ok(params)
-}
-
 fn write_stats(
     path: &Path,
     args: &RenderArgs,
@@ -450,6 +403,7 @@ fn write_stats(
         frame["holes_left"] = json!(ic.holes_left);
         frame["dropped_requests"] = json!(ic.dropped_requests);
         frame["rejected_records"] = json!(ic.rejected_records);
+        frame["phases_wall_s"] = json!(ic.phases_s);
     }
     let value = json!({
         "scene": args.scene,

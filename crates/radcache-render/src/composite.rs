@@ -1,6 +1,13 @@
-//! Composite of the cache's sub-frames (`shaders/passes/composite.comp`): emission + direct +
-//! albedo/π × the normalised splat sum on surfaces, the environment elsewhere, accumulated over
-//! jittered sub-frames into a float buffer whose mean is the image.
+//! Composite of the cache's sub-frames (`shaders/passes/composite.comp`): direct + albedo/π × the
+//! normalised splat sum on surfaces, the environment along the jittered camera ray elsewhere,
+//! accumulated over jittered sub-frames into a float buffer whose mean is the image; the
+//! G-buffer's emission goes to its own accumulator, which the emission pass turns into the
+//! box-filtered emission it adds to the image.
+//!
+//! Bindings: the scene (0–13), the G-buffer (16–21), then from 22: the splat sum (Σw·Ẽ, Σw), the
+//! frame accumulator, the non-finite counter, the emission accumulator (read by
+//! [`crate::EmissionPass`], which adds the box-filtered emission), the debug accumulator and the
+//! splat record count. A non-finite value is replaced by 0 and counted.
 
 use bytemuck::{Pod, Zeroable};
 use radcache_vk::{

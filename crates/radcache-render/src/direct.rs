@@ -19,7 +19,8 @@ const RAYS: u32 = crate::bindings::PASS_BASE + GBUFFER_BINDINGS;
 struct Push {
     samples: u32,
     seed: u32,
-    pad: [u32; 2],
+    first_sample: u32,
+    pad: u32,
 }
 
 /// The direct-lighting pipeline and its ray counter.
@@ -60,13 +61,16 @@ impl DirectPass {
         Ok(DirectPass { pipeline, rays })
     }
 
-    /// Records `samples` estimates per pixel into the G-buffer's direct image.
+    /// Records `samples` estimates per pixel into the G-buffer's direct image: samples
+    /// `first_sample .. first_sample + samples` of the pixel's low-discrepancy sequence for the
+    /// frame's `seed` (sub-frames continue one sequence: pass `k × samples` for sub-frame k).
     pub fn record(
         &self,
         rec: &mut Recorder,
         scene: &GpuScene,
         gbuffer: &GBuffer,
         samples: u32,
+        first_sample: u32,
         seed: u32,
     ) -> Result<()> {
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
@@ -77,7 +81,8 @@ impl DirectPass {
         let push = Push {
             samples: samples.max(1),
             seed,
-            pad: [0; 2],
+            first_sample,
+            pad: 0,
         };
         let (w, h) = (gbuffer.width, gbuffer.height);
         rec.pass("direct", |rec| {

@@ -1,6 +1,11 @@
 //! G-buffer rasterization (`shaders/passes/gbuffer.vert` + `gbuffer.frag`): one draw per instance
 //! with vertex pulling, reversed-Z depth (cleared to 0, GREATER), no culling (both sides are drawn;
 //! the emission rule decides what a back face emits), and a sub-pixel jitter per sub-frame.
+//!
+//! Writes the five attachments of `shaders/common/gbuffer.glsl` (position, shading normal +
+//! footprint, geometric normal + material, albedo, emission), zero on the background, and clears
+//! the direct-light image. Reads the scene bindings 0–13 (vertex and fragment stages; nothing is
+//! written from the vertex stage).
 
 use bytemuck::{Pod, Zeroable};
 use radcache_vk::{
@@ -59,9 +64,12 @@ impl GBufferPass {
         Ok(GBufferPass { pipeline })
     }
 
-    /// Records the G-buffer of `scene`'s current view with sub-pixel `jitter` (pixels, each in
-    /// [−0.5, 0.5]), clearing everything first; the images are left ready for compute reads, the
-    /// direct-light image zeroed.
+    /// Records the G-buffer of `scene`'s current view, clearing everything first, in the profiler
+    /// scope `gbuffer`. `jitter` is where each pixel's sample lies relative to its centre (pixels,
+    /// each in [−0.5, 0.5]): pixel p holds the first hit of the camera ray through
+    /// p + 0.5 + `jitter` (`camera_ray(p, 0.5 + jitter)` in `shaders/common/path.glsl`). The
+    /// images are left ready for compute reads (`ImageUse::ComputeStorage`), the direct-light
+    /// image zeroed.
     pub fn record(
         &self,
         rec: &mut Recorder,

@@ -25,6 +25,22 @@ struct Push {
     pad: u32,
 }
 
+/// Levels of the neighbour grid (`LEVELS` in `shaders/passes/neighbours.comp`): cell sizes from
+/// 2^level_max down to 2^(level_max − 11); smaller radii use the finest level.
+pub const GRID_LEVELS: u32 = 12;
+/// Grid entries per record: one in table A, one per level in table B.
+pub const GRID_SLOTS: u32 = GRID_LEVELS + 1;
+
+/// Buckets of the neighbour grid for `record_capacity` records: the power of two at or above
+/// four per record (lists stay short), at least 1024.
+pub fn grid_buckets(record_capacity: u32) -> u32 {
+    record_capacity
+        .saturating_mul(4)
+        .checked_next_power_of_two()
+        .unwrap_or(1 << 31)
+        .max(1024)
+}
+
 /// Bookkeeping steps (see the shader).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Mode {
@@ -43,6 +59,11 @@ pub struct IcState {
     pub requests: Buffer,
     /// One `IcCounters` (host-readable).
     pub counters: Buffer,
+    /// Heads of the neighbour grid's bucket lists (`uint[GRID_BUCKETS]`, a power of two; see
+    /// `shaders/passes/neighbours.comp`).
+    pub grid_heads: Buffer,
+    /// The neighbour grid's list links, `GRID_SLOTS` per record.
+    pub grid_next: Buffer,
     record_capacity: u32,
     request_capacity: u32,
 }
@@ -105,6 +126,18 @@ impl IcState {
                 std::mem::size_of::<IcCounters>() as u64,
                 storage | vk::BufferUsageFlags::INDIRECT_BUFFER,
                 MemoryLocation::GpuToCpu,
+            )?,
+            grid_heads: buffer(
+                "ic.grid.heads",
+                u64::from(grid_buckets(record_capacity)) * 4,
+                storage | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            )?,
+            grid_next: buffer(
+                "ic.grid.next",
+                u64::from(record_capacity.max(1)) * u64::from(GRID_SLOTS) * 4,
+                storage,
+                MemoryLocation::GpuOnly,
             )?,
             record_capacity,
             request_capacity,

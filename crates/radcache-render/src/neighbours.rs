@@ -1,13 +1,34 @@
 //! Neighbour clamping (`shaders/passes/neighbours.comp`, IC reference §7.5) of the batch of records
-//! just created, dispatched indirectly with one workgroup per new record.
+//! just created, through a world-space hash grid kept on the GPU (`IcState::grid_heads`,
+//! `IcState::grid_next`): the batch is inserted, then each new record reads the 27 cells around
+//! it at its own level and the coarser ones, all with indirect dispatches (one workgroup per new
+//! record). The result equals the all-pairs clamp (see the shader), at a cost that grows with the
+//! number of nearby records instead of with all records.
 
+use bytemuck::{Pod, Zeroable};
 use radcache_vk::{
-    Access, BindingKind, BindingLayout, Context, Pipeline, Recorder, Resource, ShaderCompiler,
+    vk, Access, BindingKind, BindingLayout, Context, Pipeline, Recorder, Resource, ShaderCompiler,
 };
 
 use crate::bindings::PASS_BASE;
 use crate::error::Result;
 use crate::ic_state::IcState;
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Push {
+    mode: u32,
+    level_max: i32,
+    pad: [u32; 2],
+}
+
+/// The shader's steps.
+#[derive(Clone, Copy)]
+enum Mode {
+    InsertOld = 0,
+    InsertBatch = 1,
+    Clamp = 2,
+}
 
 /// The neighbour-clamping pipeline.
 pub struct NeighbourPass {
@@ -20,32 +41,101 @@ impl std::fmt::Debug for NeighbourPass {
     }
 }
 
+/// The grid's coarsest level for a scene of size `scene_scale` (its bounding-box diagonal):
+/// cells of 2^level ≥ 2 × the scale, so the 27 cells around any record hold every record of the
+/// scene at that level.
+pub fn grid_level_max(scene_scale: f32) -> i32 {
+    let s = if scene_scale.is_finite() && scene_scale > 0.0 {
+        scene_scale
+    } else {
+        1.0
+    };
+    (s.log2().ceil() as i32 + 1).clamp(-100, 100)
+}
+
 impl NeighbourPass {
     /// Compiles the pass.
     pub fn new(ctx: &Context, shaders: &ShaderCompiler) -> Result<NeighbourPass> {
         let spirv = shaders.compile("passes/neighbours.comp", &[])?;
-        let bindings = [
-            BindingLayout::new(PASS_BASE, BindingKind::StorageBuffer),
-            BindingLayout::new(PASS_BASE + 1, BindingKind::StorageBuffer),
-            BindingLayout::new(PASS_BASE + 2, BindingKind::StorageBuffer),
-        ];
-        let pipeline = Pipeline::compute(ctx, "neighbours", &spirv, &bindings, 0)?;
+        let bindings: Vec<BindingLayout> = (0..5)
+            .map(|k| BindingLayout::new(PASS_BASE + k, BindingKind::StorageBuffer))
+            .collect();
+        let pipeline = Pipeline::compute(
+            ctx,
+            "neighbours",
+            &spirv,
+            &bindings,
+            std::mem::size_of::<Push>() as u32,
+        )?;
         Ok(NeighbourPass { pipeline })
     }
 
-    /// Records clamping the new batch against every record (after `IcState::record_end_batch`).
-    pub fn record(&self, rec: &mut Recorder, state: &IcState) -> Result<()> {
+    fn bind(&self, rec: &mut Recorder, state: &IcState, mode: Mode, scene_scale: f32) {
+        rec.bind_pipeline(&self.pipeline);
+        rec.push_bindings(&[
+            (PASS_BASE, Resource::Buffer(&state.counters)),
+            (PASS_BASE + 1, Resource::Buffer(&state.records)),
+            (PASS_BASE + 2, Resource::Buffer(&state.records)),
+            (PASS_BASE + 3, Resource::Buffer(&state.grid_heads)),
+            (PASS_BASE + 4, Resource::Buffer(&state.grid_next)),
+        ]);
+        rec.push_constants(&Push {
+            mode: mode as u32,
+            level_max: grid_level_max(scene_scale),
+            pad: [0; 2],
+        });
+    }
+
+    /// Records rebuilding the grid from every record outside the pending batch (the batch is
+    /// inserted by [`NeighbourPass::record`]); needed whenever records were added, moved or
+    /// removed other than through this pass, e.g. at the start of a frame. `scene_scale` must be
+    /// the one later batches use.
+    pub fn record_rebuild(
+        &self,
+        rec: &mut Recorder,
+        state: &IcState,
+        scene_scale: f32,
+    ) -> Result<()> {
+        rec.barrier(Access::ALL_WRITES, Access::TRANSFER_WRITE);
+        rec.fill_buffer(&state.grid_heads, 0, vk::WHOLE_SIZE, 0);
+        rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
+        rec.pass("neighbours.grid", |rec| -> Result<()> {
+            self.bind(rec, state, Mode::InsertOld, scene_scale);
+            rec.dispatch(state.record_capacity().div_ceil(64).max(1), 1, 1)?;
+            Ok(())
+        })?;
+        rec.barrier(Access::COMPUTE_WRITE, Access::ALL);
+        Ok(())
+    }
+
+    /// Records clamping the new batch against every record (after `IcState::record_end_batch`):
+    /// the batch's radii are capped at their R⁺ and inserted into the grid, then clamped.
+    pub fn record(&self, rec: &mut Recorder, state: &IcState, scene_scale: f32) -> Result<()> {
         rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
         rec.pass("neighbours", |rec| {
-            rec.bind_pipeline(&self.pipeline);
-            rec.push_bindings(&[
-                (PASS_BASE, Resource::Buffer(&state.counters)),
-                (PASS_BASE + 1, Resource::Buffer(&state.records)),
-                (PASS_BASE + 2, Resource::Buffer(&state.records)),
-            ]);
+            self.bind(rec, state, Mode::InsertBatch, scene_scale);
+            rec.dispatch_indirect(&state.counters, 16);
+            rec.barrier(Access::COMPUTE_WRITE, Access::COMPUTE_READ_WRITE);
+            self.bind(rec, state, Mode::Clamp, scene_scale);
             rec.dispatch_indirect(&state.counters, 16);
         });
         rec.barrier(Access::COMPUTE_WRITE, Access::ALL);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::grid_level_max;
+
+    #[test]
+    fn the_coarsest_cells_hold_the_whole_scene() {
+        for scale in [1e-3f32, 0.7, 1.0, 3.0, 555.0, 1e4] {
+            let l = grid_level_max(scale);
+            assert!(2f32.powi(l) >= 2.0 * scale, "{scale}: {l}");
+            assert!(2f32.powi(l) < 8.0 * scale, "{scale}: {l}");
+        }
+        assert_eq!(grid_level_max(f32::NAN), 1);
+        assert_eq!(grid_level_max(0.0), 1);
     }
 }

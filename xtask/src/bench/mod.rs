@@ -6,6 +6,7 @@
 mod ic;
 mod pt;
 mod rays;
+mod scene_rays;
 
 use anyhow::{bail, Result};
 

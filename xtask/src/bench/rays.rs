@@ -21,11 +21,11 @@ use crate::results::{append, Figure};
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuRay {
-    origin: [f32; 3],
-    tmin: f32,
-    dir: [f32; 3],
-    tmax: f32,
+pub(super) struct GpuRay {
+    pub(super) origin: [f32; 3],
+    pub(super) tmin: f32,
+    pub(super) dir: [f32; 3],
+    pub(super) tmax: f32,
 }
 
 #[repr(C)]
@@ -128,7 +128,7 @@ fn hemisphere_rays(s: &Scene, n: usize) -> Vec<GpuRay> {
         .collect()
 }
 
-fn trace(ctx: &Context, pipe: &Pipeline, tlas: &Tlas, rays: &[GpuRay]) -> Result<f64> {
+pub(super) fn trace(ctx: &Context, pipe: &Pipeline, tlas: &Tlas, rays: &[GpuRay]) -> Result<f64> {
     let ray_buf =
         ctx.create_buffer_init("bench.rays", vk::BufferUsageFlags::STORAGE_BUFFER, rays)?;
     let hits = Buffer::new(

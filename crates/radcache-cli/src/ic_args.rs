@@ -1,0 +1,116 @@
+//! The cache's options of `radcache render` (`--method ic`): a quality preset, then any of its
+//! parameters overridden one by one.
+
+use anyhow::{bail, Context as _, Result};
+use clap::{Args, ValueEnum};
+use radcache_cache::{IcParams, Preset, WeightKind};
+
+/// Cache quality preset.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Quality {
+    /// Fast previews (a = 0.3, 8×24 strata).
+    Draft,
+    /// The default (a = 0.15, 16×48 strata).
+    Default,
+    /// Offline quality (a = 0.1, 24×72 strata).
+    High,
+}
+
+/// Interpolation weight of the cache.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Weight {
+    /// Tabellion–Lamorlette (default): bounded, continuous at the zone's edge.
+    Tl,
+    /// Ward's split-sphere weight.
+    Ward,
+}
+
+/// The cache's command-line options.
+#[derive(Args, Debug)]
+pub struct IcArgs {
+    /// Cache quality preset (`--method ic`).
+    #[arg(long, value_enum, default_value_t = Quality::Default)]
+    pub quality: Quality,
+    /// Cache interpolation weight (`--method ic`).
+    #[arg(long, value_enum)]
+    pub weight: Option<Weight>,
+    /// Cache accuracy: Ward's a, or 1/κ for Tabellion–Lamorlette (smaller is more accurate).
+    #[arg(long)]
+    pub accuracy: Option<f32>,
+    /// Hemisphere strata of a record, polar × azimuthal (`--strata 16x48`); M·N ≤ 1728.
+    #[arg(long, value_name = "MxN")]
+    pub strata: Option<String>,
+    /// Record validity radius bounds R⁻,R⁺ in pixels (`--spacing 2,20`).
+    #[arg(long, value_name = "MIN,MAX")]
+    pub spacing: Option<String>,
+    /// Σw (in units of one full record) below which a pixel is a hole that gets a record.
+    #[arg(long)]
+    pub hole_threshold: Option<f32>,
+    /// Jittered sub-frames of the cache (anti-aliasing); default 8.
+    #[arg(long)]
+    pub sub_frames: Option<u32>,
+    /// Direct-lighting samples per pixel and sub-frame (`--method ic`; one ray each); default 16.
+    #[arg(long)]
+    pub direct_samples: Option<u32>,
+}
+
+fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T)> {
+    let (a, b) = text
+        .split_once(sep)
+        .with_context(|| format!("{flag} {text:?}: expected two values separated by {sep:?}"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<T>()
+            .ok()
+            .with_context(|| format!("{flag} {text:?}: {v:?} is not a number"))
+    };
+    Ok((parse(a)?, parse(b)?))
+}
+
+impl IcArgs {
+    /// The cache parameters: the preset with the overrides applied, checked.
+    pub fn params(&self) -> Result<IcParams> {
+        let mut params = IcParams::preset(match self.quality {
+            Quality::Draft => Preset::Draft,
+            Quality::Default => Preset::Default,
+            Quality::High => Preset::High,
+        });
+        if let Some(w) = self.weight {
+            params.weight_kind = match w {
+                Weight::Tl => WeightKind::TabellionLamorlette,
+                Weight::Ward => WeightKind::Ward,
+            };
+        }
+        if let Some(a) = self.accuracy {
+            if !(a.is_finite() && a > 0.0) {
+                bail!("--accuracy must be a positive number, got {a}");
+            }
+            params.accuracy = a;
+            params.kappa = 1.0 / a;
+        }
+        if let Some(text) = &self.strata {
+            let (m, n) = pair::<u32>(&text.to_lowercase(), 'x', "--strata")?;
+            if m < 1 || n < 3 || m * n > 1728 {
+                bail!("--strata {text}: need M ≥ 1, N ≥ 3 and M·N ≤ 1728");
+            }
+            (params.strata_m, params.strata_n) = (m, n);
+        }
+        if let Some(text) = &self.spacing {
+            let (lo, hi) = pair::<f32>(text, ',', "--spacing")?;
+            if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && lo <= hi) {
+                bail!("--spacing {text}: need 0 < MIN ≤ MAX");
+            }
+            (params.min_spacing_px, params.max_spacing_px) = (lo, hi);
+        }
+        if let Some(t) = self.hole_threshold {
+            if !(t.is_finite() && (0.0..=1.0).contains(&t)) {
+                bail!("--hole-threshold must lie in [0, 1], got {t}");
+            }
+            params.hole_threshold = t;
+        }
+        if !params.is_valid() {
+            bail!("invalid cache parameters: {params:?}");
+        }
+        Ok(params)
+    }
+}

@@ -1,0 +1,361 @@
+//! The cache's direct-lighting and composite passes on lavapipe: direct light against closed
+//! forms (point light, constant sky) and independent estimates (a CPU light-sampling estimate on
+//! the Cornell box, the furnace), and the composite's sums, sub-frame mean and guard.
+
+use std::f64::consts::PI;
+
+use glam::{DVec3, Quat, Vec3};
+use radcache_render::{CompositePass, DirectPass, EmissionPass, EnvMap, SplatPass};
+use radcache_scene::light::LightKind;
+use radcache_scene::writer::{GltfBuilder, LightDesc, MaterialDesc, NodeDesc};
+use radcache_scene::{Environment, Scene};
+use radcache_tests::ic_fixture::*;
+use radcache_tests::scenes::{
+    camera_node, load, mean_se, pixel_to_ndc, plane_y, temp_dir, write_and_load,
+};
+use radcache_tests::Rng;
+use radcache_vk::ImageUse;
+
+const ALBEDO: [f32; 3] = [0.8, 0.5, 0.25];
+
+/// A diffuse plane (albedo [`ALBEDO`], facing up) seen from above, its far side beyond the image's
+/// top rows (background there), with an optional point light (position, cd) and constant sky.
+fn plane_scene(name: &str, light: Option<(Vec3, f32)>, sky: Option<[f32; 3]>) -> Scene {
+    let mut b = GltfBuilder::new();
+    let mat = b.add_material(&MaterialDesc::diffuse("plane", ALBEDO));
+    let mesh = b.add_mesh("plane", &[plane_y([-4.0, 4.0], [-3.0, 3.0], 0.0, mat)]);
+    let mut roots = vec![b.add_node(&NodeDesc {
+        mesh: Some(mesh),
+        ..NodeDesc::default()
+    })];
+    let rotation = Quat::from_rotation_x(-0.6);
+    roots.push(camera_node(&mut b, Vec3::new(0.0, 2.0, 3.0), rotation, 0.7));
+    if let Some((position, intensity)) = light {
+        let kind = LightKind::Point;
+        let desc = LightDesc {
+            name: None,
+            kind,
+            color: [1.0; 3],
+            intensity,
+            range: None,
+        };
+        let l = b.add_light(&desc);
+        roots.push(b.add_node(&NodeDesc {
+            translation: Some(position.to_array()),
+            light: Some(l),
+            ..NodeDesc::default()
+        }));
+    }
+    let extras = sky.map(|l| serde_json::json!({"environment": {"radiance": l}}));
+    b.add_scene(name, &roots, extras);
+    write_and_load(&b, &temp_dir(name), name)
+}
+
+#[test]
+fn direct_light_matches_a_point_light_and_a_constant_sky() {
+    let (light, intensity, sky) = (Vec3::new(0.3, 1.5, 0.2), 5.0, [0.5, 1.0, 2.0]);
+    let albedo = Vec3::from(ALBEDO).as_dvec3();
+    for (name, point) in [("ic-passes-point", true), ("ic-passes-sky", false)] {
+        let scene = plane_scene(
+            name,
+            point.then_some((light, intensity)),
+            (!point).then_some(sky),
+        );
+        let gpu = Gpu::new(&scene, None, (32, 24));
+        let direct = DirectPass::new(&gpu.ctx, &gpu.shaders, &gpu.scene).unwrap();
+        let samples = 4;
+        let scopes = gpu.render([0.1, 0.2], Some((&direct, samples, 7)));
+        assert!(scopes.iter().any(|s| s == "direct"), "{scopes:?}");
+        let position = gpu.read(&gpu.gbuffer.position);
+        let out = gpu.read(&gpu.gbuffer.direct);
+        let mut surfaces = 0;
+        for (i, (p, d)) in position.iter().zip(&out).enumerate() {
+            let expected = if p[3] == 0.0 {
+                DVec3::ZERO
+            } else if point {
+                // ρ/π · I · cosθ / d², exact: a punctual light has no randomness.
+                let to = light.as_dvec3() - xyz(*p);
+                let d2 = to.length_squared();
+                albedo / PI * f64::from(intensity) * (to.y / d2.sqrt()) / d2
+            } else {
+                // Every cosine-sampled ray sees the sky with weight 1: exactly ρ·L.
+                albedo * Vec3::from(sky).as_dvec3()
+            };
+            surfaces += u64::from(p[3] != 0.0);
+            let tol = 1e-5 * expected.max_element() + 1e-9;
+            close("direct", i, xyz(*d), expected, tol);
+        }
+        assert!(
+            surfaces > 100 && surfaces < 32 * 24,
+            "{surfaces} surface pixels"
+        );
+        // The point light: one shadow ray per pixel, no sampling (nothing to sample); the sky:
+        // one BSDF ray per sample (only BSDF sampling finds a constant environment).
+        let expected_rays = if point {
+            surfaces
+        } else {
+            surfaces * u64::from(samples)
+        };
+        assert_eq!(direct.rays().unwrap(), expected_rays);
+        drop(direct);
+        gpu.end();
+    }
+}
+
+/// ρ/π × the irradiance from emissive triangles at the G-buffer's points: `m` uniform area
+/// samples of the emitters per pixel with CPU visibility (no MIS: independent of the GPU's).
+fn cpu_direct(scene: &Scene, g: &GRead, m: usize) -> Vec<DVec3> {
+    let tris = world_triangles(scene);
+    let emission = |t: &Tri| scene.material_emission[t.material as usize].as_dvec3();
+    let lights: Vec<&Tri> = tris
+        .iter()
+        .filter(|t| emission(t).max_element() > 0.0)
+        .collect();
+    let area = |t: &Tri| 0.5 * (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).length() as f64;
+    let total: f64 = lights.iter().map(|t| area(t)).sum();
+    let mut rng = Rng::new(5);
+    let mut next = || f64::from(rng.f32());
+    let mut out = vec![DVec3::ZERO; g.position.len()];
+    for (i, value) in out
+        .iter_mut()
+        .enumerate()
+        .filter(|(i, _)| g.position[*i][3] > 0.0)
+    {
+        let (p, n) = (xyz(g.position[i]), xyz(g.geometric[i]));
+        let mut sum = DVec3::ZERO;
+        for _ in 0..m {
+            let mut pick = next() * total;
+            let t = lights.iter().find(|t| {
+                pick -= area(t);
+                pick < 0.0
+            });
+            let t = t.unwrap_or(&lights[lights.len() - 1]);
+            let (mut a, mut b) = (next(), next());
+            if a + b > 1.0 {
+                (a, b) = (1.0 - a, 1.0 - b);
+            }
+            let [p0, p1, p2] = t.p.map(|v| v.as_dvec3());
+            let to = p0 * (1.0 - a - b) + p1 * a + p2 * b - p;
+            let dist = to.length();
+            let dir = to / dist;
+            let cos_l = -t.front.dot(dir);
+            let cos_l = if scene.materials[t.material as usize].double_sided {
+                cos_l.abs()
+            } else {
+                cos_l
+            };
+            let cos_s = n.dot(dir);
+            if cos_s > 0.0
+                && cos_l > 0.0
+                && cast(&tris, p + n * 1e-5, dir, dist * (1.0 - 1e-4)).is_none()
+            {
+                sum += emission(t) * cos_s * cos_l / (dist * dist) * total;
+            }
+        }
+        *value = xyz(g.albedo[i]) / PI * sum / m as f64;
+    }
+    out
+}
+
+/// |mean(a − b)| over `pixels` within 5 standard errors, per channel.
+fn agree(what: &str, a: &[DVec3], b: &[DVec3], pixels: &[usize]) {
+    for c in 0..3 {
+        let d: Vec<f64> = pixels.iter().map(|&i| a[i][c] - b[i][c]).collect();
+        let m = mean_se(&d);
+        let scale = pixels.iter().map(|&i| b[i][c]).sum::<f64>() / pixels.len() as f64;
+        eprintln!(
+            "{what} channel {c}: mean difference {:.3e} ± {:.3e} (mean {scale:.4})",
+            m.mean, m.se
+        );
+        assert!(
+            m.mean.abs() <= 5.0 * m.se + 1e-5 * scale,
+            "{what} channel {c}: {m:?}"
+        );
+    }
+}
+
+#[test]
+fn direct_light_is_unbiased_on_the_cornell_box() {
+    let scene = cornell();
+    let gpu = Gpu::new(&scene, None, (16, 16));
+    let direct = DirectPass::new(&gpu.ctx, &gpu.shaders, &gpu.scene).unwrap();
+    let mut runs = Vec::new();
+    for (samples, seed) in [(4, 11), (256, 12)] {
+        gpu.render([0.0; 2], Some((&direct, samples, seed)));
+        runs.push(
+            gpu.read(&gpu.gbuffer.direct)
+                .into_iter()
+                .map(xyz)
+                .collect::<Vec<_>>(),
+        );
+        let rays = direct.rays().unwrap();
+        assert!(
+            rays > 0 && rays <= 2 * 256 * u64::from(samples),
+            "{rays} rays"
+        );
+    }
+    let g = gpu.read_gbuffer();
+    let cpu = cpu_direct(&scene, &g, 256);
+    let pixels: Vec<usize> = (0..256).filter(|&i| g.position[i][3] > 0.0).collect();
+    assert!(pixels.len() > 200, "{} surface pixels", pixels.len());
+    agree("4 samples vs CPU", &runs[0], &cpu, &pixels);
+    agree("256 samples vs CPU", &runs[1], &cpu, &pixels);
+    agree("4 vs 256 samples", &runs[0], &runs[1], &pixels);
+    drop(direct);
+    gpu.end();
+}
+
+#[test]
+fn direct_light_in_the_furnace_is_albedo_times_emission() {
+    let (albedo, le) = (0.5, 1.0);
+    let dir = temp_dir("ic-passes-furnace");
+    let scene = load(&radcache_scene::assets::write_furnace(&dir, albedo, le).unwrap());
+    let gpu = Gpu::new(&scene, None, (16, 16));
+    let direct = DirectPass::new(&gpu.ctx, &gpu.shaders, &gpu.scene).unwrap();
+    gpu.render([0.0; 2], Some((&direct, 4, 3)));
+    let out = gpu.read(&gpu.gbuffer.direct);
+    // Every direction sees an emitting wall: irradiance π·Le, direct ρ/π · π·Le = ρ·Le.
+    let expected = f64::from(albedo * le);
+    for c in 0..3 {
+        let values: Vec<f64> = out.iter().map(|p| f64::from(p[c])).collect();
+        assert!(values.iter().all(|v| v.is_finite() && *v >= 0.0));
+        let m = mean_se(&values);
+        assert!(
+            (m.mean - expected).abs() <= 5.0 * m.se + 1e-5,
+            "channel {c}: {m:?}, expected {expected}"
+        );
+    }
+    drop(direct);
+    gpu.end();
+}
+
+/// Texel of an equirectangular `w × h` map seen along `d`, unless `d` is within 10⁻³ texel of a
+/// texel edge (where f32 and f64 may disagree).
+fn env_texel(d: DVec3, w: u32, h: u32) -> Option<usize> {
+    let u = (0.5 + d.x.atan2(-d.z) / (2.0 * PI)) * f64::from(w);
+    let v = d.y.clamp(-1.0, 1.0).acos() / PI * f64::from(h);
+    let edge = |x: f64| (x - x.round()).abs() < 1e-3;
+    (!edge(u) && !edge(v)).then(|| v.floor() as usize * w as usize + u.floor() as usize)
+}
+
+#[test]
+fn composite_sums_direct_indirect_emission_and_environment() {
+    let mut scene = faces_scene();
+    let (ew, eh, env_scale) = (8, 4, 1.5);
+    let texels: Vec<[f32; 3]> = (0..ew * eh)
+        .map(|i| {
+            [
+                0.1 * (i % ew + 1) as f32,
+                0.3 * (i / ew + 1) as f32,
+                0.05 * i as f32,
+            ]
+        })
+        .collect();
+    let map = EnvMap::from_rgb(std::path::Path::new("sky"), ew, eh, texels.clone()).unwrap();
+    scene.environment = Environment::Map {
+        path: "sky".into(),
+        scale: env_scale,
+    };
+    let (w, h) = (40, 32);
+    let gpu = Gpu::new(&scene, Some(&map), (w, h));
+    let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
+    let direct = DirectPass::new(ctx, shaders, &gpu.scene).unwrap();
+    let splat = SplatPass::new(ctx, shaders, w, h).unwrap();
+    let composite = CompositePass::new(ctx, shaders, &gpu.scene, w, h).unwrap();
+    let emission = EmissionPass::new(ctx, shaders, &gpu.scene).unwrap();
+    let jitter = [0.2, -0.3];
+    gpu.render(jitter, Some((&direct, 4, 9)));
+    let g = gpu.read_gbuffer();
+    let lit = gpu.read(&gpu.gbuffer.direct);
+    // One sub-frame with a constant splat sum (Σw·Ẽ, Σw) in every pixel.
+    let sub_frame = |sum: Px, clear: bool| {
+        let mut rec = ctx.begin("test.composite").unwrap();
+        if clear {
+            composite.record_clear(&mut rec);
+        }
+        for (image, value) in [(&splat.sum, sum), (&splat.count, [0.0; 4])] {
+            rec.use_image(image, ImageUse::TransferDst);
+            rec.clear_color(image, value);
+        }
+        composite
+            .record(&mut rec, &gpu.scene, &gpu.gbuffer, &splat, jitter, false)
+            .unwrap();
+        names(&ctx.submit(rec).unwrap().wait().unwrap())
+    };
+    // No record reaches any pixel (Σw = 0: no indirect light), then Ẽ = (1, 2, 3) everywhere.
+    sub_frame([0.0; 4], true);
+    let scopes = sub_frame([2.0, 4.0, 6.0, 2.0], false);
+    assert!(scopes.iter().any(|s| s == "composite"), "{scopes:?}");
+    let (mean, bad) = composite.read_mean(ctx).unwrap();
+    assert_eq!(bad, 0);
+    let view = scene.camera_at(0.0);
+    let (mut surfaces, mut sky) = (0, 0);
+    for (i, m) in mean.iter().enumerate() {
+        let m = DVec3::from(m.map(f64::from));
+        if g.position[i][3] > 0.0 {
+            let indirect = xyz(g.albedo[i]) / PI * DVec3::new(1.0, 2.0, 3.0) * 0.5;
+            close(
+                "surface",
+                i,
+                m,
+                xyz(lit[i]) + indirect,
+                1e-5 * (m.max_element() + 1.0),
+            );
+            surfaces += 1;
+        } else {
+            let sx = f64::from(i as u32 % w) + 0.5 + f64::from(jitter[0]);
+            let sy = f64::from(i as u32 / w) + 0.5 + f64::from(jitter[1]);
+            let (nx, ny) = pixel_to_ndc(sx, sy, w, h);
+            let d = view.ray_direction(nx, ny, w as f32 / h as f32).as_dvec3();
+            if let Some(t) = env_texel(d, ew, eh) {
+                let expected = Vec3::from(texels[t]).as_dvec3() * f64::from(env_scale);
+                close("environment", i, m, expected, 1e-5 * expected.max_element());
+                sky += 1;
+            }
+        }
+    }
+    assert!(
+        surfaces > 500 && sky > 100,
+        "{surfaces} surface and {sky} sky pixels"
+    );
+    // The emission pass adds the box-filtered emission: nothing away from emitters, the exact
+    // radiance where the pixel and its 8 neighbours all see the same emitting face.
+    let mut rec = ctx.begin("test.emission").unwrap();
+    emission.record(&mut rec, &gpu.scene, &composite).unwrap();
+    ctx.submit(rec).unwrap().wait().unwrap();
+    let (with_emission, _) = composite.read_mean(ctx).unwrap();
+    let (mut dark, mut inside) = (0, 0);
+    for i in 0..(w * h) as usize {
+        let (x, y) = ((i as u32 % w) as i64, (i as u32 / w) as i64);
+        let block: Vec<usize> = (-1..=1)
+            .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
+            .filter(|&(a, b)| a >= 0 && b >= 0 && a < i64::from(w) && b < i64::from(h))
+            .map(|(a, b)| (b * i64::from(w) + a) as usize)
+            .collect();
+        let key = |j: usize| (g.geometric[j], g.emission[j]);
+        let added =
+            DVec3::from(with_emission[i].map(f64::from)) - DVec3::from(mean[i].map(f64::from));
+        let tol = 1e-5 * (DVec3::from(mean[i].map(f64::from)).max_element() + 10.0);
+        if block.iter().all(|&j| xyz(g.emission[j]) == DVec3::ZERO) {
+            close("no emission", i, added, DVec3::ZERO, 0.0);
+            dark += 1;
+        } else if block.len() == 9 && block.iter().all(|&j| key(j) == key(i)) {
+            close("emission", i, added, xyz(g.emission[i]), tol);
+            inside += 1;
+        }
+    }
+    assert!(
+        dark > 500 && inside > 10,
+        "{dark} dark and {inside} emitting pixels checked"
+    );
+    // A non-finite splat sum: every surface pixel is dropped (0) and counted, the sky unchanged.
+    sub_frame([f32::INFINITY, f32::INFINITY, f32::INFINITY, 1.0], true);
+    let (guarded, bad) = composite.read_mean(ctx).unwrap();
+    assert_eq!(bad, surfaces as u64);
+    for (i, (a, b)) in guarded.iter().zip(&mean).enumerate() {
+        let expected = if g.position[i][3] > 0.0 { [0.0; 3] } else { *b };
+        assert_eq!(*a, expected, "pixel {i}");
+    }
+    drop((direct, splat, composite, emission));
+    gpu.end();
+}
