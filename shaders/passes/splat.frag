@@ -34,6 +34,10 @@ void main() {
                                     rec.grad_r_blue.xyz, att * rec.grad_t_red.xyz,
                                     att * rec.grad_t_green.xyz, att * rec.grad_t_blue.xyz,
                                     g.position, g.normal, p_i, n_i);
+    if (pc.mark_frame != 0u) {
+        // Every writer stores the same value: the race is benign.
+        last_used[v_record] = pc.mark_frame;
+    }
     o_sum = vec4(w * e, w);
     o_count = 1.0;
 }

@@ -1,10 +1,13 @@
 //! `radcache`: render glTF scenes with global illumination, inspect them, compare images.
 
 mod compare;
+mod flicker;
+mod frame;
 mod ic_args;
 mod info;
 mod progress;
 mod render;
+mod sequence;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -25,11 +28,13 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Render a scene to an EXR (and optionally a PNG preview).
-    Render(render::RenderArgs),
+    Render(Box<render::RenderArgs>),
     /// Print a scene's summary and the plan of what its frames need.
     Info(info::InfoArgs),
     /// Compare a candidate image against a reference (RMSE, relMSE, MAE, block RMSE, FLIP, ...).
     Compare(compare::CompareArgs),
+    /// Measure the flicker of an EXR sequence, against a reference sequence or over static pixels.
+    Flicker(flicker::FlickerArgs),
 }
 
 /// Where the GLSL sources live: `RADCACHE_SHADERS`, else the source tree this binary was built
@@ -56,6 +61,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render::run(&args),
         Command::Info(args) => info::run(&args),
         Command::Compare(args) => compare::run(&args),
+        Command::Flicker(args) => flicker::run(&args),
     };
     match result {
         Ok(code) => code,

@@ -1,4 +1,6 @@
-//! `radcache render SCENE -o OUT.exr`: load, upload, render, write.
+//! `radcache render SCENE -o OUT.exr`: load, upload, render, write; one frame or a sequence
+//! (`-o out/frame_####.exr --frames 1..120`), resumable, with the cache kept across frames
+//! where the plan allows.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -6,19 +8,17 @@ use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
-use radcache_image::{
-    png_beside, write_exr, write_png, ExrOptions, Image, Layer, Metadata, PngOptions, ToneMap,
-};
-use radcache_render::{
-    render_aovs, render_ic, render_path, vulkan_clip_from_view, Budget, EnvMap, GpuScene,
-    IcSettings, IcStats, PathSettings,
-};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+use radcache_render::{Budget, EnvMap, GpuScene};
 use radcache_scene::{EnvOverride, Environment, LoadOptions, Scene};
 use radcache_vk::{Context, ShaderCompiler};
 use serde_json::json;
 
+use crate::frame::{self, FrameSetup};
 use crate::ic_args::IcArgs;
-use crate::progress::ProgressLine;
+use crate::sequence::{FrameArgs, Sequence, SequenceProgress};
 
 /// Environment overrides shared by `render` and `info`.
 #[derive(Args, Debug, Clone)]
@@ -80,63 +80,81 @@ pub enum Method {
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// The glTF scene (.gltf or .glb).
-    scene: PathBuf,
+    pub(crate) scene: PathBuf,
     /// Output EXR (or .png for a PNG only); `####` is replaced by the frame number.
     #[arg(short, long)]
-    output: PathBuf,
+    pub(crate) output: PathBuf,
     /// Image size WxH; default 512 pixels high at the camera's aspect ratio.
     #[arg(long, value_name = "WxH")]
-    resolution: Option<String>,
+    pub(crate) resolution: Option<String>,
     /// Rendering method.
     #[arg(long, value_enum, default_value_t = Method::Ic)]
-    method: Method,
+    pub(crate) method: Method,
     #[command(flatten)]
-    ic: IcArgs,
+    pub(crate) ic: IcArgs,
     /// Samples per pixel (path tracer).
     #[arg(long, conflicts_with = "time_budget")]
-    spp: Option<u32>,
+    pub(crate) spp: Option<u32>,
     /// Sample until this many seconds have passed instead of a fixed spp.
     #[arg(long, value_name = "SECONDS")]
-    time_budget: Option<f64>,
+    pub(crate) time_budget: Option<f64>,
     /// Seed of the random sequences.
     #[arg(long, default_value_t = 0)]
-    seed: u32,
-    /// Scene time in seconds (for animated scenes).
-    #[arg(long, default_value_t = 0.0)]
-    time: f32,
-    /// Frame number (for `####` in the output path and the stats).
-    #[arg(long, default_value_t = 1)]
-    frame: u32,
+    pub(crate) seed: u32,
+    /// Scene time in seconds of a single frame (default: from the frame number, see `--fps`).
+    #[arg(long)]
+    pub(crate) time: Option<f32>,
+    /// Render this one frame (the number replaces `####` in the output path).
+    #[arg(long)]
+    pub(crate) frame: Option<u32>,
+    /// Render a sequence: frames A..B inclusive (`####` in the output path); default with a
+    /// pattern on an animated scene: the animation's own range.
+    #[arg(long, value_name = "A..B")]
+    pub(crate) frames: Option<String>,
+    /// Frames per second: frame f shows the scene at start + (f − first)/fps.
+    #[arg(long, default_value_t = 24.0)]
+    pub(crate) fps: f32,
+    /// Scene time of the first frame (default: the animation's first key, else 0).
+    #[arg(long)]
+    pub(crate) start_time: Option<f32>,
+    /// Render frames again that are already on disk (a sequence skips them otherwise, so an
+    /// interrupted run resumes where it stopped).
+    #[arg(long)]
+    pub(crate) overwrite: bool,
+    /// Rebuild the cache every frame instead of keeping its records (static scenes and
+    /// camera-only animation keep them by default).
+    #[arg(long)]
+    pub(crate) no_temporal: bool,
     /// Use the camera with this name instead of the scene's first.
     #[arg(long)]
-    camera: Option<String>,
+    pub(crate) camera: Option<String>,
     #[command(flatten)]
-    env: EnvArgs,
+    pub(crate) env: EnvArgs,
     /// Write per-frame statistics as JSON.
     #[arg(long, value_name = "FILE.json")]
-    stats: Option<PathBuf>,
+    pub(crate) stats: Option<PathBuf>,
     /// Store half floats in the EXR.
     #[arg(long)]
-    half: bool,
+    pub(crate) half: bool,
     /// Add albedo, normal and depth layers to the EXR.
     #[arg(long)]
-    aov: bool,
+    pub(crate) aov: bool,
     /// Add the cache's debug layers to the EXR: `ic_indirect` (indirect radiance only),
     /// `ic_weight` (Σw), `ic_records` (records per pixel), `ic_positions` (record positions).
     #[arg(long)]
-    debug_aov: bool,
+    pub(crate) debug_aov: bool,
     /// Also write a PNG preview beside the EXR.
     #[arg(long)]
-    png: bool,
+    pub(crate) png: bool,
     /// Exposure of the PNG preview, in stops.
     #[arg(long, default_value_t = 0.0)]
-    exposure: f32,
+    pub(crate) exposure: f32,
     /// Tone curve of the PNG preview.
     #[arg(long, default_value = "none", value_parser = ["none", "filmic"])]
-    tonemap: String,
+    pub(crate) tonemap: String,
     /// No progress line.
     #[arg(long, short)]
-    quiet: bool,
+    pub(crate) quiet: bool,
 }
 
 fn parse_resolution(text: &str) -> Result<(u32, u32)> {
@@ -165,11 +183,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         (Some(n), None) => Budget::Samples(n),
         (None, None) => Budget::Samples(64),
     };
-    let output = radcache_image::frame_path(&args.output, args.frame)
-        .unwrap_or_else(|_| args.output.clone());
-    let png_only = output
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    let pattern = args.output.to_string_lossy().contains('#');
 
     let t_load = Instant::now();
     let opts = LoadOptions {
@@ -185,9 +199,21 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         _ => None,
     };
     let load_s = t_load.elapsed().as_secs_f64();
+    let plan = scene.plan();
+    let sequence = Sequence::new(
+        &FrameArgs {
+            frames: args.frames.as_deref(),
+            frame: args.frame,
+            time: args.time,
+            start_time: args.start_time,
+            fps: args.fps,
+            pattern,
+        },
+        plan.animation.time_range,
+    )?;
 
-    let view = scene.camera_at(args.time);
-    let (width, height) = match &args.resolution {
+    let view = scene.camera_at(sequence.frames[0].1);
+    let size = match &args.resolution {
         Some(r) => parse_resolution(r)?,
         None => {
             let aspect = view.perspective.aspect_or(1.0);
@@ -200,220 +226,134 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let t_upload = Instant::now();
     let mut gpu = GpuScene::new(&ctx, &scene, env_map.as_ref())?;
     let upload_s = t_upload.elapsed().as_secs_f64();
-    let (out, ic_stats) = match args.method {
-        Method::Path => {
-            let settings = PathSettings {
-                width,
-                height,
-                budget,
-                seed: args.seed,
-                frame: args.frame,
-                time: args.time,
-                aovs: args.aov,
-                ..PathSettings::default()
-            };
-            let mut bar = ProgressLine::new(format!("frame {}", args.frame), "spp", args.quiet);
-            let out = render_path(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |p| {
-                bar.update(p.done, p.total, p.elapsed_s)
-            })?;
-            bar.finish();
-            (out, None)
-        }
-        Method::Ic => {
-            let settings = IcSettings {
-                width,
-                height,
-                params: args.ic.params()?,
-                sub_frames: args
-                    .ic
-                    .sub_frames
-                    .unwrap_or(IcSettings::default().sub_frames)
-                    .max(1),
-                direct_samples: args
-                    .ic
-                    .direct_samples
-                    .unwrap_or(IcSettings::default().direct_samples)
-                    .max(1),
-                seed: args.seed,
-                frame: args.frame,
-                time: args.time,
-                debug_aovs: args.debug_aov,
-                ..IcSettings::default()
-            };
-            let mut bar =
-                ProgressLine::new(format!("frame {}", args.frame), "sub-frames", args.quiet);
-            let (mut out, stats) =
-                render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |p| {
-                    bar.update(p.done, p.total, p.elapsed_s)
-                })?;
-            bar.finish();
-            if args.aov {
-                out.aovs = Some(render_aovs(&ctx, &shaders, &gpu, width, height)?);
-            }
-            (out, Some(stats))
-        }
+    // Records are world-space: valid for as long as nothing but the camera moves.
+    let temporal = !args.no_temporal && plan.keeps_records();
+    let setup = FrameSetup {
+        args,
+        ctx: &ctx,
+        shaders: &shaders,
+        scene: &scene,
+        size,
+        budget,
+        temporal,
     };
-    if out.nonfinite_pixels > 0 {
-        log::warn!(
-            "{} pixels were non-finite and written as black",
-            out.nonfinite_pixels
-        );
-    }
-
-    let mut image = Image::from_pixels(width, height, out.pixels.clone())?;
-    if let Some(aovs) = &out.aovs {
-        image.add_layer(Layer::albedo(aovs.albedo.clone()))?;
-        image.add_layer(Layer::normal(aovs.normal.clone()))?;
-        image.add_layer(Layer::depth(aovs.depth.clone()))?;
-    }
-    if let Some(debug) = ic_stats.as_ref().and_then(|s| s.debug.as_ref()) {
-        let rgb = || vec!["R".to_string(), "G".to_string(), "B".to_string()];
-        let y = || vec!["Y".to_string()];
-        image.add_layer(Layer::new("ic_indirect", rgb(), debug.indirect.clone())?)?;
-        image.add_layer(Layer::new("ic_weight", y(), debug.weight_sum.clone())?)?;
-        image.add_layer(Layer::new(
-            "ic_records",
-            y(),
-            debug.records_per_pixel.clone(),
-        )?)?;
-        image.add_layer(Layer::new(
-            "ic_positions",
-            y(),
-            debug.record_positions.clone(),
-        )?)?;
-    }
-    let aspect = width as f32 / height as f32;
-    let mut meta = Metadata::new();
-    let method = match args.method {
-        Method::Path => "path",
-        Method::Ic => "ic",
-    };
-    meta.method = Some(method.into());
-    meta.spp = Some(out.spp);
-    if let Some(stats) = &ic_stats {
-        meta.extra.insert(
-            "quality".into(),
-            format!("{:?}", args.ic.quality).to_lowercase(),
-        );
-        meta.extra
-            .insert("records".into(), stats.records.to_string());
-    }
-    meta.render_time_s = Some(out.time_s);
-    meta.scene_file = Some(args.scene.display().to_string());
-    meta.world_from_camera = Some(view.world_from_camera.to_cols_array());
-    meta.projection = Some(
-        vulkan_clip_from_view(view.perspective.yfov, aspect, view.perspective.znear)
-            .to_cols_array(),
-    );
-    meta.extra.insert("seed".into(), args.seed.to_string());
-    meta.extra.insert("time".into(), args.time.to_string());
-    meta.extra.insert("device".into(), ctx.info().name.clone());
-    let png_options = PngOptions {
-        exposure: args.exposure,
-        tone_map: if args.tonemap == "filmic" {
-            ToneMap::Filmic
+    let stop = interrupt_flag(sequence.frames.len() > 1);
+    let mut progress = SequenceProgress::new(sequence.frames.len(), args.quiet);
+    let mut ic = None;
+    let mut entries = Vec::new();
+    let mut write_s = 0.0;
+    let mut stopped = false;
+    for &(number, time) in &sequence.frames {
+        if stop.load(Ordering::SeqCst) {
+            stopped = true;
+            break;
+        }
+        let output = if pattern {
+            radcache_image::frame_path(&args.output, number)?
         } else {
-            ToneMap::None
-        },
-    };
-    let t_write = Instant::now();
-    for path in [Some(output.as_path()), args.stats.as_deref()]
-        .into_iter()
-        .flatten()
-    {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("creating the output folder {}", dir.display()))?;
-        }
-    }
-    if png_only {
-        write_png(&output, &image, &png_options)?;
-    } else {
-        let exr = ExrOptions {
-            half: args.half,
-            ..ExrOptions::default()
+            args.output.clone()
         };
-        write_exr(&output, &image, &meta, &exr)?;
-        if args.png {
-            write_png(png_beside(&output), &image, &png_options)?;
+        if pattern && !args.overwrite && output.exists() {
+            progress.skipped(number, &output);
+            continue;
         }
+        let t_frame = Instant::now();
+        let rendered = frame::render(&setup, &mut gpu, &mut ic, number, time)?;
+        if rendered.out.nonfinite_pixels > 0 {
+            log::warn!(
+                "frame {number}: {} pixels were non-finite and written as black",
+                rendered.out.nonfinite_pixels
+            );
+        }
+        let image = frame::image(&rendered)?;
+        let meta = frame::metadata(&setup, &rendered, number, time);
+        let t_write = Instant::now();
+        frame::write(args, &output, &image, &meta)?;
+        entries.push(frame::stats_entry(&rendered, number, time));
+        if let Some(path) = &args.stats {
+            write_stats(path, &setup, &entries, [load_s, upload_s, write_s])?;
+        }
+        write_s += t_write.elapsed().as_secs_f64();
+        if !args.quiet && sequence.frames.len() == 1 {
+            let out = &rendered.out;
+            let rays: u64 = out.rays.values().sum();
+            eprintln!(
+                "wrote {} ({}x{}, {}, {} spp, {:.2} s, {:.2} Mrays/s)",
+                output.display(),
+                size.0,
+                size.1,
+                frame::method_name(args.method),
+                out.spp,
+                out.time_s,
+                rays as f64 / out.time_s.max(1e-9) / 1e6
+            );
+        }
+        progress.rendered(number, t_frame.elapsed().as_secs_f64());
     }
-    let write_s = t_write.elapsed().as_secs_f64();
-    if let Some(path) = &args.stats {
-        let run = RunInfo {
-            method,
-            size: (width, height),
-            cpu_s: [load_s, upload_s, write_s],
-        };
-        write_stats(path, args, &ctx, &out, ic_stats.as_ref(), &run)?;
-    }
-    if !args.quiet {
-        let rays: u64 = out.rays.values().sum();
-        eprintln!(
-            "wrote {} ({width}x{height}, {method}, {} spp, {:.2} s, {:.2} Mrays/s)",
-            output.display(),
-            out.spp,
-            out.time_s,
-            rays as f64 / out.time_s.max(1e-9) / 1e6
-        );
-    }
+    progress.finish(stopped);
+    drop(ic);
     drop(gpu);
     let first = ctx.first_validation_error();
     let report = ctx.shutdown();
     if report.validation_errors > 0 {
-        // The image is written; the run still fails, since a validation error is a bug.
+        // The images are written; the run still fails, since a validation error is a bug.
         bail!(
             "{} Vulkan validation errors (first: {})",
             report.validation_errors,
             first.unwrap_or_default()
         );
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(if stopped {
+        ExitCode::from(130)
+    } else {
+        ExitCode::SUCCESS
+    })
 }
 
-/// What the stats file says about the run besides the frames.
-struct RunInfo {
-    method: &'static str,
-    size: (u32, u32),
-    cpu_s: [f64; 3],
+/// A flag set by the first Ctrl-C of a sequence render: the frame in flight is finished and
+/// written, then the run stops (exit code 130). A second Ctrl-C abandons that frame at once;
+/// frames are written atomically, so nothing partial is left at an output path. A single frame
+/// keeps the default behaviour (Ctrl-C stops at once).
+fn interrupt_flag(sequence: bool) -> Arc<AtomicBool> {
+    let flag = Arc::new(AtomicBool::new(false));
+    if sequence {
+        let seen = flag.clone();
+        let installed = ctrlc::set_handler(move || {
+            if seen.swap(true, Ordering::SeqCst) {
+                eprintln!("\nabandoning the frame in flight");
+                std::process::exit(130);
+            }
+            eprintln!("\nfinishing the frame in flight (Ctrl-C again to abandon it)");
+        });
+        if let Err(e) = installed {
+            log::warn!("Ctrl-C will stop at once: {e}");
+        }
+    }
+    flag
 }
 
+/// Writes the stats file (atomically, after every frame, so an interrupted run keeps it).
 fn write_stats(
     path: &Path,
-    args: &RenderArgs,
-    ctx: &Context,
-    out: &radcache_render::FrameOutput,
-    ic: Option<&IcStats>,
-    run: &RunInfo,
+    setup: &FrameSetup<'_>,
+    frames: &[serde_json::Value],
+    cpu_s: [f64; 3],
 ) -> Result<()> {
-    let (width, height) = run.size;
-    let [load_s, upload_s, write_s] = run.cpu_s;
-    let mut frame = json!({
-        "frame": args.frame,
-        "time": args.time,
-        "time_s": out.time_s,
-        "spp": out.spp,
-        "rays": out.rays,
-        "passes_ms": out.passes_ms,
-        "nonfinite_pixels": out.nonfinite_pixels,
-    });
-    if let Some(ic) = ic {
-        frame["records"] = json!(ic.records);
-        frame["records_per_level"] = json!(ic.records_per_level);
-        frame["holes_left"] = json!(ic.holes_left);
-        frame["dropped_requests"] = json!(ic.dropped_requests);
-        frame["rejected_records"] = json!(ic.rejected_records);
-        frame["phases_wall_s"] = json!(ic.phases_s);
-    }
+    let [load_s, upload_s, write_s] = cpu_s;
     let value = json!({
-        "scene": args.scene,
-        "method": run.method,
-        "device": ctx.info().name,
-        "resolution": [width, height],
+        "scene": setup.args.scene,
+        "method": frame::method_name(setup.args.method),
+        "device": setup.ctx.info().name,
+        "resolution": [setup.size.0, setup.size.1],
+        "temporal": setup.temporal,
         "cpu_s": {"scene_load": load_s, "upload": upload_s, "write": write_s},
-        "frames": [frame],
+        "frames": frames,
     });
     let text = serde_json::to_string_pretty(&value)?;
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("creating the stats folder {}", dir.display()))?;
+    }
     radcache_image::write_atomic(path, |w| {
         use std::io::Write;
         w.write_all(text.as_bytes())

@@ -108,6 +108,39 @@ pub enum Error {
         candidate: (u32, u32),
     },
 
+    /// A frame sequence is too short to have a pair of consecutive frames.
+    #[error("a frame sequence needs at least 2 frames, got {frames}")]
+    TooFewFrames {
+        /// The number of frames given.
+        frames: usize,
+    },
+
+    /// A frame of a sequence, or of its reference sequence, differs in size from the first frame
+    /// of the sequence.
+    #[error(
+        "{sequence} frame {frame} is {}x{}, but frame 0 of the sequence is {}x{}",
+        found.0, found.1, expected.0, expected.1
+    )]
+    FrameSizeMismatch {
+        /// Which sequence the frame belongs to: `"sequence"` or `"reference"`.
+        sequence: &'static str,
+        /// Index of the frame in its sequence (0 = first).
+        frame: usize,
+        /// The frame's (width, height).
+        found: (u32, u32),
+        /// (width, height) of the sequence's first frame.
+        expected: (u32, u32),
+    },
+
+    /// A reference sequence does not have as many frames as the sequence it is compared with.
+    #[error("the sequence has {frames} frames but its reference has {reference}")]
+    SequenceLengthMismatch {
+        /// Frames in the sequence.
+        frames: usize,
+        /// Frames in the reference sequence.
+        reference: usize,
+    },
+
     /// Pixel data or a layer does not fit the image it is given to.
     #[error("invalid image data: {0}")]
     InvalidImage(String),

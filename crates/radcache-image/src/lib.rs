@@ -19,6 +19,7 @@ mod color;
 mod error;
 mod exr_read;
 mod exr_write;
+mod flicker;
 mod flip;
 mod image;
 mod metadata;
@@ -35,6 +36,9 @@ pub use color::{
 pub use error::{Error, Result};
 pub use exr_read::read_exr;
 pub use exr_write::{write_exr, ExrOptions};
+pub use flicker::{
+    flicker, FlickerMeter, FlickerMode, FlickerPair, FlickerReport, STATIC_TOLERANCE,
+};
 pub use image::{Image, Layer, ALBEDO, DEPTH, NORMAL};
 pub use metadata::{Metadata, RADCACHE_VERSION};
 pub use metrics::{compare, Metrics, BLOCK_SIZE};

@@ -43,6 +43,9 @@ pub struct IcSettings {
     pub record_capacity: u32,
     /// Also produce the debug AOVs ([`IcDebug`]).
     pub debug_aovs: bool,
+    /// Records kept across frames that weighed on no pixel for this many frames are evicted at
+    /// the start of the next one (memory stays bounded over long sequences).
+    pub evict_after_frames: u32,
 }
 
 impl Default for IcSettings {
@@ -58,6 +61,7 @@ impl Default for IcSettings {
             time: 0.0,
             record_capacity: 1 << 18,
             debug_aovs: false,
+            evict_after_frames: 60,
         }
     }
 }
@@ -77,6 +81,11 @@ pub struct IcStats {
     pub rejected_records: u64,
     /// Records kept from the previous frame (0 for a fresh cache).
     pub records_kept: u64,
+    /// Records evicted at the start of the frame (unused for `evict_after_frames`).
+    pub records_evicted: u64,
+    /// Passes of the cache phase over the sub-frames (the last one created no record, unless
+    /// the limit of 4 was reached).
+    pub cache_passes: u32,
     /// Wall time of the hole-filling submissions (splat, holes, records, neighbours), s.
     pub hole_filling_s: f64,
     /// Wall time of the record-creation submissions alone (records and neighbours), s.

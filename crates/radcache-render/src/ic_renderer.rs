@@ -38,6 +38,9 @@ use crate::records::RecordPass;
 use crate::render::{FrameOutput, Progress};
 use crate::splat::{SplatPass, SplatWeights};
 
+/// Most passes of the cache phase over the sub-frames (see [`IcRenderer::render`]).
+const MAX_CACHE_PASSES: u32 = 4;
+
 fn add_timings(map: &mut BTreeMap<String, f64>, timings: Vec<PassTiming>) {
     for t in timings {
         *map.entry(t.name).or_default() += t.duration_ms;
@@ -82,6 +85,8 @@ pub struct IcRenderer {
     state: IcState,
     /// False until a frame has left records to keep.
     has_records: bool,
+    /// Frames rendered (the last-use marks of `IcState::last_used`).
+    frames: u32,
 }
 
 impl std::fmt::Debug for IcRenderer {
@@ -128,6 +133,7 @@ impl IcRenderer {
             emission: EmissionPass::new(ctx, shaders, gpu)?,
             state: IcState::new(ctx, shaders, settings.record_capacity, w * h)?,
             has_records: false,
+            frames: 0,
         })
     }
 
@@ -189,6 +195,15 @@ impl IcRenderer {
             })
         };
 
+        self.frames += 1;
+        let now = self.frames;
+        if self.has_records {
+            let limit = settings.evict_after_frames;
+            let evicted = self
+                .state
+                .compact(ctx, |_, used| used != 0 && now - used <= limit)?;
+            stats.records_evicted = u64::from(evicted);
+        }
         let mut rec = ctx.begin("ic.setup")?;
         gpu.record_update(ctx, &mut rec)?;
         if !self.has_records {
@@ -201,22 +216,38 @@ impl IcRenderer {
         stats.records_kept = u64::from(self.state.read_counters()?.counts[0]);
         phases.lap("setup");
 
-        for k in 0..sub_frames {
-            self.fill_holes(
-                ctx,
-                gpu,
-                settings,
-                k,
-                &mut stats,
-                &mut passes_ms,
-                &mut phases,
-            )?;
-            report(k + 1);
+        // Records created for a later sub-frame shrink earlier ones (neighbour clamping), which
+        // can uncover a pixel an earlier sub-frame had covered: passes repeat until one creates
+        // nothing (at most MAX_CACHE_PASSES), so the records left are a fixed point and the
+        // next frame of a static scene creates none and shades identically.
+        for pass in 0..MAX_CACHE_PASSES {
+            let before = stats.records_per_level.iter().sum::<u64>();
+            for k in 0..sub_frames {
+                self.fill_holes(
+                    ctx,
+                    gpu,
+                    settings,
+                    k,
+                    &mut stats,
+                    &mut passes_ms,
+                    &mut phases,
+                )?;
+                if pass == 0 {
+                    report(k + 1);
+                }
+            }
+            stats.cache_passes = pass + 1;
+            if stats.records_per_level.iter().sum::<u64>() == before {
+                break;
+            }
         }
         *rays.entry("records".into()).or_default() += stats.record_rays;
         self.has_records = true;
 
-        let final_weights = SplatWeights::from_params(&self.params);
+        let final_weights = SplatWeights {
+            mark_frame: now,
+            ..SplatWeights::from_params(&self.params)
+        };
         for k in 0..sub_frames {
             let jitter = sub_frame_jitter(k);
             let mut rec = ctx.begin("ic.shade")?;

@@ -64,6 +64,9 @@ pub struct IcState {
     pub grid_heads: Buffer,
     /// The neighbour grid's list links, `GRID_SLOTS` per record.
     pub grid_next: Buffer,
+    /// Per record, the last frame (the renderer's count, from 1) whose final splat it weighed
+    /// in; 0 = never.
+    pub last_used: Buffer,
     record_capacity: u32,
     request_capacity: u32,
 }
@@ -139,6 +142,12 @@ impl IcState {
                 storage,
                 MemoryLocation::GpuOnly,
             )?,
+            last_used: buffer(
+                "ic.last_used",
+                u64::from(record_capacity.max(1)) * 4,
+                storage | vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC,
+                MemoryLocation::GpuOnly,
+            )?,
             record_capacity,
             request_capacity,
         })
@@ -170,6 +179,8 @@ impl IcState {
 
     /// Records forgetting every record (the start of a frame without reuse).
     pub fn record_reset(&self, rec: &mut Recorder) -> Result<()> {
+        rec.barrier(Access::ALL, Access::TRANSFER_WRITE);
+        rec.fill_buffer(&self.last_used, 0, vk::WHOLE_SIZE, 0);
         self.step(rec, Mode::Reset)
     }
 
@@ -186,6 +197,56 @@ impl IcState {
     /// Records adding the batch to the record count and the splat draw.
     pub fn record_end_batch(&self, rec: &mut Recorder) -> Result<()> {
         self.step(rec, Mode::EndBatch)
+    }
+
+    /// Keeps the records `keep` selects (by index and last use) and drops the others, moving the
+    /// kept ones to the front in their order; returns how many were dropped. The caller must
+    /// rebuild the neighbour grid afterwards. Rare (eviction), so it goes through the host.
+    pub fn compact(&self, ctx: &Context, keep: impl Fn(usize, u32) -> bool) -> Result<u32> {
+        let counters = self.read_counters()?;
+        let count = counters.counts[0].min(self.record_capacity) as usize;
+        if count == 0 {
+            return Ok(0);
+        }
+        let used: Vec<u32> = ctx.read_buffer(&self.last_used, count)?;
+        let kept: Vec<usize> = (0..count).filter(|&i| keep(i, used[i])).collect();
+        let dropped = (count - kept.len()) as u32;
+        if dropped == 0 {
+            return Ok(0);
+        }
+        let records: Vec<GpuRecord> = ctx.read_buffer(&self.records, count)?;
+        let mut rec = ctx.begin("ic.compact")?;
+        let n = kept.len() as u32;
+        let mut staging = Vec::new();
+        if n > 0 {
+            let new_records: Vec<GpuRecord> = kept.iter().map(|&i| records[i]).collect();
+            let new_used: Vec<u32> = kept.iter().map(|&i| used[i]).collect();
+            let src = vk::BufferUsageFlags::TRANSFER_SRC;
+            let r = ctx.create_buffer_init("ic.compact.records", src, &new_records)?;
+            let u = ctx.create_buffer_init("ic.compact.last_used", src, &new_used)?;
+            rec.barrier(Access::ALL, Access::TRANSFER_WRITE);
+            let bytes = std::mem::size_of_val(&new_records[..]) as u64;
+            rec.copy_buffer(&r, 0, &self.records, 0, bytes);
+            rec.copy_buffer(&u, 0, &self.last_used, 0, u64::from(n) * 4);
+            staging.extend([r, u]);
+        }
+        // Slots past the kept records start again as never used.
+        rec.fill_buffer(
+            &self.last_used,
+            u64::from(n) * 4,
+            (count as u64 - u64::from(n)) * 4,
+            0,
+        );
+        let mut c = counters;
+        c.counts[0] = n;
+        c.counts[2] = n;
+        c.dispatch[0] = 0;
+        c.draw[1] = n;
+        rec.update_buffer(&self.counters, 0, std::slice::from_ref(&c));
+        rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
+        ctx.submit(rec)?.wait()?;
+        drop(staging);
+        Ok(dropped)
     }
 
     /// The counters after the last submission's fence.

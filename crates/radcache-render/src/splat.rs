@@ -34,6 +34,11 @@ pub struct SplatWeights {
     pub w_min: f32,
     /// In-front tolerance in pixel footprints.
     pub front_tol_px: f32,
+    /// Frame number written to the last-use slot of every record that weighs on a pixel (0: none;
+    /// the final splat marks, the coverage splats do not).
+    pub mark_frame: u32,
+    /// Padding to 16-byte rows.
+    pub pad: [u32; 3],
 }
 
 impl SplatWeights {
@@ -47,6 +52,8 @@ impl SplatWeights {
                 WeightKind::TabellionLamorlette => 0.0,
             },
             front_tol_px: params.front_tolerance_px,
+            mark_frame: 0,
+            pad: [0; 3],
         }
     }
 }
@@ -74,6 +81,7 @@ impl SplatPass {
         let mut bindings = vec![BindingLayout::new(FRAME, BindingKind::UniformBuffer)];
         bindings.extend(GBuffer::layout());
         bindings.push(BindingLayout::new(RECORDS, BindingKind::StorageBuffer));
+        bindings.push(BindingLayout::new(RECORDS + 1, BindingKind::StorageBuffer));
         let format = vk::Format::R32G32B32A32_SFLOAT;
         let pipeline = Pipeline::graphics(
             ctx,
@@ -137,6 +145,7 @@ impl SplatPass {
         let mut bindings = vec![scene_bindings[FRAME as usize]];
         bindings.extend(gbuffer.bindings());
         bindings.push((RECORDS, Resource::Buffer(&state.records)));
+        bindings.push((RECORDS + 1, Resource::Buffer(&state.last_used)));
         rec.pass(name, |rec| {
             rec.begin_rendering(
                 &[

@@ -149,6 +149,17 @@ impl Scene {
     }
 }
 
+impl ScenePlan {
+    /// Whether an animation's irradiance records stay valid from frame to frame: records are
+    /// world-space, so they do while nothing but the camera moves.
+    pub fn keeps_records(&self) -> bool {
+        matches!(
+            self.animation.kind,
+            AnimationKind::None | AnimationKind::CameraOnly
+        )
+    }
+}
+
 impl fmt::Display for ScenePlan {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "plan:")?;
@@ -203,6 +214,12 @@ impl fmt::Display for ScenePlan {
         if let Some((t0, t1)) = a.time_range {
             write!(f, ", time range [{t0:.3}, {t1:.3}] s")?;
         }
-        writeln!(f)
+        writeln!(f)?;
+        let cache = if self.keeps_records() {
+            "records kept from frame to frame (holes filled where the view uncovers new surfaces)"
+        } else {
+            "rebuilt every frame (moving geometry or lights)"
+        };
+        writeln!(f, "  cache across frames: {cache}")
     }
 }

@@ -152,6 +152,7 @@ fn cornell_box() {
         "plan:",
         "animation: none",
         "emissive triangles: 2",
+        "cache across frames: records kept",
     ] {
         assert!(text.contains(needle), "summary lacks {needle:?}:\n{text}");
     }
@@ -259,6 +260,10 @@ fn animated_scene() {
     assert!(text.contains("time range [0.000, 5.000] s"), "{text}");
     assert!(
         text.contains("geometry (camera yes, lights no, geometry yes)"),
+        "{text}"
+    );
+    assert!(
+        text.contains("cache across frames: rebuilt every frame"),
         "{text}"
     );
 }

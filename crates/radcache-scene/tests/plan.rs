@@ -117,6 +117,7 @@ fn animated_camera_and_plan_text() {
         "environment: none",
         "textures: no",
         "animation: camera only (camera yes, lights no, geometry no), time range [0.500, 2.500] s",
+        "cache across frames: records kept",
     ] {
         assert!(text.contains(needle), "plan text lacks {needle:?}:\n{text}");
     }

@@ -1,0 +1,246 @@
+//! One frame of `radcache render`: render it (path tracer, or the cache's renderer kept across
+//! the frames of a sequence), assemble the image with its layers and metadata, write it
+//! atomically, and describe it for the stats file.
+
+use std::path::Path;
+
+use anyhow::{Context as _, Result};
+use radcache_image::{
+    png_beside, write_exr, write_png, ExrOptions, Image, Layer, Metadata, PngOptions, ToneMap,
+};
+use radcache_render::{
+    render_aovs, render_path, vulkan_clip_from_view, Budget, FrameOutput, GpuScene, IcRenderer,
+    IcSettings, IcStats, PathSettings,
+};
+use radcache_scene::Scene;
+use radcache_vk::{Context, ShaderCompiler};
+use serde_json::{json, Value};
+
+use crate::progress::ProgressLine;
+use crate::render::{Method, RenderArgs};
+
+/// What stays the same over the frames of a run.
+pub struct FrameSetup<'a> {
+    pub args: &'a RenderArgs,
+    pub ctx: &'a Context,
+    pub shaders: &'a ShaderCompiler,
+    pub scene: &'a Scene,
+    pub size: (u32, u32),
+    pub budget: Budget,
+    /// Keep the cache's records from frame to frame.
+    pub temporal: bool,
+}
+
+impl std::fmt::Debug for FrameSetup<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FrameSetup")
+            .field("size", &self.size)
+            .field("temporal", &self.temporal)
+            .finish_non_exhaustive()
+    }
+}
+
+/// A rendered frame.
+#[derive(Debug)]
+pub struct Rendered {
+    pub out: FrameOutput,
+    pub ic: Option<IcStats>,
+}
+
+/// Renders `frame` at scene time `time`. The cache's renderer is created on the first frame and
+/// kept in `ic`; without `setup.temporal` it forgets its records before every frame.
+pub fn render(
+    setup: &FrameSetup<'_>,
+    gpu: &mut GpuScene,
+    ic: &mut Option<IcRenderer>,
+    frame: u32,
+    time: f32,
+) -> Result<Rendered> {
+    let args = setup.args;
+    let (width, height) = setup.size;
+    match args.method {
+        Method::Path => {
+            let settings = PathSettings {
+                width,
+                height,
+                budget: setup.budget,
+                seed: args.seed,
+                frame,
+                time,
+                aovs: args.aov,
+                ..PathSettings::default()
+            };
+            let mut bar = ProgressLine::new(format!("frame {frame}"), "spp", args.quiet);
+            let out = render_path(
+                setup.ctx,
+                setup.shaders,
+                setup.scene,
+                gpu,
+                &settings,
+                &mut |p| bar.update(p.done, p.total, p.elapsed_s),
+            )?;
+            bar.finish();
+            Ok(Rendered { out, ic: None })
+        }
+        Method::Ic => {
+            let defaults = IcSettings::default();
+            let settings = IcSettings {
+                width,
+                height,
+                params: args.ic.params()?,
+                sub_frames: args.ic.sub_frames.unwrap_or(defaults.sub_frames).max(1),
+                direct_samples: args
+                    .ic
+                    .direct_samples
+                    .unwrap_or(defaults.direct_samples)
+                    .max(1),
+                seed: args.seed,
+                frame,
+                time,
+                debug_aovs: args.debug_aov,
+                ..defaults
+            };
+            let renderer = match ic {
+                Some(r) => r,
+                None => ic.insert(IcRenderer::new(setup.ctx, setup.shaders, gpu, &settings)?),
+            };
+            if !setup.temporal {
+                renderer.forget();
+            }
+            let mut bar =
+                ProgressLine::new(format!("frame {frame}"), "sub-frame phases", args.quiet);
+            let (mut out, stats) =
+                renderer.render(setup.ctx, setup.scene, gpu, &settings, &mut |p| {
+                    bar.update(p.done, p.total, p.elapsed_s)
+                })?;
+            bar.finish();
+            if args.aov {
+                out.aovs = Some(render_aovs(setup.ctx, setup.shaders, gpu, width, height)?);
+            }
+            Ok(Rendered {
+                out,
+                ic: Some(stats),
+            })
+        }
+    }
+}
+
+/// The frame's image with its AOV and debug layers.
+pub fn image(r: &Rendered) -> Result<Image> {
+    let out = &r.out;
+    let mut image = Image::from_pixels(out.width, out.height, out.pixels.clone())?;
+    if let Some(aovs) = &out.aovs {
+        image.add_layer(Layer::albedo(aovs.albedo.clone()))?;
+        image.add_layer(Layer::normal(aovs.normal.clone()))?;
+        image.add_layer(Layer::depth(aovs.depth.clone()))?;
+    }
+    if let Some(debug) = r.ic.as_ref().and_then(|s| s.debug.as_ref()) {
+        let rgb = || vec!["R".to_string(), "G".to_string(), "B".to_string()];
+        let y = || vec!["Y".to_string()];
+        image.add_layer(Layer::new("ic_indirect", rgb(), debug.indirect.clone())?)?;
+        image.add_layer(Layer::new("ic_weight", y(), debug.weight_sum.clone())?)?;
+        let per_pixel = debug.records_per_pixel.clone();
+        image.add_layer(Layer::new("ic_records", y(), per_pixel)?)?;
+        let positions = debug.record_positions.clone();
+        image.add_layer(Layer::new("ic_positions", y(), positions)?)?;
+    }
+    Ok(image)
+}
+
+/// The EXR metadata of a frame.
+pub fn metadata(setup: &FrameSetup<'_>, r: &Rendered, frame: u32, time: f32) -> Metadata {
+    let args = setup.args;
+    let (width, height) = setup.size;
+    let view = setup.scene.camera_at(time);
+    let mut meta = Metadata::new();
+    meta.method = Some(method_name(args.method).into());
+    meta.spp = Some(r.out.spp);
+    if let Some(stats) = &r.ic {
+        meta.extra.insert(
+            "quality".into(),
+            format!("{:?}", args.ic.quality).to_lowercase(),
+        );
+        meta.extra
+            .insert("records".into(), stats.records.to_string());
+    }
+    meta.render_time_s = Some(r.out.time_s);
+    meta.scene_file = Some(args.scene.display().to_string());
+    meta.world_from_camera = Some(view.world_from_camera.to_cols_array());
+    let aspect = width as f32 / height as f32;
+    meta.projection = Some(
+        vulkan_clip_from_view(view.perspective.yfov, aspect, view.perspective.znear)
+            .to_cols_array(),
+    );
+    meta.extra.insert("seed".into(), args.seed.to_string());
+    meta.extra.insert("frame".into(), frame.to_string());
+    meta.extra.insert("time".into(), time.to_string());
+    meta.extra
+        .insert("device".into(), setup.ctx.info().name.clone());
+    meta
+}
+
+/// The method's name in files and messages.
+pub fn method_name(method: Method) -> &'static str {
+    match method {
+        Method::Path => "path",
+        Method::Ic => "ic",
+    }
+}
+
+/// Writes the frame to `output` (EXR, or PNG when the path says so; a PNG preview beside the EXR
+/// with `--png`), each file atomically.
+pub fn write(args: &RenderArgs, output: &Path, image: &Image, meta: &Metadata) -> Result<()> {
+    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("creating the output folder {}", dir.display()))?;
+    }
+    let png_options = PngOptions {
+        exposure: args.exposure,
+        tone_map: if args.tonemap == "filmic" {
+            ToneMap::Filmic
+        } else {
+            ToneMap::None
+        },
+    };
+    let png_only = output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if png_only {
+        write_png(output, image, &png_options)?;
+    } else {
+        let exr = ExrOptions {
+            half: args.half,
+            ..ExrOptions::default()
+        };
+        write_exr(output, image, meta, &exr)?;
+        if args.png {
+            write_png(png_beside(output), image, &png_options)?;
+        }
+    }
+    Ok(())
+}
+
+/// The frame's entry in the stats file.
+pub fn stats_entry(r: &Rendered, frame: u32, time: f32) -> Value {
+    let out = &r.out;
+    let mut entry = json!({
+        "frame": frame,
+        "time": time,
+        "time_s": out.time_s,
+        "spp": out.spp,
+        "rays": out.rays,
+        "passes_ms": out.passes_ms,
+        "nonfinite_pixels": out.nonfinite_pixels,
+    });
+    if let Some(ic) = &r.ic {
+        entry["records"] = json!(ic.records);
+        entry["records_kept"] = json!(ic.records_kept);
+        entry["records_created"] = json!(ic.records_per_level.iter().sum::<u64>());
+        entry["records_per_level"] = json!(ic.records_per_level);
+        entry["holes_left"] = json!(ic.holes_left);
+        entry["dropped_requests"] = json!(ic.dropped_requests);
+        entry["rejected_records"] = json!(ic.rejected_records);
+        entry["phases_wall_s"] = json!(ic.phases_s);
+    }
+    entry
+}

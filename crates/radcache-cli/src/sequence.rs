@@ -1,0 +1,248 @@
+//! Frame sequences of `radcache render`: which frames, at which scene times, and the progress
+//! line across them.
+//!
+//! Frames are numbered like Blender's: `--frames 1..120` is inclusive. Frame `f` of a sequence
+//! starting at frame `first` shows the scene at `start + (f − first) / fps`, where `start` is
+//! `--start-time`, else the animation's first key time, else 0. Without `--frames` or `--frame`,
+//! an output pattern with `#` on an animated scene renders the animation's own range (from its
+//! first to its last key at `fps`); anything else renders frame 1.
+
+use std::io::Write;
+use std::time::Instant;
+
+use anyhow::{bail, Context as _, Result};
+
+/// The frames to render and their scene times.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sequence {
+    /// (frame number, scene time in seconds), in order.
+    pub frames: Vec<(u32, f32)>,
+}
+
+/// Parses an inclusive frame range `A..B` (or a single frame `N`).
+pub fn parse_frames(text: &str) -> Result<(u32, u32)> {
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .with_context(|| format!("--frames {text:?}: {v:?} is not a frame number"))
+    };
+    let (a, b) = match text.split_once("..") {
+        Some((a, b)) => (parse(a)?, parse(b.trim_start_matches('='))?),
+        None => {
+            let n = parse(text)?;
+            (n, n)
+        }
+    };
+    if a > b {
+        bail!("--frames {text:?}: the first frame {a} comes after the last {b}");
+    }
+    if b - a >= 1_000_000 {
+        bail!("--frames {text:?}: more than a million frames");
+    }
+    Ok((a, b))
+}
+
+/// What the command line says about frames and time.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FrameArgs<'a> {
+    /// `--frames A..B`.
+    pub frames: Option<&'a str>,
+    /// `--frame N`.
+    pub frame: Option<u32>,
+    /// `--time T` (single frames only).
+    pub time: Option<f32>,
+    /// `--start-time S`.
+    pub start_time: Option<f32>,
+    /// `--fps F`.
+    pub fps: f32,
+    /// The output path contains a `#` run.
+    pub pattern: bool,
+}
+
+impl Sequence {
+    /// The frames for `args` on a scene whose animation spans `range` (key times, if any).
+    pub fn new(args: &FrameArgs<'_>, range: Option<(f32, f32)>) -> Result<Sequence> {
+        if !(args.fps.is_finite() && args.fps > 0.0) {
+            bail!("--fps must be a positive number, got {}", args.fps);
+        }
+        if let Some(s) = args.start_time.filter(|s| !s.is_finite()) {
+            bail!("--start-time must be finite, got {s}");
+        }
+        if let Some(t) = args.time.filter(|t| !t.is_finite()) {
+            bail!("--time must be finite, got {t}");
+        }
+        let start = args.start_time.or(range.map(|(t0, _)| t0)).unwrap_or(0.0);
+        let (first, last) = match (args.frames, args.frame) {
+            (Some(_), Some(_)) => bail!("--frames and --frame exclude each other"),
+            (Some(text), None) => parse_frames(text)?,
+            (None, Some(n)) => (n, n),
+            (None, None) => match range {
+                Some((t0, t1)) if args.pattern && args.time.is_none() => {
+                    let count = ((t1 - t0).max(0.0) * args.fps + 1e-3).floor() as u32 + 1;
+                    (1, count.min(1_000_000))
+                }
+                _ => (1, 1),
+            },
+        };
+        if first != last && !args.pattern {
+            bail!("a sequence needs a run of '#' in the output path for the frame number");
+        }
+        if let Some(t) = args.time {
+            if first != last {
+                bail!("--time sets one frame's time; use --start-time for a sequence");
+            }
+            return Ok(Sequence {
+                frames: vec![(first, t)],
+            });
+        }
+        let frames = (first..=last)
+            .map(|f| (f, start + (f - first) as f32 / args.fps))
+            .collect();
+        Ok(Sequence { frames })
+    }
+}
+
+/// One line per finished frame on stderr: frame time, frames done and skipped, ETA.
+#[derive(Debug)]
+pub struct SequenceProgress {
+    total: usize,
+    done: usize,
+    skipped: usize,
+    render_s: f64,
+    start: Instant,
+    quiet: bool,
+}
+
+impl SequenceProgress {
+    /// Progress over `total` frames.
+    pub fn new(total: usize, quiet: bool) -> Self {
+        SequenceProgress {
+            total,
+            done: 0,
+            skipped: 0,
+            render_s: 0.0,
+            start: Instant::now(),
+            quiet,
+        }
+    }
+
+    fn line(&self, text: &str) {
+        if !self.quiet {
+            let _ = writeln!(std::io::stderr().lock(), "{text}");
+        }
+    }
+
+    /// A frame already on disk was kept.
+    pub fn skipped(&mut self, frame: u32, path: &std::path::Path) {
+        self.skipped += 1;
+        self.line(&format!(
+            "frame {frame}: {} exists, skipped (--overwrite renders it again)",
+            path.display()
+        ));
+    }
+
+    /// A frame was rendered and written in `seconds`.
+    pub fn rendered(&mut self, frame: u32, seconds: f64) {
+        self.done += 1;
+        self.render_s += seconds;
+        if self.total <= 1 {
+            return; // a single frame has its own "wrote" line
+        }
+        let left = self.total - self.done - self.skipped;
+        let eta = self.render_s / self.done as f64 * left as f64;
+        self.line(&format!(
+            "frame {frame}: {seconds:.2} s [{}/{} done, {} skipped] ETA {eta:.0} s",
+            self.done, self.total, self.skipped
+        ));
+    }
+
+    /// The closing summary; `stopped` when Ctrl-C ended the run early.
+    pub fn finish(&self, stopped: bool) {
+        if self.total <= 1 && !stopped {
+            return;
+        }
+        let mean = if self.done > 0 {
+            self.render_s / self.done as f64
+        } else {
+            0.0
+        };
+        self.line(&format!(
+            "{}{} frames rendered ({mean:.2} s each), {} skipped, {} not rendered, {:.1} s in all",
+            if stopped { "stopped: " } else { "" },
+            self.done,
+            self.skipped,
+            self.total - self.done - self.skipped,
+            self.start.elapsed().as_secs_f64()
+        ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(frames: Option<&str>, frame: Option<u32>) -> FrameArgs<'_> {
+        FrameArgs {
+            frames,
+            frame,
+            fps: 24.0,
+            pattern: true,
+            ..FrameArgs::default()
+        }
+    }
+
+    #[test]
+    fn ranges_are_inclusive_and_checked() {
+        assert_eq!(parse_frames("1..120").unwrap(), (1, 120));
+        assert_eq!(parse_frames("5..=7").unwrap(), (5, 7));
+        assert_eq!(parse_frames("3").unwrap(), (3, 3));
+        for bad in ["7..5", "a..3", "1..", "-1..2", ""] {
+            assert!(parse_frames(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn frame_times_follow_fps_and_start() {
+        let s = Sequence::new(&args(Some("10..12"), None), Some((0.5, 2.0))).unwrap();
+        assert_eq!(
+            s.frames,
+            vec![(10, 0.5), (11, 0.5 + 1.0 / 24.0), (12, 0.5 + 2.0 / 24.0)]
+        );
+        let mut a = args(Some("1..2"), None);
+        a.start_time = Some(3.0);
+        a.fps = 2.0;
+        assert_eq!(
+            Sequence::new(&a, None).unwrap().frames,
+            vec![(1, 3.0), (2, 3.5)]
+        );
+    }
+
+    #[test]
+    fn the_default_is_the_animation_range_or_frame_one() {
+        let s = Sequence::new(&args(None, None), Some((0.0, 1.0))).unwrap();
+        assert_eq!(s.frames.len(), 25);
+        assert_eq!(s.frames[24], (25, 1.0));
+        let s = Sequence::new(&args(None, None), None).unwrap();
+        assert_eq!(s.frames, vec![(1, 0.0)]);
+        let mut single = args(None, Some(7));
+        single.time = Some(0.25);
+        assert_eq!(
+            Sequence::new(&single, None).unwrap().frames,
+            vec![(7, 0.25)]
+        );
+    }
+
+    #[test]
+    fn contradictions_are_errors() {
+        assert!(Sequence::new(&args(Some("1..3"), Some(2)), None).is_err());
+        let mut a = args(Some("1..3"), None);
+        a.time = Some(1.0);
+        assert!(Sequence::new(&a, None).is_err());
+        a = args(Some("1..3"), None);
+        a.pattern = false;
+        assert!(Sequence::new(&a, None).is_err());
+        a = args(Some("1..3"), None);
+        a.fps = 0.0;
+        assert!(Sequence::new(&a, None).is_err());
+    }
+}
