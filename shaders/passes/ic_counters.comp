@@ -3,7 +3,8 @@
 //   mode 0  reset: no records, no requests (capacities from the push constants)
 //   mode 1  begin level: no requests, hole count 0
 //   mode 2  begin batch: record_base = record_count; dispatch = one workgroup per request that fits
-//   mode 3  end batch: record_count += dispatched; the splat draw covers every record
+//   mode 3  end batch: record_count += dispatched; the splat draw covers every record, the batch
+//           draw the batch's records
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -27,6 +28,7 @@ void main() {
         counters.dispatch = uvec4(0u, 1u, 1u, 0u);
         counters.draw = uvec4(6u, 0u, 0u, 0u);
         counters.limits = uvec4(pc.record_capacity, pc.request_capacity, 0u, 0u);
+        counters.batch_draw = uvec4(6u, 0u, 0u, 0u);
     } else if (pc.mode == 1u) {
         counters.counts.y = 0u;
         counters.counts.w = 0u;
@@ -37,8 +39,10 @@ void main() {
         counters.limits.z += requested - n;
         counters.counts.z = counters.counts.x;
         counters.dispatch = uvec4(n, 1u, 1u, 0u);
+        counters.batch_draw = uvec4(6u, 0u, 0u, 0u);
     } else {
         counters.counts.x += counters.dispatch.x;
         counters.draw = uvec4(6u, counters.counts.x, 0u, 0u);
+        counters.batch_draw = uvec4(6u, counters.dispatch.x, 0u, counters.counts.z);
     }
 }

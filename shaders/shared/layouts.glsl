@@ -80,6 +80,7 @@ struct IcCounters {
     uvec4 dispatch;
     uvec4 draw;
     uvec4 limits;
-};  // 64 bytes
+    uvec4 batch_draw;
+};  // 80 bytes
 
 #endif

@@ -110,6 +110,7 @@ fn the_hash_grid_gives_the_all_pairs_clamp() {
         dispatch: [(n - base) as u32, 1, 1, 0],
         draw: [6, n as u32, 0, 0],
         limits: [4096, 1024, 0, 0],
+        batch_draw: [6, (n - base) as u32, 0, base as u32],
     };
     let mut rec = ctx.begin("test.grid").unwrap();
     upload(&mut rec, &state, &records, counters);

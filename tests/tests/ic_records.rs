@@ -177,6 +177,7 @@ fn counters(base: u32, requests: u32, groups: u32, capacity: u32) -> IcCounters 
         dispatch: [groups, 1, 1, 0],
         draw: [6, base, 0, 0],
         limits: [capacity, 64, 0, 0],
+        batch_draw: [6, 0, 0, 0],
     }
 }
 

@@ -5,7 +5,7 @@
 use glam::Vec3;
 use radcache_cache::{extrapolate_irradiance, record_weight, IcParams, WeightKind};
 use radcache_render::{
-    GBuffer, GpuScene, HolePass, IcState, NeighbourPass, SplatPass, SplatWeights,
+    GBuffer, GpuScene, HolePass, IcState, NeighbourPass, SplatPass, SplatScope, SplatWeights,
 };
 use radcache_scene::{LoadOptions, Scene};
 use radcache_shared::gpu::{GpuRecord, IcCounters};
@@ -82,6 +82,7 @@ fn counters(records: u32, batch_base: u32) -> IcCounters {
         dispatch: [records - batch_base, 1, 1, 0],
         draw: [6, records, 0, 0],
         limits: [64, 1024, 0, 0],
+        batch_draw: [6, records - batch_base, 0, batch_base],
     }
 }
 
@@ -153,7 +154,15 @@ fn splat_sums_match_the_cpu_weight_and_extrapolation() {
     fill_gbuffer(&mut rec, &f.gbuffer);
     set_state(&mut rec, &f.state, &recs, counters(2, 0));
     f.splat
-        .record(&mut rec, "splat", &f.gpu, &f.gbuffer, &f.state, &weights)
+        .record(
+            &mut rec,
+            "splat",
+            SplatScope::All,
+            &f.gpu,
+            &f.gbuffer,
+            &f.state,
+            &weights,
+        )
         .unwrap();
     f.ctx.submit(rec).unwrap().wait().unwrap();
     let sums: Vec<[f32; 4]> = f.ctx.read_image(&f.splat.sum).unwrap();
@@ -214,7 +223,15 @@ fn holes_request_one_record_per_block_and_vanish_when_covered() {
     fill_gbuffer(&mut rec, &f.gbuffer);
     set_state(&mut rec, &f.state, &[], counters(0, 0));
     f.splat
-        .record(&mut rec, "splat", &f.gpu, &f.gbuffer, &f.state, &weights)
+        .record(
+            &mut rec,
+            "splat",
+            SplatScope::All,
+            &f.gpu,
+            &f.gbuffer,
+            &f.state,
+            &weights,
+        )
         .unwrap();
     holes
         .record(
@@ -248,7 +265,15 @@ fn holes_request_one_record_per_block_and_vanish_when_covered() {
     set_state(&mut rec, &f.state, &[cover], counters(1, 0));
     f.state.record_begin_level(&mut rec).unwrap();
     f.splat
-        .record(&mut rec, "splat", &f.gpu, &f.gbuffer, &f.state, &weights)
+        .record(
+            &mut rec,
+            "splat",
+            SplatScope::All,
+            &f.gpu,
+            &f.gbuffer,
+            &f.state,
+            &weights,
+        )
         .unwrap();
     holes
         .record(
@@ -285,6 +310,7 @@ fn counters_turn_requests_into_dispatches_within_capacity() {
     assert_eq!(c.counts[2], 60, "batch base");
     assert_eq!(c.counts[0], 64, "record count");
     assert_eq!(c.draw, [6, 64, 0, 0]);
+    assert_eq!(c.batch_draw, [6, 4, 0, 60], "the batch's own draw");
     assert_eq!(c.limits[2], 6, "dropped requests");
     end(f);
 }

@@ -81,6 +81,7 @@ fn settings(time: f32, frame: u32) -> IcSettings {
         direct_samples: 4,
         time,
         frame,
+        settle_records: true,
         ..IcSettings::default()
     }
 }

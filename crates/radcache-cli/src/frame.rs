@@ -29,6 +29,8 @@ pub struct FrameSetup<'a> {
     pub budget: Budget,
     /// Keep the cache's records from frame to frame.
     pub temporal: bool,
+    /// More than one frame is rendered.
+    pub sequence: bool,
 }
 
 impl std::fmt::Debug for FrameSetup<'_> {
@@ -98,6 +100,7 @@ pub fn render(
                 frame,
                 time,
                 debug_aovs: args.debug_aov,
+                settle_records: setup.temporal && setup.sequence,
                 ..defaults
             };
             let renderer = match ic {

@@ -236,6 +236,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         size,
         budget,
         temporal,
+        sequence: sequence.frames.len() > 1,
     };
     let stop = interrupt_flag(sequence.frames.len() > 1);
     let mut progress = SequenceProgress::new(sequence.frames.len(), args.quiet);

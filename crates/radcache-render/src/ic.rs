@@ -46,6 +46,10 @@ pub struct IcSettings {
     /// Records kept across frames that weighed on no pixel for this many frames are evicted at
     /// the start of the next one (memory stays bounded over long sequences).
     pub evict_after_frames: u32,
+    /// Repeat the cache phase until a pass over the sub-frames creates no record (see
+    /// [`crate::IcRenderer::render`]), so that a next frame that keeps the records finds no hole
+    /// where nothing changed (sequences; a single frame does not need it).
+    pub settle_records: bool,
 }
 
 impl Default for IcSettings {
@@ -62,6 +66,7 @@ impl Default for IcSettings {
             record_capacity: 1 << 18,
             debug_aovs: false,
             evict_after_frames: 60,
+            settle_records: false,
         }
     }
 }

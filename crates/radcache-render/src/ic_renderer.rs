@@ -36,7 +36,7 @@ use crate::ic_state::IcState;
 use crate::neighbours::NeighbourPass;
 use crate::records::RecordPass;
 use crate::render::{FrameOutput, Progress};
-use crate::splat::{SplatPass, SplatWeights};
+use crate::splat::{SplatPass, SplatScope, SplatWeights};
 
 /// Most passes of the cache phase over the sub-frames (see [`IcRenderer::render`]).
 const MAX_CACHE_PASSES: u32 = 4;
@@ -217,10 +217,15 @@ impl IcRenderer {
         phases.lap("setup");
 
         // Records created for a later sub-frame shrink earlier ones (neighbour clamping), which
-        // can uncover a pixel an earlier sub-frame had covered: passes repeat until one creates
-        // nothing (at most MAX_CACHE_PASSES), so the records left are a fixed point and the
-        // next frame of a static scene creates none and shades identically.
-        for pass in 0..MAX_CACHE_PASSES {
+        // can uncover a pixel an earlier sub-frame had covered: with `settle_records`, passes
+        // repeat until one creates nothing (at most MAX_CACHE_PASSES), so the records left are a
+        // fixed point and the next frame of a static scene creates none and shades identically.
+        let passes = if settings.settle_records {
+            MAX_CACHE_PASSES
+        } else {
+            1
+        };
+        for pass in 0..passes {
             let before = stats.records_per_level.iter().sum::<u64>();
             for k in 0..sub_frames {
                 self.fill_holes(
@@ -265,6 +270,7 @@ impl IcRenderer {
             self.splat.record(
                 &mut rec,
                 "splat",
+                SplatScope::All,
                 gpu,
                 &self.gbuffer,
                 &self.state,
@@ -352,9 +358,18 @@ impl IcRenderer {
             let selection = Instant::now();
             let mut rec = ctx.begin("ic.select")?;
             self.state.record_begin_level(&mut rec)?;
+            // The first level splats every record; each later one adds what the level before
+            // created (radii that neighbour clamping shrank since are not redrawn: the final
+            // splat uses them).
+            let scope = if level == 0 {
+                SplatScope::All
+            } else {
+                SplatScope::LastBatch
+            };
             self.splat.record(
                 &mut rec,
                 "splat.coverage",
+                scope,
                 gpu,
                 &self.gbuffer,
                 &self.state,

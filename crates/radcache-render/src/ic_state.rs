@@ -242,6 +242,7 @@ impl IcState {
         c.counts[2] = n;
         c.dispatch[0] = 0;
         c.draw[1] = n;
+        c.batch_draw = [6, 0, 0, 0];
         rec.update_buffer(&self.counters, 0, std::slice::from_ref(&c));
         rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
         ctx.submit(rec)?.wait()?;

@@ -54,5 +54,5 @@ pub use records::{
 };
 pub use records::{RecordPass, MAX_STRATA, R_EPS_REL};
 pub use render::{render_path, Budget, FrameOutput, PathSettings, Progress};
-pub use splat::{SplatPass, SplatWeights};
+pub use splat::{SplatPass, SplatScope, SplatWeights};
 pub use upload::vulkan_clip_from_view;

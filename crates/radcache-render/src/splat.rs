@@ -16,6 +16,16 @@ use crate::gbuffer::{GBuffer, GBUFFER_BINDINGS};
 use crate::gpu_scene::GpuScene;
 use crate::ic_state::IcState;
 
+/// Which records a splat draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplatScope {
+    /// Clear the target, then splat every record.
+    All,
+    /// Add the last batch's records to the target as it is (`IcCounters::batch_draw`): the
+    /// coverage of a creation level grows by what the previous level created.
+    LastBatch,
+}
+
 /// Format of the record-count target.
 const COUNT_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
 
@@ -125,17 +135,23 @@ impl SplatPass {
         })
     }
 
-    /// Records clearing the target and splatting every record with `weights`, in a profiler
-    /// scope named `name` (e.g. `splat` or `splat.coverage`).
+    /// Records splatting the records of `scope` with `weights`, in a profiler scope named `name`
+    /// (e.g. `splat` or `splat.coverage`).
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         rec: &mut Recorder,
         name: &str,
+        scope: SplatScope,
         scene: &GpuScene,
         gbuffer: &GBuffer,
         state: &IcState,
         weights: &SplatWeights,
     ) -> Result<()> {
+        let (clear, offset) = match scope {
+            SplatScope::All => (Some([0.0; 4]), 32),
+            SplatScope::LastBatch => (None, 64),
+        };
         for image in gbuffer.images() {
             rec.use_image(image, ImageUse::FragmentStorage);
         }
@@ -151,11 +167,11 @@ impl SplatPass {
                 &[
                     ColorTarget {
                         image: &self.sum,
-                        clear: Some([0.0; 4]),
+                        clear,
                     },
                     ColorTarget {
                         image: &self.count,
-                        clear: Some([0.0; 4]),
+                        clear,
                     },
                 ],
                 None,
@@ -163,7 +179,7 @@ impl SplatPass {
             rec.bind_pipeline(&self.pipeline);
             rec.push_bindings(&bindings);
             rec.push_constants(weights);
-            rec.draw_indirect(&state.counters, 32, 1);
+            rec.draw_indirect(&state.counters, offset, 1);
             rec.end_rendering();
         });
         rec.use_image(&self.sum, ImageUse::ComputeStorage);

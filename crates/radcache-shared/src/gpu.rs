@@ -165,6 +165,10 @@ gpu_struct! {
         /// Record capacity (x), request capacity (y), requests dropped for lack of space (z),
         /// records rejected as invalid (w).
         pub limits: [u32; 4] => "uvec4",
+        /// `VkDrawIndirectCommand` of the splat of the last batch only: 6 vertices, one instance
+        /// per record of the batch, first instance its first record (no instance before a batch
+        /// ends, none after a level that created nothing).
+        pub batch_draw: [u32; 4] => "uvec4",
     }
 }
 
