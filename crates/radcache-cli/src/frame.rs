@@ -3,6 +3,7 @@
 //! atomically, and describe it for the stats file.
 
 use std::path::Path;
+use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use radcache_image::{
@@ -47,6 +48,10 @@ impl std::fmt::Debug for FrameSetup<'_> {
 pub struct Rendered {
     pub out: FrameOutput,
     pub ic: Option<IcStats>,
+    /// When the frame's rendering started (its spans count from here).
+    pub started: Instant,
+    /// When the cache's renderer was created (passes and pipelines), on the first frame.
+    pub created: Option<(Instant, Instant)>,
 }
 
 /// Renders `frame` at scene time `time`. The cache's renderer is created on the first frame and
@@ -73,6 +78,7 @@ pub fn render(
                 ..PathSettings::default()
             };
             let mut bar = ProgressLine::new(format!("frame {frame}"), "spp", args.quiet);
+            let started = Instant::now();
             let out = render_path(
                 setup.ctx,
                 setup.shaders,
@@ -82,7 +88,12 @@ pub fn render(
                 &mut |p| bar.update(p.done, p.total, p.elapsed_s),
             )?;
             bar.finish();
-            Ok(Rendered { out, ic: None })
+            Ok(Rendered {
+                out,
+                ic: None,
+                started,
+                created: None,
+            })
         }
         Method::Ic => {
             let defaults = IcSettings::default();
@@ -103,15 +114,22 @@ pub fn render(
                 settle_records: setup.temporal && setup.sequence,
                 ..defaults
             };
+            let mut created = None;
             let renderer = match ic {
                 Some(r) => r,
-                None => ic.insert(IcRenderer::new(setup.ctx, setup.shaders, gpu, &settings)?),
+                None => {
+                    let start = Instant::now();
+                    let r = IcRenderer::new(setup.ctx, setup.shaders, gpu, &settings)?;
+                    created = Some((start, Instant::now()));
+                    ic.insert(r)
+                }
             };
             if !setup.temporal {
                 renderer.forget();
             }
             let mut bar =
                 ProgressLine::new(format!("frame {frame}"), "sub-frame phases", args.quiet);
+            let started = Instant::now();
             let (mut out, stats) =
                 renderer.render(setup.ctx, setup.scene, gpu, &settings, &mut |p| {
                     bar.update(p.done, p.total, p.elapsed_s)
@@ -123,6 +141,8 @@ pub fn render(
             Ok(Rendered {
                 out,
                 ic: Some(stats),
+                started,
+                created,
             })
         }
     }

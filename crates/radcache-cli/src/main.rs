@@ -5,6 +5,7 @@ mod flicker;
 mod frame;
 mod ic_args;
 mod info;
+mod profile;
 mod progress;
 mod render;
 mod sequence;

@@ -18,6 +18,7 @@ use serde_json::json;
 
 use crate::frame::{self, FrameSetup};
 use crate::ic_args::IcArgs;
+use crate::profile::Profile;
 use crate::sequence::{FrameArgs, Sequence, SequenceProgress};
 
 /// Environment overrides shared by `render` and `info`.
@@ -130,6 +131,10 @@ pub struct RenderArgs {
     pub(crate) camera: Option<String>,
     #[command(flatten)]
     pub(crate) env: EnvArgs,
+    /// Write the run's timeline (GPU passes, host work) in the Chrome trace event format, for
+    /// Perfetto or chrome://tracing.
+    #[arg(long, value_name = "FILE.json")]
+    pub(crate) profile: Option<PathBuf>,
     /// Write per-frame statistics as JSON.
     #[arg(long, value_name = "FILE.json")]
     pub(crate) stats: Option<PathBuf>,
@@ -184,6 +189,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         (None, None) => Budget::Samples(64),
     };
     let pattern = args.output.to_string_lossy().contains('#');
+    let mut profile = Profile::new();
 
     let t_load = Instant::now();
     let opts = LoadOptions {
@@ -199,6 +205,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         _ => None,
     };
     let load_s = t_load.elapsed().as_secs_f64();
+    profile.cpu("scene load", t_load, Instant::now(), None);
     let plan = scene.plan();
     let sequence = Sequence::new(
         &FrameArgs {
@@ -226,6 +233,12 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let t_upload = Instant::now();
     let mut gpu = GpuScene::new(&ctx, &scene, env_map.as_ref())?;
     let upload_s = t_upload.elapsed().as_secs_f64();
+    profile.cpu(
+        "upload + acceleration structures",
+        t_upload,
+        Instant::now(),
+        None,
+    );
     // Records are world-space: valid for as long as nothing but the camera moves.
     let temporal = !args.no_temporal && plan.keeps_records();
     let setup = FrameSetup {
@@ -266,10 +279,17 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
                 rendered.out.nonfinite_pixels
             );
         }
+        if let Some((from, to)) = rendered.created {
+            profile.cpu("pipelines", from, to, Some(number));
+        }
+        profile.frame(number, rendered.started, &rendered.out);
+        let t_image = Instant::now();
         let image = frame::image(&rendered)?;
         let meta = frame::metadata(&setup, &rendered, number, time);
         let t_write = Instant::now();
+        profile.cpu("image + metadata", t_image, t_write, Some(number));
         frame::write(args, &output, &image, &meta)?;
+        profile.cpu("write", t_write, Instant::now(), Some(number));
         entries.push(frame::stats_entry(&rendered, number, time));
         if let Some(path) = &args.stats {
             write_stats(path, &setup, &entries, [load_s, upload_s, write_s])?;
@@ -292,6 +312,12 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         progress.rendered(number, t_frame.elapsed().as_secs_f64());
     }
     progress.finish(stopped);
+    if let Some(path) = &args.profile {
+        profile.write(path)?;
+    }
+    if !args.quiet && (args.profile.is_some() || args.stats.is_some()) {
+        eprint!("{}", profile.table());
+    }
     drop(ic);
     drop(gpu);
     let first = ctx.first_validation_error();

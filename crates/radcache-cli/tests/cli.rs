@@ -189,3 +189,68 @@ fn bad_input_is_one_clear_error() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--resolution"));
 }
+
+#[test]
+fn profile_writes_a_chrome_trace_and_prints_the_pass_table() {
+    let dir = out_dir("profile");
+    let trace = dir.join("trace.json");
+    let out = radcache(&[
+        "render",
+        &cornell(),
+        "-o",
+        &text(&dir.join("f_####.exr")),
+        "--frames",
+        "1..2",
+        "--resolution",
+        "24x24",
+        "--quality",
+        "draft",
+        "--sub-frames",
+        "2",
+        "--profile",
+        &text(&trace),
+    ]);
+    assert_ok(&out);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&trace).unwrap()).unwrap();
+    let events = json["traceEvents"].as_array().unwrap();
+    let named = |n: &str| events.iter().filter(|e| e["name"] == n).count();
+    // Track names, host work outside and inside frames, GPU passes of both frames.
+    assert_eq!(named("thread_name"), 2);
+    for host in [
+        "scene load",
+        "upload + acceleration structures",
+        "write",
+        "frame 1",
+    ] {
+        assert!(named(host) >= 1, "no {host:?} event");
+    }
+    let gpu: Vec<&serde_json::Value> = events.iter().filter(|e| e["cat"] == "gpu").collect();
+    for pass in ["gbuffer", "records", "splat", "composite"] {
+        assert!(
+            gpu.iter().any(|e| e["name"] == pass),
+            "no GPU {pass:?} span"
+        );
+    }
+    assert!(gpu.iter().any(|e| e["args"]["frame"] == 2));
+    assert!(events
+        .iter()
+        .filter(|e| e["ph"] == "X")
+        .all(|e| e["ts"].as_f64().unwrap() >= 0.0 && e["dur"].as_f64().unwrap() >= 0.0));
+    // Frame 2 starts after frame 1 ends.
+    let start = |n: &str| {
+        let e = events.iter().find(|e| e["name"] == n).unwrap();
+        (e["ts"].as_f64().unwrap(), e["dur"].as_f64().unwrap())
+    };
+    let ((t1, d1), (t2, _)) = (start("frame 1"), start("frame 2"));
+    assert!(
+        t2 >= t1 + d1,
+        "frame 2 at {t2} µs, frame 1 ends at {}",
+        t1 + d1
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("Mrays/s") && stderr.contains("records "),
+        "{stderr}"
+    );
+}

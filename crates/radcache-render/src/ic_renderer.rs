@@ -21,8 +21,9 @@ use std::time::Instant;
 use radcache_cache::IcParams;
 use radcache_scene::Scene;
 use radcache_shared::gpu::GpuRecord;
-use radcache_vk::{Context, PassTiming, ShaderCompiler};
+use radcache_vk::{Context, ShaderCompiler};
 
+use crate::clock::FrameClock;
 use crate::composite::CompositePass;
 use crate::direct::DirectPass;
 use crate::emission::EmissionPass;
@@ -40,33 +41,6 @@ use crate::splat::{SplatPass, SplatScope, SplatWeights};
 
 /// Most passes of the cache phase over the sub-frames (see [`IcRenderer::render`]).
 const MAX_CACHE_PASSES: u32 = 4;
-
-fn add_timings(map: &mut BTreeMap<String, f64>, timings: Vec<PassTiming>) {
-    for t in timings {
-        *map.entry(t.name).or_default() += t.duration_ms;
-    }
-}
-
-/// Wall time per phase of a frame.
-struct Phases {
-    lap: Instant,
-    seconds: BTreeMap<String, f64>,
-}
-
-impl Phases {
-    fn new() -> Self {
-        Phases {
-            lap: Instant::now(),
-            seconds: BTreeMap::new(),
-        }
-    }
-
-    /// Adds the time since the previous lap to `name`.
-    fn lap(&mut self, name: &str) {
-        *self.seconds.entry(name.to_string()).or_default() += self.lap.elapsed().as_secs_f64();
-        self.lap = Instant::now();
-    }
-}
 
 /// The cache's passes and state for one image size and one set of cache parameters.
 pub struct IcRenderer {
@@ -172,14 +146,13 @@ impl IcRenderer {
                 settings.params
             )));
         }
+        let mut clock = FrameClock::new();
         let start = Instant::now();
-        let mut phases = Phases::new();
         let (w, h) = (self.width, self.height);
         gpu.set_time(scene, settings.time)?;
         let view = scene.camera_at(settings.time);
         gpu.set_view(&view, w, h, settings.frame, settings.seed)?;
 
-        let mut passes_ms = BTreeMap::new();
         let mut rays: BTreeMap<String, u64> = BTreeMap::new();
         let mut stats = IcStats {
             records_per_level: vec![0; self.params.levels as usize],
@@ -212,9 +185,9 @@ impl IcRenderer {
         self.neighbours
             .record_rebuild(&mut rec, &self.state, gpu.scene_scale())?;
         self.composite.record_clear(&mut rec);
-        add_timings(&mut passes_ms, ctx.submit(rec)?.wait()?);
+        clock.submit(ctx, rec)?;
         stats.records_kept = u64::from(self.state.read_counters()?.counts[0]);
-        phases.lap("setup");
+        clock.lap("setup");
 
         // Records created for a later sub-frame shrink earlier ones (neighbour clamping), which
         // can uncover a pixel an earlier sub-frame had covered: with `settle_records`, passes
@@ -228,15 +201,7 @@ impl IcRenderer {
         for pass in 0..passes {
             let before = stats.records_per_level.iter().sum::<u64>();
             for k in 0..sub_frames {
-                self.fill_holes(
-                    ctx,
-                    gpu,
-                    settings,
-                    k,
-                    &mut stats,
-                    &mut passes_ms,
-                    &mut phases,
-                )?;
+                self.fill_holes(ctx, gpu, settings, k, &mut stats, &mut clock)?;
                 if pass == 0 {
                     report(k + 1);
                 }
@@ -295,36 +260,37 @@ impl IcRenderer {
                 jitter,
                 settings.debug_aovs,
             )?;
-            add_timings(&mut passes_ms, ctx.submit(rec)?.wait()?);
+            clock.submit(ctx, rec)?;
             *rays.entry("direct".into()).or_default() += self.direct.rays()?;
             let c = self.state.read_counters()?;
             stats.holes_left += u64::from(c.counts[3]);
             stats.records = u64::from(c.counts[0]);
             stats.dropped_requests = u64::from(c.limits[2]);
             stats.rejected_records = u64::from(c.limits[3]);
-            phases.lap("shade");
+            clock.lap("shade");
             report(sub_frames + k + 1);
         }
         let mut rec = ctx.begin("ic.emission")?;
         self.emission.record(&mut rec, gpu, &self.composite)?;
-        add_timings(&mut passes_ms, ctx.submit(rec)?.wait()?);
+        clock.submit(ctx, rec)?;
         *rays.entry("emission".into()).or_default() += self.emission.rays()?;
-        phases.lap("emission");
+        clock.lap("emission");
         let (pixels, nonfinite_pixels) = self.composite.read_mean(ctx)?;
         if settings.debug_aovs {
             stats.debug = Some(self.read_debug(ctx, sub_frames, stats.records)?);
         }
-        phases.lap("readback");
-        stats.phases_s = phases.seconds;
+        clock.lap("readback");
+        stats.phases_s = std::mem::take(&mut clock.phases_s);
         Ok((
             FrameOutput {
                 width: w,
                 height: h,
                 pixels,
                 spp: sub_frames,
-                time_s: start.elapsed().as_secs_f64(),
+                time_s: clock.elapsed_s(),
                 rays,
-                passes_ms,
+                passes_ms: std::mem::take(&mut clock.passes_ms),
+                spans: clock.spans,
                 nonfinite_pixels,
                 aovs: None,
             },
@@ -343,8 +309,7 @@ impl IcRenderer {
         settings: &IcSettings,
         k: u32,
         stats: &mut IcStats,
-        passes_ms: &mut BTreeMap<String, f64>,
-        phases: &mut Phases,
+        clock: &mut FrameClock,
     ) -> Result<()> {
         let creation = self.params.for_creation();
         let creation_weights = SplatWeights::from_params(&creation);
@@ -352,8 +317,8 @@ impl IcRenderer {
         let mut rec = ctx.begin("ic.gbuffer")?;
         self.gbuffer_pass
             .record(&mut rec, gpu, &self.gbuffer, sub_frame_jitter(k))?;
-        add_timings(passes_ms, ctx.submit(rec)?.wait()?);
-        phases.lap("cache_gbuffer");
+        clock.submit(ctx, rec)?;
+        clock.lap("cache_gbuffer");
         for level in 0..self.params.levels {
             let selection = Instant::now();
             let mut rec = ctx.begin("ic.select")?;
@@ -386,10 +351,10 @@ impl IcRenderer {
                 false,
             )?;
             self.state.record_begin_batch(&mut rec)?;
-            add_timings(passes_ms, ctx.submit(rec)?.wait()?);
+            clock.submit(ctx, rec)?;
             let c = self.state.read_counters()?;
             stats.hole_filling_s += selection.elapsed().as_secs_f64();
-            phases.lap("hole_selection");
+            clock.lap("hole_selection");
             if c.dispatch[0] == 0 {
                 if c.counts[3] == 0 {
                     break; // no hole at this spacing: finer levels would find none either
@@ -412,13 +377,13 @@ impl IcRenderer {
             self.state.record_end_batch(&mut rec)?;
             self.neighbours
                 .record(&mut rec, &self.state, gpu.scene_scale())?;
-            add_timings(passes_ms, ctx.submit(rec)?.wait()?);
+            clock.submit(ctx, rec)?;
             let created_s = creation_start.elapsed().as_secs_f64();
             stats.record_pass_s += created_s;
             stats.hole_filling_s += created_s;
             stats.record_rays += self.records.rays()?;
             stats.records_per_level[level as usize] += u64::from(c.dispatch[0]);
-            phases.lap("record_creation");
+            clock.lap("record_creation");
         }
         Ok(())
     }

@@ -11,6 +11,7 @@
 
 mod aov;
 pub mod bindings;
+mod clock;
 mod composite;
 mod direct;
 mod emission;
@@ -33,6 +34,7 @@ mod splat;
 mod upload;
 
 pub use aov::{render_aovs, AovPass, Aovs};
+pub use clock::{Span, Track};
 pub use composite::CompositePass;
 pub use direct::DirectPass;
 pub use emission::EmissionPass;

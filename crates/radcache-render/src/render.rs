@@ -7,6 +7,7 @@ use radcache_scene::Scene;
 use radcache_vk::{Context, ShaderCompiler};
 
 use crate::aov::{AovPass, Aovs};
+use crate::clock::{FrameClock, Span};
 use crate::error::{Error, Result};
 use crate::gpu_scene::GpuScene;
 use crate::path_trace::PathTracer;
@@ -84,6 +85,8 @@ pub struct FrameOutput {
     pub rays: BTreeMap<String, u64>,
     /// GPU time per pass name, ms (summed over submissions).
     pub passes_ms: BTreeMap<String, f64>,
+    /// The frame's timeline: GPU passes and host phases.
+    pub spans: Vec<Span>,
     /// Pixels whose value was non-finite and replaced by black (0 unless something is wrong).
     pub nonfinite_pixels: u64,
     /// The AOVs, when asked for.
@@ -107,8 +110,9 @@ pub fn render_path(
     gpu.set_time(scene, settings.time)?;
     let view = scene.camera_at(settings.time);
     gpu.set_view(&view, w, h, settings.frame, settings.seed)?;
+    let mut clock = FrameClock::new();
     let mut tracer = PathTracer::new(ctx, shaders, gpu, w, h)?;
-    let mut passes_ms: BTreeMap<String, f64> = BTreeMap::new();
+    clock.lap("pipelines");
     let mut rays = 0u64;
 
     let aov_pass = if settings.aovs {
@@ -122,12 +126,13 @@ pub fn render_path(
     if let Some(pass) = &aov_pass {
         pass.record(&mut rec, gpu)?;
     }
-    add_timings(&mut passes_ms, ctx.submit(rec)?.wait()?);
+    clock.submit(ctx, rec)?;
     let aovs = match &aov_pass {
         Some(pass) => Some(pass.read(ctx)?),
         None => None,
     };
     drop(aov_pass);
+    clock.lap("setup");
 
     let target = match settings.budget {
         Budget::Samples(n) => n.max(1),
@@ -138,9 +143,10 @@ pub fn render_path(
         let count = chunk.min(target - tracer.samples());
         let mut rec = ctx.begin("frame.path_trace")?;
         tracer.record_samples(&mut rec, gpu, count)?;
+        let submitted = Instant::now();
         let timings = ctx.submit(rec)?.wait()?;
         let gpu_ms: f64 = timings.iter().map(|t| t.duration_ms).sum();
-        add_timings(&mut passes_ms, timings);
+        clock.gpu(submitted, timings);
         rays += tracer.last_chunk_rays()?;
         let elapsed_s = start.elapsed().as_secs_f64();
         let total = match settings.budget {
@@ -167,7 +173,9 @@ pub fn render_path(
             chunk = chunk.min(PathTracer::chunk_size(count, gpu_ms, left).max(1));
         }
     }
+    clock.lap("path_trace");
     let (pixels, nonfinite_pixels) = tracer.read_mean(ctx)?;
+    clock.lap("readback");
     let mut ray_map = BTreeMap::new();
     ray_map.insert("path_trace".to_string(), rays);
     Ok(FrameOutput {
@@ -177,14 +185,9 @@ pub fn render_path(
         spp: tracer.samples(),
         time_s: start.elapsed().as_secs_f64(),
         rays: ray_map,
-        passes_ms,
+        passes_ms: clock.passes_ms,
+        spans: clock.spans,
         nonfinite_pixels,
         aovs,
     })
-}
-
-fn add_timings(map: &mut BTreeMap<String, f64>, timings: Vec<radcache_vk::PassTiming>) {
-    for t in timings {
-        *map.entry(t.name).or_default() += t.duration_ms;
-    }
 }
