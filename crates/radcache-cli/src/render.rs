@@ -290,7 +290,9 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         profile.cpu("image + metadata", t_image, t_write, Some(number));
         frame::write(args, &output, &image, &meta)?;
         profile.cpu("write", t_write, Instant::now(), Some(number));
-        entries.push(frame::stats_entry(&rendered, number, time));
+        let mut entry = frame::stats_entry(&rendered, number, time);
+        entry["device_memory_bytes"] = json!(ctx.memory_by_category());
+        entries.push(entry);
         if let Some(path) = &args.stats {
             write_stats(path, &setup, &entries, [load_s, upload_s, write_s])?;
         }

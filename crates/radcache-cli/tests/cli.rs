@@ -91,6 +91,9 @@ fn render_writes_exr_with_metadata_aovs_png_and_stats() {
     // At least one camera ray per pixel sample.
     assert!(frame["rays"]["path_trace"].as_u64().unwrap() >= 24 * 16 * 3);
     assert!(frame["passes_ms"]["path_trace"].as_f64().unwrap() > 0.0);
+    // Device memory by category: at least the scene's buffers (vertices, BVH inputs, ...).
+    let memory = frame["device_memory_bytes"].as_object().unwrap();
+    assert!(memory["scene"].as_u64().unwrap() > 0, "{memory:?}");
 }
 
 #[test]

@@ -442,6 +442,23 @@ impl Context {
             .unwrap_or(0)
     }
 
+    /// Bytes of device memory allocated per category: the part of each allocation's name before
+    /// its first `.` (`ic.records` → `ic`, `scene.vertices` → `scene`), from the allocator's
+    /// report; unnamed allocations count as `other`.
+    pub fn memory_by_category(&self) -> std::collections::BTreeMap<String, u64> {
+        let mut out = std::collections::BTreeMap::new();
+        if let Some(a) = self.shared.lock_allocator().as_ref() {
+            for alloc in a.generate_report().allocations {
+                let category = match alloc.name.split('.').next() {
+                    Some(c) if !c.is_empty() => c.to_string(),
+                    _ => "other".to_string(),
+                };
+                *out.entry(category).or_insert(0) += alloc.size;
+            }
+        }
+        out
+    }
+
     /// Waits for the GPU to finish all work and destroys retired objects.
     pub fn wait_idle(&self) -> Result<()> {
         self.shared.wait_idle()?;
