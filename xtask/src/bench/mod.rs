@@ -6,7 +6,9 @@
 mod ic;
 mod pt;
 mod rays;
+mod scaling;
 mod scene_rays;
+mod tessellate;
 
 use anyhow::{bail, Result};
 
@@ -18,6 +20,10 @@ pub fn run(args: &[&str]) -> Result<()> {
         ["rays", rest @ ..] => rays::run(rest),
         ["pt", rest @ ..] => pt::run(rest),
         ["ic", rest @ ..] => ic::run(rest),
-        _ => bail!("usage: cargo xtask bench rays [--rays N] | pt [--spp N] | ic"),
+        ["scaling", rest @ ..] => scaling::run(rest),
+        _ => bail!(
+            "usage: cargo xtask bench rays [--rays N] | pt [--spp N] | ic \
+             | scaling [--preset draft|default|high] [--max-size N]"
+        ),
     }
 }

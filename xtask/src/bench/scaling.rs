@@ -1,0 +1,333 @@
+//! `cargo xtask bench scaling [--preset draft|default|high] [--max-size N]`: how the cache's
+//! frame scales with resolution and with triangle count, on the Cornell box.
+//!
+//! Both sweeps use the **draft** preset unless `--preset` says otherwise, so that the 1024² frame
+//! stays within a few minutes on lavapipe; the printed header names the preset in use.
+//!
+//! - Resolution: the cache at 128², 256², 512² and 1024² (sizes above `--max-size`, default
+//!   1024, are skipped): the frame's wall time (`FrameOutput::time_s`, pipeline creation
+//!   included), records, ray queries (all passes, and the record pass alone) and the wall time of
+//!   the frame's main phases (`IcStats::phases_s`).
+//! - Triangles: at 256² (or `--max-size` when smaller), the same scene with every triangle split
+//!   into n² congruent sub-triangles (`tessellate.rs`), n = 1, 2, 4, 8, 10: 1× to 100× the
+//!   triangles. Per level: triangles, the upload's wall time (`GpuScene::new`, which builds and
+//!   compacts the BLASes, then the first TLAS build; the TLAS alone is also given), the frame's
+//!   time, records, rays, and the relMSE of the image against the untessellated one at the same
+//!   settings and seed. The surface is the same, so that relMSE must stay at noise level; the
+//!   noise level is given by the untessellated scene rendered with another seed.
+//!
+//! Every figure goes to `bench/results.csv` (bench `scaling`): cases `cornell_res_<size>` and
+//! `cornell_tess_<k>x`, suffixed `_default` or `_high` when that preset was asked for.
+
+use std::time::Instant;
+
+use anyhow::{bail, Context as _, Result};
+use radcache_cache::{IcParams, Preset};
+use radcache_image::{compare, Image};
+use radcache_render::{render_ic, FrameOutput, GpuScene, IcSettings, IcStats};
+use radcache_scene::{LoadOptions, Scene};
+use radcache_vk::{Context, ShaderCompiler};
+
+use super::tessellate::subdivide_scene;
+use crate::results::{append, Figure};
+
+const USAGE: &str = "usage: cargo xtask bench scaling [--preset draft|default|high] [--max-size N]";
+
+/// The resolutions of the first sweep.
+const SIZES: [u32; 4] = [128, 256, 512, 1024];
+/// The subdivision levels of the second sweep (n² triangles per triangle).
+const LEVELS: [u32; 5] = [1, 2, 4, 8, 10];
+/// The size of the second sweep (smaller when `--max-size` is).
+const TESS_SIZE: u32 = 256;
+
+/// Phases of `IcStats::phases_s`: (key, CSV metric, column title). The table shows the first
+/// five and the rest summed.
+const PHASES: [(&str, &str, &str); 8] = [
+    ("record_creation", "phase_record_creation_s", "create"),
+    ("shade", "phase_shade_s", "shade"),
+    ("hole_selection", "phase_hole_selection_s", "select"),
+    ("cache_gbuffer", "phase_cache_gbuffer_s", "gbuffer"),
+    ("pipelines", "phase_pipelines_s", "pipelines"),
+    ("setup", "phase_setup_s", "setup"),
+    ("emission", "phase_emission_s", "emission"),
+    ("readback", "phase_readback_s", "readback"),
+];
+
+struct Options {
+    preset: Preset,
+    max_size: u32,
+}
+
+fn parse(args: &[&str]) -> Result<Options> {
+    let mut o = Options {
+        preset: Preset::Draft,
+        max_size: 1024,
+    };
+    let mut it = args.iter();
+    while let Some(&arg) = it.next() {
+        let mut value = || {
+            it.next()
+                .copied()
+                .with_context(|| format!("{arg}: no value\n{USAGE}"))
+        };
+        match arg {
+            "--preset" => {
+                o.preset = match value()? {
+                    "draft" => Preset::Draft,
+                    "default" => Preset::Default,
+                    "high" => Preset::High,
+                    other => bail!("unknown preset {other:?}\n{USAGE}"),
+                }
+            }
+            "--max-size" => {
+                let v = value()?;
+                o.max_size = v
+                    .parse()
+                    .with_context(|| format!("--max-size {v:?}\n{USAGE}"))?;
+                anyhow::ensure!(o.max_size >= 16, "--max-size must be at least 16");
+            }
+            other => bail!("unknown argument {other:?}\n{USAGE}"),
+        }
+    }
+    Ok(o)
+}
+
+fn preset_name(p: Preset) -> &'static str {
+    match p {
+        Preset::Draft => "draft",
+        Preset::Default => "default",
+        Preset::High => "high",
+    }
+}
+
+fn settings(size: u32, preset: Preset, seed: u32) -> IcSettings {
+    IcSettings {
+        width: size,
+        height: size,
+        params: IcParams::preset(preset),
+        seed,
+        ..IcSettings::default()
+    }
+}
+
+fn total_rays(out: &FrameOutput) -> u64 {
+    out.rays.values().sum()
+}
+
+fn phase(stats: &IcStats, key: &str) -> f64 {
+    stats.phases_s.get(key).copied().unwrap_or(0.0)
+}
+
+fn image(out: FrameOutput) -> Result<Image> {
+    Ok(Image::from_pixels(out.width, out.height, out.pixels)?)
+}
+
+/// The scene uploaded with its TLAS built: (scene, wall s of everything, wall s of the TLAS).
+fn upload(ctx: &Context, scene: &Scene) -> Result<(GpuScene, f64, f64)> {
+    let start = Instant::now();
+    let mut gpu = GpuScene::new(ctx, scene, None)?;
+    let tlas_start = Instant::now();
+    gpu.set_time(scene, 0.0)?;
+    let mut rec = ctx.begin("scaling.tlas")?;
+    gpu.record_update(ctx, &mut rec)?;
+    ctx.submit(rec)?.wait()?;
+    let end = Instant::now();
+    Ok((
+        gpu,
+        (end - start).as_secs_f64(),
+        (end - tlas_start).as_secs_f64(),
+    ))
+}
+
+pub fn run(args: &[&str]) -> Result<()> {
+    let opts = parse(args)?;
+    let (preset, pname) = (opts.preset, preset_name(opts.preset));
+    let suffix = match preset {
+        Preset::Draft => String::new(),
+        _ => format!("_{pname}"),
+    };
+    let root = crate::root();
+    let (scene, _) = Scene::load(
+        &root.join("assets/cornell/cornell.gltf"),
+        &LoadOptions::default(),
+    )?;
+    let ctx = Context::new()?;
+    let device = ctx.info().name.clone();
+    let shaders = ShaderCompiler::new(root.join("shaders"))?;
+    let mut figures = Vec::new();
+
+    // Warm-up: shader compilation is not part of the figures.
+    {
+        let (mut gpu, _, _) = upload(&ctx, &scene)?;
+        let warm = IcSettings {
+            sub_frames: 1,
+            ..settings(16, Preset::Draft, 0)
+        };
+        render_ic(&ctx, &shaders, &scene, &mut gpu, &warm, &mut |_| {})?;
+    }
+
+    // 1. Resolution.
+    println!(
+        "device: {device}; Cornell box, {} triangles; preset `{pname}`{}",
+        scene.instanced_triangle_count(),
+        if preset == Preset::Draft {
+            " (the default here, so that 1024² stays within minutes on lavapipe)"
+        } else {
+            ""
+        }
+    );
+    println!("\nresolution sweep (frame and phases: wall time, s)");
+    let head: Vec<String> = PHASES[..5].iter().map(|p| format!("{:>9}", p.2)).collect();
+    println!(
+        "{:>9} {:>8} {:>8} {:>9} {:>9} {} {:>9}",
+        "size",
+        "frame",
+        "records",
+        "Mrays",
+        "rec Mrays",
+        head.join(" "),
+        "other"
+    );
+    let mut gpu = upload(&ctx, &scene)?.0;
+    for size in SIZES.into_iter().filter(|&s| s <= opts.max_size) {
+        let (out, stats) = render_ic(
+            &ctx,
+            &shaders,
+            &scene,
+            &mut gpu,
+            &settings(size, preset, 0),
+            &mut |_| {},
+        )?;
+        let rays = total_rays(&out);
+        let shown: Vec<String> = PHASES[..5]
+            .iter()
+            .map(|p| format!("{:>9.3}", phase(&stats, p.0)))
+            .collect();
+        let other: f64 = PHASES[5..].iter().map(|p| phase(&stats, p.0)).sum();
+        println!(
+            "{:>9} {:>8.2} {:>8} {:>9.2} {:>9.2} {} {:>9.3}",
+            format!("{size}²"),
+            out.time_s,
+            stats.records,
+            rays as f64 / 1e6,
+            stats.record_rays as f64 / 1e6,
+            shown.join(" "),
+            other
+        );
+        let case = format!("cornell_res_{size}{suffix}");
+        figures.push(Figure::new(&case, "frame_s", out.time_s, "s"));
+        figures.push(Figure::new(
+            &case,
+            "records",
+            stats.records as f64,
+            "records",
+        ));
+        figures.push(Figure::new(&case, "rays", rays as f64, "rays"));
+        figures.push(Figure::new(
+            &case,
+            "record_rays",
+            stats.record_rays as f64,
+            "rays",
+        ));
+        for (key, metric, _) in PHASES {
+            figures.push(Figure::new(&case, metric, phase(&stats, key), "s"));
+        }
+    }
+    drop(gpu);
+
+    // 2. Triangles.
+    let size = TESS_SIZE.min(opts.max_size);
+    println!(
+        "\ntriangle sweep at {size}² (each triangle split into n² sub-triangles; upload = \
+         GpuScene::new + first TLAS build, wall time, s; relMSE against the 1× image)"
+    );
+    println!(
+        "{:>6} {:>10} {:>9} {:>9} {:>8} {:>8} {:>9} {:>11}",
+        "level", "triangles", "upload", "TLAS", "frame", "records", "Mrays", "relMSE vs 1×"
+    );
+    let mut reference: Option<Image> = None;
+    for n in LEVELS {
+        let tess = if n == 1 {
+            scene.clone()
+        } else {
+            subdivide_scene(&scene, n)?
+        };
+        let triangles = tess.instanced_triangle_count();
+        let (mut gpu, upload_s, tlas_s) = upload(&ctx, &tess)?;
+        let (out, stats) = render_ic(
+            &ctx,
+            &shaders,
+            &tess,
+            &mut gpu,
+            &settings(size, preset, 0),
+            &mut |_| {},
+        )?;
+        let (time_s, rays) = (out.time_s, total_rays(&out));
+        let img = image(out)?;
+        let case = format!("cornell_tess_{}x{suffix}", n * n);
+        let relmse = match &reference {
+            Some(r) => Some(compare(r, &img)?.relmse),
+            None => {
+                // The noise level: the same scene and settings with another seed.
+                let (other, _) = render_ic(
+                    &ctx,
+                    &shaders,
+                    &tess,
+                    &mut gpu,
+                    &settings(size, preset, 1),
+                    &mut |_| {},
+                )?;
+                let noise = compare(&img, &image(other)?)?.relmse;
+                figures.push(Figure::new(&case, "relmse_seed_noise", noise, "relMSE"));
+                reference = Some(img);
+                println!(
+                    "{:>6} noise level (1×, seed 1 against seed 0): relMSE {noise:.3e}",
+                    ""
+                );
+                None
+            }
+        };
+        println!(
+            "{:>6} {:>10} {:>9.3} {:>9.4} {:>8.2} {:>8} {:>9.2} {:>11}",
+            format!("{}×", n * n),
+            triangles,
+            upload_s,
+            tlas_s,
+            time_s,
+            stats.records,
+            rays as f64 / 1e6,
+            relmse.map_or("-".to_string(), |e| format!("{e:.3e}"))
+        );
+        let blas = &gpu.stats().blas;
+        figures.push(Figure::new(
+            &case,
+            "triangles",
+            triangles as f64,
+            "triangles",
+        ));
+        figures.push(Figure::new(&case, "upload_s", upload_s, "s"));
+        figures.push(Figure::new(&case, "tlas_s", tlas_s, "s"));
+        figures.push(Figure::new(
+            &case,
+            "blas_gpu_ms",
+            blas.build_ms + blas.compact_ms,
+            "ms",
+        ));
+        figures.push(Figure::new(&case, "frame_s", time_s, "s"));
+        figures.push(Figure::new(
+            &case,
+            "records",
+            stats.records as f64,
+            "records",
+        ));
+        figures.push(Figure::new(&case, "rays", rays as f64, "rays"));
+        if let Some(e) = relmse {
+            figures.push(Figure::new(&case, "relmse_vs_1x", e, "relMSE"));
+        }
+    }
+
+    append("scaling", &device, &figures)?;
+    let report = ctx.shutdown();
+    anyhow::ensure!(report.leaked.is_empty(), "leaked: {:?}", report.leaked);
+    Ok(())
+}
