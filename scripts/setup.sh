@@ -4,11 +4,12 @@
 # - adds the bookworm-backports suite and installs Mesa 25 (lavapipe with VK_KHR_ray_query) from it;
 # - installs the Vulkan loader, the Khronos validation layer, spirv-tools (spirv-val) and the
 #   tools the `shaderc` crate needs to build glslang/SPIRV-Tools from source (cmake, ninja, g++, python3);
+# - installs fonts-dejavu-core (DejaVu Sans: the text of `radcache convergence`'s PNG plot);
 # - checks for a Rust toolchain.
 # Idempotent: a machine that already has everything is left as it is (a quick check, no apt call).
 set -euo pipefail
 
-need_pkgs=(libvulkan1 vulkan-tools vulkan-validationlayers spirv-tools build-essential cmake ninja-build python3 git pkg-config)
+need_pkgs=(libvulkan1 vulkan-tools vulkan-validationlayers spirv-tools build-essential cmake ninja-build python3 git pkg-config fonts-dejavu-core)
 
 have_all() {
   for p in "${need_pkgs[@]}"; do

@@ -1,6 +1,7 @@
 //! `radcache`: render glTF scenes with global illumination, inspect them, compare images.
 
 mod compare;
+mod convergence;
 mod flicker;
 mod frame;
 mod ic_args;
@@ -36,6 +37,9 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Measure the flicker of an EXR sequence, against a reference sequence or over static pixels.
     Flicker(flicker::FlickerArgs),
+    /// Error against run time of the cache and the path tracer on one frame: CSV, log–log plot,
+    /// Markdown summary with the Pareto front and the speed-ups.
+    Convergence(convergence::ConvergenceArgs),
 }
 
 /// Where the GLSL sources live: `RADCACHE_SHADERS`, else the source tree this binary was built
@@ -63,6 +67,7 @@ fn main() -> ExitCode {
         Command::Info(args) => info::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Flicker(args) => flicker::run(&args),
+        Command::Convergence(args) => convergence::run(&args),
     };
     match result {
         Ok(code) => code,

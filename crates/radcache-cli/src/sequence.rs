@@ -2,7 +2,8 @@
 //! line across them.
 //!
 //! Frames are numbered like Blender's: `--frames 1..120` is inclusive. Frame `f` of a sequence
-//! starting at frame `first` shows the scene at `start + (f − first) / fps`, where `start` is
+//! starting at frame `first` shows the scene at `start + (f − first) / fps` (a single `--frame N`
+//! counts from frame 1, like a sequence `1..N`), where `start` is
 //! `--start-time`, else the animation's first key time, else 0. Without `--frames` or `--frame`,
 //! an output pattern with `#` on an animated scene renders the animation's own range (from its
 //! first to its last key at `fps`); anything else renders frame 1.
@@ -72,16 +73,20 @@ impl Sequence {
             bail!("--time must be finite, got {t}");
         }
         let start = args.start_time.or(range.map(|(t0, _)| t0)).unwrap_or(0.0);
-        let (first, last) = match (args.frames, args.frame) {
+        // `origin`: the frame shown at `start`.
+        let (first, last, origin) = match (args.frames, args.frame) {
             (Some(_), Some(_)) => bail!("--frames and --frame exclude each other"),
-            (Some(text), None) => parse_frames(text)?,
-            (None, Some(n)) => (n, n),
+            (Some(text), None) => {
+                let (a, b) = parse_frames(text)?;
+                (a, b, a)
+            }
+            (None, Some(n)) => (n, n, 1.min(n)),
             (None, None) => match range {
                 Some((t0, t1)) if args.pattern && args.time.is_none() => {
                     let count = ((t1 - t0).max(0.0) * args.fps + 1e-3).floor() as u32 + 1;
-                    (1, count.min(1_000_000))
+                    (1, count.min(1_000_000), 1)
                 }
-                _ => (1, 1),
+                _ => (1, 1, 1),
             },
         };
         if first != last && !args.pattern {
@@ -96,7 +101,7 @@ impl Sequence {
             });
         }
         let frames = (first..=last)
-            .map(|f| (f, start + (f - first) as f32 / args.fps))
+            .map(|f| (f, start + (f - origin) as f32 / args.fps))
             .collect();
         Ok(Sequence { frames })
     }
@@ -225,6 +230,11 @@ mod tests {
         let s = Sequence::new(&args(None, None), None).unwrap();
         assert_eq!(s.frames, vec![(1, 0.0)]);
         let mut single = args(None, Some(7));
+        assert_eq!(
+            Sequence::new(&single, Some((0.5, 2.0))).unwrap().frames,
+            vec![(7, 0.5 + 6.0 / 24.0)],
+            "frame 7 of a sequence that starts at frame 1"
+        );
         single.time = Some(0.25);
         assert_eq!(
             Sequence::new(&single, None).unwrap().frames,
