@@ -258,6 +258,8 @@ pub fn stats_entry(r: &Rendered, frame: u32, time: f32) -> Value {
     if let Some(ic) = &r.ic {
         entry["records"] = json!(ic.records);
         entry["records_kept"] = json!(ic.records_kept);
+        entry["records_evicted"] = json!(ic.records_evicted);
+        entry["cache_passes"] = json!(ic.cache_passes);
         entry["records_created"] = json!(ic.records_per_level.iter().sum::<u64>());
         entry["records_per_level"] = json!(ic.records_per_level);
         entry["holes_left"] = json!(ic.holes_left);

@@ -184,7 +184,19 @@ fn a_killed_sequence_resumes_to_the_same_frames() {
     assert_ok(&again);
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
-    assert_eq!(json["frames"].as_array().unwrap().len(), FRAMES as usize);
+    let frames = json["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), FRAMES as usize);
+    assert_eq!(json["temporal"], true, "a static scene keeps its records");
+    // Frame 1 builds the cache; every later frame keeps it all and creates nothing.
+    assert_eq!(frames[0]["records_kept"], 0);
+    for f in &frames[1..] {
+        assert_eq!(f["records_kept"], frames[0]["records"], "{f}");
+        assert_eq!(
+            (&f["records_created"], &f["records_evicted"]),
+            (&0.into(), &0.into())
+        );
+        assert!(f["cache_passes"].as_u64().unwrap() >= 1);
+    }
 }
 
 #[test]
