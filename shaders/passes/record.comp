@@ -13,8 +13,9 @@
 // the azimuth); it still counts for its stratum. Each ray returns the full indirect radiance
 // arriving along it: next-event estimation at its first hit plus the path continued from there
 // (MIS, Russian roulette from the path's second vertex: a record averages M·N paths, so early
-// roulette costs little variance per ray saved; common/path.glsl, with path regeneration), WITHOUT the emission of the first hit and WITHOUT the
-// environment on a first-segment miss (the direct pass accounts for both at the shading point).
+// roulette costs little variance per ray saved; common/path.glsl, with path regeneration),
+// WITHOUT the emission of the first hit and WITHOUT the environment on a first-segment miss (the
+// direct pass accounts for both at the shading point).
 // r_jk is the first hit's distance, IC_FAR on a miss. A non-finite sample counts as 0.
 //
 // Record (§4.1, §6, §7): one invocation sums the strata exactly as the CPU twin
@@ -53,7 +54,7 @@ layout(local_size_x = 64) in;
 
 layout(binding = B_GBUFFER_END, std430) readonly buffer Requests { uint requests[]; };
 layout(binding = B_GBUFFER_END + 1, std430) buffer Counters { IcCounters counters; };
-layout(binding = B_GBUFFER_END + 2, std430) writeonly buffer Records { GpuRecord records[]; };
+layout(binding = B_GBUFFER_END + 2, std430) buffer Records { GpuRecord records[]; };
 layout(binding = B_GBUFFER_END + 3, std430) buffer RayCount { uint ray_count; };
 layout(binding = B_GBUFFER_END + 4, std430) writeonly buffer Samples { vec4 samples[]; };
 
@@ -66,7 +67,14 @@ layout(push_constant) uniform Push {
     float max_px;          // R⁺ likewise
     float v_scale;         // validity radius / R (IcParams::validity_scale)
     float r_eps_rel;       // r_eps = r_eps_rel × scene scale (frame.camera_position.w)
+    uint source;           // 0: pixel requests (G-buffer); 1: record indices, refreshed in place
+    uint pad0;
+    uint pad1;
+    uint pad2;
 } pc;
+
+// Level and sub-frame of the record being written (a refreshed record keeps its own).
+uint g_level_subframe;
 
 // Radiance per stratum as three float arrays (vec3 arrays would pad to 16 bytes: 1728 strata
 // must fit the 32 KiB of shared memory every device offers).
@@ -82,7 +90,7 @@ vec3 stratum_l(uint i) {
 }
 
 uvec4 record_info(uint pixel_index, uint flags) {
-    return uvec4(pixel_index, pc.level_subframe & 0xffffu, pc.level_subframe >> 16u, flags);
+    return uvec4(pixel_index, g_level_subframe & 0xffffu, g_level_subframe >> 16u, flags);
 }
 
 // A record that can never weigh anything (see the header), counted in limits.w.
@@ -109,7 +117,7 @@ void write_rejected(uint index, vec3 position, float footprint, uint pixel_index
 // vertex on: next-event estimation at the first hit plus the continuation, i.e. the full indirect
 // radiance arriving along the ray.
 PathState begin_stratum(uint i, uint n, uint m, vec3 origin, vec3 t, vec3 b, vec3 nn, vec3 ng,
-                        uint record_seed, out Rng rng) {
+                        uint record_seed, uint pass_seed, out Rng rng) {
     float xi, psi;
     stratum_jitter(record_seed, i, xi, psi);
     vec3 dir = frame_to_world(stratum_direction_local(i / n, i % n, m, n, xi, psi), t, b, nn);
@@ -118,7 +126,7 @@ PathState begin_stratum(uint i, uint n, uint m, vec3 origin, vec3 t, vec3 b, vec
         dir = normalize(dir - 2.0 * below * ng);
         atomicOr(s_folded, 1u);
     }
-    rng = rng_init(record_seed, i, pc.seed);
+    rng = rng_init(record_seed, i, pass_seed);
     Ray ray;
     ray.origin = origin;
     ray.dir = dir;
@@ -132,29 +140,56 @@ void main() {
     if (request >= min(counters.counts.y, counters.limits.y)) {
         return;
     }
-    uint index = counters.counts.z + request;
-    if (index >= counters.limits.x) {
-        if (lid == 0u) {
-            atomicAdd(counters.limits.z, 1u);
+    uint index;
+    uint pixel_index;
+    uint pass_seed = pc.seed;
+    GSample g;
+    g_level_subframe = pc.level_subframe;
+    if (pc.source == 1u) {
+        // Refresh in place: the surface point, normal and footprint are the record's own, and
+        // so are its pixel, level and sub-frame, hence its seeds (records.rs creation_seed): under
+        // unchanged lighting the refreshed record reproduces its value.
+        index = requests[request];
+        if (index >= counters.counts.x) {
+            return;
         }
-        return;
-    }
-    uint pixel_index = requests[request];
-    ivec2 size = imageSize(g_position);
-    uint width = uint(max(size.x, 1));
-    uint row = pixel_index / width;
-    if (row >= uint(max(size.y, 0))) {
-        if (lid == 0u) {
-            write_rejected(index, vec3(0.0), 0.0, pixel_index, FLAG_NO_SURFACE);
+        GpuRecord old = records[index];
+        if (dot(old.normal_rorig.xyz, old.normal_rorig.xyz) == 0.0) {
+            return;  // a rejected record stays rejected
         }
-        return;
-    }
-    GSample g = gbuffer_load(ivec2(pixel_index % width, row));
-    if (!g.surface) {
-        if (lid == 0u) {
-            write_rejected(index, g.position, g.footprint, pixel_index, FLAG_NO_SURFACE);
+        pixel_index = old.info.x;
+        g_level_subframe = old.info.y | (old.info.z << 16u);
+        pass_seed = (pc.seed * 0x9e3779b9u) ^ old.info.z;
+        g.surface = true;
+        g.position = old.position_radius.xyz;
+        g.normal = old.normal_rorig.xyz;
+        g.geometric = vec3(old.grad_r_red.w, old.grad_r_green.w, old.grad_r_blue.w);
+        g.footprint = old.bounds.z;
+    } else {
+        index = counters.counts.z + request;
+        if (index >= counters.limits.x) {
+            if (lid == 0u) {
+                atomicAdd(counters.limits.z, 1u);
+            }
+            return;
         }
-        return;
+        pixel_index = requests[request];
+        ivec2 size = imageSize(g_position);
+        uint width = uint(max(size.x, 1));
+        uint row = pixel_index / width;
+        if (row >= uint(max(size.y, 0))) {
+            if (lid == 0u) {
+                write_rejected(index, vec3(0.0), 0.0, pixel_index, FLAG_NO_SURFACE);
+            }
+            return;
+        }
+        g = gbuffer_load(ivec2(pixel_index % width, row));
+        if (!g.surface) {
+            if (lid == 0u) {
+                write_rejected(index, g.position, g.footprint, pixel_index, FLAG_NO_SURFACE);
+            }
+            return;
+        }
     }
 
     uint m = clamp(pc.m, 1u, MAX_STRATA / 3u);
@@ -165,7 +200,7 @@ void main() {
     vec3 t, b;
     basis_from_normal(nn, t, b);
     vec3 origin = offset_ray_origin(g.position, ng);
-    uint record_seed = ircache_hash(pixel_index ^ ircache_hash(pc.seed));
+    uint record_seed = ircache_hash(pixel_index ^ ircache_hash(pass_seed));
     bool dump = uint(samples.length()) >= (request + 1u) * count;
     if (lid == 0u) {
         s_rays = 0u;
@@ -179,7 +214,7 @@ void main() {
     Rng rng;
     PathState st;
     if (i < count) {
-        st = begin_stratum(i, n, m, origin, t, b, nn, ng, record_seed, rng);
+        st = begin_stratum(i, n, m, origin, t, b, nn, ng, record_seed, pass_seed, rng);
     }
     while (i < count) {
         path_step(st, rng);
@@ -195,7 +230,7 @@ void main() {
             }
             i += GROUP;
             if (i < count) {
-                st = begin_stratum(i, n, m, origin, t, b, nn, ng, record_seed, rng);
+                st = begin_stratum(i, n, m, origin, t, b, nn, ng, record_seed, pass_seed, rng);
             }
         }
     }
@@ -269,9 +304,9 @@ void main() {
     rec.normal_rorig = vec4(nn, r_orig);
     rec.irradiance = vec4(e, att);
     rec.bounds = vec4(lo, hi, g.footprint, r_harm);
-    rec.grad_r_red = vec4(gr[0], 0.0);
-    rec.grad_r_green = vec4(gr[1], 0.0);
-    rec.grad_r_blue = vec4(gr[2], 0.0);
+    rec.grad_r_red = vec4(gr[0], ng.x);
+    rec.grad_r_green = vec4(gr[1], ng.y);
+    rec.grad_r_blue = vec4(gr[2], ng.z);
     rec.grad_t_red = vec4(gt[0], 0.0);
     rec.grad_t_green = vec4(gt[1], 0.0);
     rec.grad_t_blue = vec4(gt[2], 0.0);

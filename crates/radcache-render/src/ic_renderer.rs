@@ -35,7 +35,7 @@ use crate::holes::HolePass;
 use crate::ic::{sub_frame_jitter, IcDebug, IcSettings, IcStats};
 use crate::ic_state::IcState;
 use crate::neighbours::NeighbourPass;
-use crate::records::RecordPass;
+use crate::records::{creation_seed, RecordPass};
 use crate::render::{FrameOutput, Progress};
 use crate::splat::{SplatPass, SplatScope, SplatWeights};
 
@@ -313,7 +313,7 @@ impl IcRenderer {
     ) -> Result<()> {
         let creation = self.params.for_creation();
         let creation_weights = SplatWeights::from_params(&creation);
-        let seed = settings.seed.wrapping_mul(0x9e37_79b9) ^ k;
+        let seed = creation_seed(settings.seed, k);
         let mut rec = ctx.begin("ic.gbuffer")?;
         self.gbuffer_pass
             .record(&mut rec, gpu, &self.gbuffer, sub_frame_jitter(k))?;

@@ -50,7 +50,7 @@ pub use ic_state::IcState;
 pub use neighbours::NeighbourPass;
 pub use path_trace::PathTracer;
 pub use records::{
-    record_seed, DISPATCH_OFFSET, RECORD_BINDINGS_BASE, RECORD_FLAG_CLAMPED_DOWN,
+    creation_seed, record_seed, DISPATCH_OFFSET, RECORD_BINDINGS_BASE, RECORD_FLAG_CLAMPED_DOWN,
     RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED, RECORD_FLAG_INVALID_IRRADIANCE,
     RECORD_FLAG_NO_SURFACE,
 };

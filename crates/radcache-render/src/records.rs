@@ -15,9 +15,10 @@
 //! - `+4` the optional sample dump, `vec4[]` of `(L_jk, r_jk)`
 //!   ([`RecordPass::record_with_samples`]).
 //!
-//! Push constants (32 bytes): `M`, `N`, seed, level | sub-frame << 16 (u32), then `min_px`,
+//! Push constants (48 bytes): `M`, `N`, seed, level | sub-frame << 16 (u32), then `min_px`,
 //! `max_px` (R⁻/R⁺ as validity radii in pixel footprints), the validity scale
-//! (`IcParams::validity_scale`) and `r_eps` relative to the scene scale (f32).
+//! (`IcParams::validity_scale`) and `r_eps` relative to the scene scale (f32), then the source
+//! (0: pixel requests; 1: record indices to refresh in place, [`RecordPass::record_refresh`]).
 
 use bytemuck::{Pod, Zeroable};
 use radcache_cache::sampling::ircache_hash;
@@ -54,7 +55,7 @@ pub const RECORD_FLAG_CLAMPED_DOWN: u32 = 8;
 /// `info.w`: some gather directions fell below the geometric surface and were mirrored into it.
 pub const RECORD_FLAG_FOLDED: u32 = 16;
 
-/// Push constants of `record.comp` (32 bytes).
+/// Push constants of `record.comp` (48 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 struct Push {
@@ -67,6 +68,16 @@ struct Push {
     max_px: f32,
     v_scale: f32,
     r_eps_rel: f32,
+    /// 0: requests are pixels (new records); 1: requests are record indices (refresh in place).
+    source: u32,
+    pad: [u32; 3],
+}
+
+/// The pass seed of the records created for sub-frame `sub_frame` of a frame rendered with
+/// `seed` (`IcRenderer`); `record.comp` recomputes it from a record's stored sub-frame when it
+/// refreshes the record, so a refresh draws the record's own directions and paths again.
+pub fn creation_seed(seed: u32, sub_frame: u32) -> u32 {
+    seed.wrapping_mul(0x9e37_79b9) ^ sub_frame
 }
 
 /// Seed of the jitter of the record created at `pixel_index` with the pass seed `seed`: stratum
@@ -180,7 +191,34 @@ impl RecordPass {
             records,
             samples: &self.no_samples,
         };
-        self.record_io(rec, scene, gbuffer, &io, level, sub_frame, seed)
+        self.record_io(rec, scene, gbuffer, &io, level, sub_frame, seed, 0)
+    }
+
+    /// Records refreshing records in place (temporal caching, IC reference §11.2 step 6): request
+    /// `i` of `requests` (`i < min(counts.y, limits.y)`, dispatched from `counters`) is a record
+    /// index; that record is computed again at its own point, normal and footprint, with its own
+    /// pixel, level and sub-frame, and the pass seed [`creation_seed`]`(frame_seed, sub-frame)`,
+    /// so under unchanged lighting its irradiance and gradients come out bit for bit as they were
+    /// (its radius comes back before neighbour clamping). Rejected records are left as they are.
+    /// `gbuffer` is bound but not read.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_refresh(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        requests: &Buffer,
+        counters: &Buffer,
+        records: &Buffer,
+        frame_seed: u32,
+    ) -> Result<()> {
+        let io = Io {
+            requests,
+            counters,
+            records,
+            samples: &self.no_samples,
+        };
+        self.record_io(rec, scene, gbuffer, &io, 0, 0, frame_seed, 1)
     }
 
     /// As [`RecordPass::record`], and request `i` also writes the samples of its strata,
@@ -206,7 +244,7 @@ impl RecordPass {
             records,
             samples,
         };
-        self.record_io(rec, scene, gbuffer, &io, level, sub_frame, seed)
+        self.record_io(rec, scene, gbuffer, &io, level, sub_frame, seed, 0)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -219,6 +257,7 @@ impl RecordPass {
         level: u32,
         sub_frame: u32,
         seed: u32,
+        source: u32,
     ) -> Result<()> {
         if level > 0xffff || sub_frame > 0xffff {
             return Err(Error::Invalid(format!(
@@ -235,6 +274,8 @@ impl RecordPass {
             max_px: p.max_spacing_px,
             v_scale: p.validity_scale(),
             r_eps_rel: R_EPS_REL,
+            source,
+            pad: [0; 3],
         };
         for image in gbuffer.images() {
             rec.use_image(image, ImageUse::ComputeStorage);

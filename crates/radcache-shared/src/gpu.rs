@@ -135,11 +135,12 @@ gpu_struct! {
         pub irradiance: [f32; 4] => "vec4",
         /// `R⁻` (x), `R⁺` (y), pixel footprint at creation (z), harmonic-mean distance (w).
         pub bounds: [f32; 4] => "vec4",
-        /// Rotational gradient of the red channel (xyz).
+        /// Rotational gradient of the red channel (xyz); x of the geometric normal at creation
+        /// (w; with the next two, what a refresh in place needs to draw the same rays again).
         pub grad_r_red: [f32; 4] => "vec4",
-        /// Rotational gradient of the green channel (xyz).
+        /// Rotational gradient of the green channel (xyz); y of the geometric normal (w).
         pub grad_r_green: [f32; 4] => "vec4",
-        /// Rotational gradient of the blue channel (xyz).
+        /// Rotational gradient of the blue channel (xyz); z of the geometric normal (w).
         pub grad_r_blue: [f32; 4] => "vec4",
         /// Translational gradient of the red channel (xyz).
         pub grad_t_red: [f32; 4] => "vec4",
