@@ -317,7 +317,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     if let Some(path) = &args.profile {
         profile.write(path)?;
     }
-    if !args.quiet && (args.profile.is_some() || args.stats.is_some()) {
+    if !args.quiet {
         eprint!("{}", profile.table());
     }
     drop(ic);
