@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{Context as _, Result};
+use anyhow::Result;
 use radcache_image::{
     png_beside, write_exr, write_png, ExrOptions, Image, Layer, Metadata, PngOptions, ToneMap,
 };
@@ -213,10 +213,7 @@ pub fn method_name(method: Method) -> &'static str {
 /// Writes the frame to `output` (EXR, or PNG when the path says so; a PNG preview beside the EXR
 /// with `--png`), each file atomically.
 pub fn write(args: &RenderArgs, output: &Path, image: &Image, meta: &Metadata) -> Result<()> {
-    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("creating the output folder {}", dir.display()))?;
-    }
+    crate::output::make_parent(output, "output")?;
     let png_options = PngOptions {
         exposure: args.exposure,
         tone_map: if args.tonemap == "filmic" {

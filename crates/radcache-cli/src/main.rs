@@ -6,6 +6,7 @@ mod flicker;
 mod frame;
 mod ic_args;
 mod info;
+mod output;
 mod profile;
 mod progress;
 mod render;

@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{Context as _, Result};
+use anyhow::Result;
 use radcache_render::{FrameOutput, Track};
 use serde_json::{json, Value};
 
@@ -122,22 +122,7 @@ impl Profile {
         ];
         events.extend(self.events.iter().cloned());
         let value = json!({ "traceEvents": events, "displayTimeUnit": "ms" });
-        let text = serde_json::to_string(&value)?;
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .with_context(|| format!("creating the profile folder {}", dir.display()))?;
-        }
-        radcache_image::write_atomic(path, |w| {
-            use std::io::Write;
-            w.write_all(text.as_bytes())
-                .map_err(|source| radcache_image::Error::Io {
-                    op: "cannot write",
-                    path: path.to_path_buf(),
-                    source,
-                })
-        })
-        .with_context(|| format!("writing the profile {}", path.display()))?;
-        Ok(())
+        crate::output::write_text(path, &serde_json::to_string(&value)?, "profile")
     }
 
     /// The per-pass table (GPU time; rays/s over the pass's own GPU time).

@@ -378,20 +378,5 @@ fn write_stats(
         "cpu_s": {"scene_load": load_s, "upload": upload_s, "write": write_s},
         "frames": frames,
     });
-    let text = serde_json::to_string_pretty(&value)?;
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("creating the stats folder {}", dir.display()))?;
-    }
-    radcache_image::write_atomic(path, |w| {
-        use std::io::Write;
-        w.write_all(text.as_bytes())
-            .map_err(|source| radcache_image::Error::Io {
-                op: "cannot write",
-                path: path.to_path_buf(),
-                source,
-            })
-    })
-    .with_context(|| format!("writing stats {}", path.display()))?;
-    Ok(())
+    crate::output::write_text(path, &serde_json::to_string_pretty(&value)?, "stats")
 }

@@ -185,13 +185,18 @@ impl RecordPass {
         sub_frame: u32,
         seed: u32,
     ) -> Result<()> {
-        let io = Io {
+        self.record_with_samples(
+            rec,
+            scene,
+            gbuffer,
             requests,
             counters,
             records,
-            samples: &self.no_samples,
-        };
-        self.record_io(rec, scene, gbuffer, &io, level, sub_frame, seed, 0)
+            level,
+            sub_frame,
+            seed,
+            &self.no_samples,
+        )
     }
 
     /// Records refreshing records in place (temporal caching, IC reference §11.2 step 6): request
