@@ -5,7 +5,8 @@
 //   +1 normal     xyz unit shading normal, turned toward the camera; w = pixel footprint (world
 //                 size of one pixel at the point, ircache_math.glsl `pixel_footprint`)
 //   +2 geometric  xyz unit geometric normal, turned toward the camera; w = material index
-//   +3 albedo     rgb diffuse albedo (base colour × (1 − metallic), textured); w = 0
+//   +3 albedo     rgb diffuse albedo (base colour × (1 − metallic), textured); w = the mesh
+//                 instance (custom index; exact as a float below 2^24)
 //   +4 emission   rgb radiance emitted toward the camera (front/back rule applied); w = 0
 //   +5 direct     rgb direct light reflected toward the camera (albedo/π × NEE, MIS); w = 0
 //
@@ -35,6 +36,7 @@ struct GSample {
     float footprint;   // world size of one pixel at `position`
     vec3 geometric;    // toward the camera
     uint material;
+    uint instance;     // mesh instance (custom index)
     vec3 albedo;
     vec3 emission;
 };
@@ -50,7 +52,9 @@ GSample gbuffer_load(ivec2 pixel) {
     s.footprint = n.w;
     s.geometric = g.xyz;
     s.material = uint(max(g.w, 0.0));
-    s.albedo = imageLoad(g_albedo, pixel).rgb;
+    vec4 a = imageLoad(g_albedo, pixel);
+    s.albedo = a.rgb;
+    s.instance = uint(max(a.w, 0.0));
     s.emission = imageLoad(g_emission, pixel).rgb;
     return s;
 }

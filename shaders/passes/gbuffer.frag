@@ -62,6 +62,6 @@ void main() {
     o_position = vec4(v_position, 1.0);
     o_normal = vec4(ns, footprint);
     o_geometric = vec4(ng, float(material));
-    o_albedo = vec4(material_albedo(material, v_uv), 0.0);
+    o_albedo = vec4(material_albedo(material, v_uv), float(pc.instance));
     o_emission = vec4(material_emission(material, v_uv, front), 0.0);
 }

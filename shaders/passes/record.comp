@@ -43,7 +43,9 @@
 #define MAX_STRATA 1728u
 #define GROUP 64u
 
-// info.w flags (records.rs RECORD_FLAG_*).
+// info.w: flags (low 8 bits, records.rs RECORD_FLAG_*) and 1 + the record's mesh instance
+// (bits 8 and up, RECORD_INSTANCE_SHIFT; 0 for a rejected record).
+const uint INSTANCE_SHIFT = 8u;
 const uint FLAG_INVALID_IRRADIANCE = 1u;
 const uint FLAG_NO_SURFACE = 2u;
 const uint FLAG_CLAMPED_UP = 4u;
@@ -67,7 +69,8 @@ layout(push_constant) uniform Push {
     float max_px;          // R⁺ likewise
     float v_scale;         // validity radius / R (IcParams::validity_scale)
     float r_eps_rel;       // r_eps = r_eps_rel × scene scale (frame.camera_position.w)
-    uint source;           // 0: pixel requests (G-buffer); 1: record indices, refreshed in place
+    uint source;           // 0: pixel requests (G-buffer); 1: record indices, refreshed in place;
+                           // 2: as 1, the new R_orig no larger than the record's (temporal refresh)
     uint pad0;
     uint pad1;
     uint pad2;
@@ -75,6 +78,10 @@ layout(push_constant) uniform Push {
 
 // Level and sub-frame of the record being written (a refreshed record keeps its own).
 uint g_level_subframe;
+// 1 + its instance, shifted into place (a refreshed record keeps its own).
+uint g_instance_bits = 0u;
+// Upper bound of R_orig (source 2: the record's own, so a refresh never undoes neighbour clamping).
+float g_r_orig_cap = IC_FAR;
 
 // Radiance per stratum as three float arrays (vec3 arrays would pad to 16 bytes: 1728 strata
 // must fit the 32 KiB of shared memory every device offers).
@@ -91,6 +98,10 @@ vec3 stratum_l(uint i) {
 
 uvec4 record_info(uint pixel_index, uint flags) {
     return uvec4(pixel_index, g_level_subframe & 0xffffu, g_level_subframe >> 16u, flags);
+}
+
+uvec4 record_info_instance(uint pixel_index, uint flags) {
+    return record_info(pixel_index, flags | g_instance_bits);
 }
 
 // A record that can never weigh anything (see the header), counted in limits.w.
@@ -145,7 +156,7 @@ void main() {
     uint pass_seed = pc.seed;
     GSample g;
     g_level_subframe = pc.level_subframe;
-    if (pc.source == 1u) {
+    if (pc.source != 0u) {
         // Refresh in place: the surface point, normal and footprint are the record's own, and
         // so are its pixel, level and sub-frame, hence its seeds (records.rs creation_seed): under
         // unchanged lighting the refreshed record reproduces its value.
@@ -157,6 +168,8 @@ void main() {
         if (dot(old.normal_rorig.xyz, old.normal_rorig.xyz) == 0.0) {
             return;  // a rejected record stays rejected
         }
+        g_instance_bits = old.info.w & ~((1u << INSTANCE_SHIFT) - 1u);
+        g_r_orig_cap = pc.source == 2u ? old.normal_rorig.w : IC_FAR;
         pixel_index = old.info.x;
         g_level_subframe = old.info.y | (old.info.z << 16u);
         pass_seed = (pc.seed * 0x9e3779b9u) ^ old.info.z;
@@ -184,6 +197,7 @@ void main() {
             return;
         }
         g = gbuffer_load(ivec2(pixel_index % width, row));
+        g_instance_bits = (g.instance + 1u) << INSTANCE_SHIFT;
         if (!g.surface) {
             if (lid == 0u) {
                 write_rejected(index, g.position, g.footprint, pixel_index, FLAG_NO_SURFACE);
@@ -295,7 +309,7 @@ void main() {
     float r_lo, r_hi;
     radius_bounds(g.footprint, pc.min_px, pc.max_px, pc.v_scale, r_lo, r_hi);
     float r_orig, r_used, lo, hi, att;
-    finalize_radius(r_raw, e, gt[0], gt[1], gt[2], IC_FAR, r_lo, r_hi, r_orig, r_used, lo, hi, att);
+    finalize_radius(r_raw, e, gt[0], gt[1], gt[2], g_r_orig_cap, r_lo, r_hi, r_orig, r_used, lo, hi, att);
     flags |= r_orig < lo ? FLAG_CLAMPED_UP : 0u;
     flags |= r_orig > hi ? FLAG_CLAMPED_DOWN : 0u;
 
@@ -310,6 +324,6 @@ void main() {
     rec.grad_t_red = vec4(gt[0], 0.0);
     rec.grad_t_green = vec4(gt[1], 0.0);
     rec.grad_t_blue = vec4(gt[2], 0.0);
-    rec.info = record_info(pixel_index, flags);
+    rec.info = record_info_instance(pixel_index, flags);
     records[index] = rec;
 }

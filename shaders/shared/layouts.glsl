@@ -83,4 +83,13 @@ struct IcCounters {
     uvec4 batch_draw;
 };  // 80 bytes
 
+struct GpuRecordTemporal {
+    vec4 object_position;
+    vec4 object_normal;
+    vec4 object_geometric;
+    vec4 birth_irradiance;
+    vec4 gradient;
+    uvec4 info;
+};  // 96 bytes
+
 #endif

@@ -16,8 +16,8 @@ use radcache_cache::record::*;
 use radcache_cache::sampling::*;
 use radcache_cache::{IcParams, IC_FAR, R_FLOOR};
 use radcache_render::{record_seed, GBuffer, GpuScene, IcState, RecordPass, R_EPS_REL};
+use radcache_render::{RECORD_FLAGS_MASK, RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE};
 use radcache_render::{RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED};
-use radcache_render::{RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE};
 use radcache_scene::Scene;
 use radcache_shared::gpu::{GpuRecord, IcCounters};
 use radcache_tests::geometry::intersect;
@@ -282,7 +282,11 @@ fn check_record(
     assert!(!down || r_orig > r_used);
     let up_flag = if up { RECORD_FLAG_CLAMPED_UP } else { 0 };
     let flags = up_flag | if down { RECORD_FLAG_CLAMPED_DOWN } else { 0 };
-    assert_eq!(rec.info[3] & !RECORD_FLAG_FOLDED, flags, "{rec:?}");
+    assert_eq!(
+        rec.info[3] & RECORD_FLAGS_MASK & !RECORD_FLAG_FOLDED,
+        flags,
+        "{rec:?}"
+    );
     assert_eq!(rec.info[..3], [q.index(), level, sub_frame]);
     est
 }

@@ -32,6 +32,8 @@ pub struct FrameSetup<'a> {
     pub temporal: bool,
     /// More than one frame is rendered.
     pub sequence: bool,
+    /// Seconds per frame when records need lifespans (moving geometry or lights), else 0.
+    pub time_step_s: f32,
 }
 
 impl std::fmt::Debug for FrameSetup<'_> {
@@ -112,6 +114,7 @@ pub fn render(
                 time,
                 debug_aovs: args.debug_aov,
                 settle_records: setup.temporal && setup.sequence,
+                time_step_s: setup.time_step_s,
                 ..defaults
             };
             let mut created = None;
@@ -256,6 +259,10 @@ pub fn stats_entry(r: &Rendered, frame: u32, time: f32) -> Value {
         entry["records"] = json!(ic.records);
         entry["records_kept"] = json!(ic.records_kept);
         entry["records_evicted"] = json!(ic.records_evicted);
+        entry["records_refreshed"] = json!(ic.records_refreshed);
+        entry["record_rays"] = json!(ic.record_rays);
+        entry["refresh_rays"] = json!(ic.refresh_rays);
+        entry["lookahead_rays"] = json!(ic.lookahead_rays);
         entry["cache_passes"] = json!(ic.cache_passes);
         entry["records_created"] = json!(ic.records_per_level.iter().sum::<u64>());
         entry["records_per_level"] = json!(ic.records_per_level);

@@ -122,8 +122,8 @@ pub struct RenderArgs {
     /// interrupted run resumes where it stopped).
     #[arg(long)]
     pub(crate) overwrite: bool,
-    /// Rebuild the cache every frame instead of keeping its records (static scenes and
-    /// camera-only animation keep them by default).
+    /// Rebuild the cache every frame instead of keeping its records (by default records are
+    /// kept; with moving geometry or lights they carry lifespans and are refreshed in place).
     #[arg(long)]
     pub(crate) no_temporal: bool,
     /// Use the camera with this name instead of the scene's first.
@@ -239,8 +239,14 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         Instant::now(),
         None,
     );
-    // Records are world-space: valid for as long as nothing but the camera moves.
-    let temporal = !args.no_temporal && plan.keeps_records();
+    // Records are kept across frames; where geometry or lights move they carry lifespans
+    // (temporal caching, a time step of one frame).
+    let temporal = !args.no_temporal;
+    let time_step_s = if temporal && sequence.frames.len() > 1 && plan.needs_lifespans() {
+        1.0 / args.fps
+    } else {
+        0.0
+    };
     let setup = FrameSetup {
         args,
         ctx: &ctx,
@@ -250,6 +256,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         budget,
         temporal,
         sequence: sequence.frames.len() > 1,
+        time_step_s,
     };
     let stop = interrupt_flag(sequence.frames.len() > 1);
     let mut progress = SequenceProgress::new(sequence.frames.len(), args.quiet);
@@ -375,6 +382,7 @@ fn write_stats(
         "device": setup.ctx.info().name,
         "resolution": [setup.size.0, setup.size.1],
         "temporal": setup.temporal,
+        "time_step_s": setup.time_step_s,
         "cpu_s": {"scene_load": load_s, "upload": upload_s, "write": write_s},
         "frames": frames,
     });

@@ -25,7 +25,7 @@ pub struct GBuffer {
     pub normal: Image,
     /// Geometric normal toward the camera (xyz), material index (w).
     pub geometric: Image,
-    /// Diffuse albedo (rgb).
+    /// Diffuse albedo (rgb), mesh instance (w, its custom index as a float).
     pub albedo: Image,
     /// Emitted radiance toward the camera (rgb).
     pub emission: Image,

@@ -197,7 +197,7 @@ impl GpuScene {
         let instances = host_buffer(
             ctx,
             "scene.instances",
-            vk::BufferUsageFlags::STORAGE_BUFFER,
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
             instance_count * std::mem::size_of::<GpuInstance>() as u64,
         )?;
         let max_emitters: usize = scene
@@ -322,6 +322,12 @@ impl GpuScene {
                 (n > 0).then_some((i as u32, n))
             })
             .collect()
+    }
+
+    /// The instances at the current time (`GpuInstance` per instance, by custom index) and
+    /// their number.
+    pub fn instances(&self) -> (&Buffer, u32) {
+        (&self.instances, self.instance_mesh.len() as u32)
     }
 
     /// Emissive triangles at the current time.

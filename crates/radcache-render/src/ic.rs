@@ -50,6 +50,11 @@ pub struct IcSettings {
     /// [`crate::IcRenderer::render`]), so that a next frame that keeps the records finds no hole
     /// where nothing changed (sequences; a single frame does not need it).
     pub settle_records: bool,
+    /// Seconds from this frame to the next (`1 / fps`) when the scene's geometry or lights move
+    /// and records are kept: records then follow their instances and carry temporal gradients
+    /// and lifespans (`crate::temporal`). 0 (the default) for a single frame or a scene whose
+    /// lighting does not change. Must be set when the renderer is created.
+    pub time_step_s: f32,
 }
 
 impl Default for IcSettings {
@@ -67,6 +72,7 @@ impl Default for IcSettings {
             debug_aovs: false,
             evict_after_frames: 60,
             settle_records: false,
+            time_step_s: 0.0,
         }
     }
 }
@@ -95,8 +101,15 @@ pub struct IcStats {
     pub hole_filling_s: f64,
     /// Wall time of the record-creation submissions alone (records and neighbours), s.
     pub record_pass_s: f64,
-    /// Ray queries of the record pass.
+    /// Ray queries of the record pass (new records, refreshes and look-ahead evaluations).
     pub record_rays: u64,
+    /// Records whose lifespan ended, recomputed in place at the start of the frame.
+    pub records_refreshed: u64,
+    /// Ray queries of those refreshes (part of `record_rays`).
+    pub refresh_rays: u64,
+    /// Ray queries of the look-ahead evaluations of the frame's new and refreshed records at the
+    /// next frame's time (part of `record_rays`).
+    pub lookahead_rays: u64,
     /// Wall time of each phase of the frame, s: `pipelines` (creating the passes, [`render_ic`]
     /// only), `setup`, `cache_gbuffer`, `hole_selection`, `record_creation`, `shade`
     /// (G-buffer, direct, splat, composite), `emission`, `readback` (summed over sub-frames).

@@ -14,6 +14,12 @@
 //! Every sub-frame is therefore shaded with the same, final set of records, and a frame whose
 //! holes are all covered by kept records creates none and shades exactly as the frame before it.
 //! Finally the **emission** pass adds the box-filtered emission.
+//!
+//! With `IcSettings::time_step_s` (animated geometry or lights), records also carry temporal
+//! state (`crate::temporal`, steps in `ic_renderer/lifecycle.rs`): the setup moves them with
+//! their instances and extrapolates them in time, expired ones are refreshed in place before the
+//! cache phase, and the frame's new and refreshed records are evaluated once more at the next
+//! frame's time after it.
 
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -38,6 +44,9 @@ use crate::neighbours::NeighbourPass;
 use crate::records::{creation_seed, RecordPass};
 use crate::render::{FrameOutput, Progress};
 use crate::splat::{SplatPass, SplatScope, SplatWeights};
+use crate::temporal::TemporalPass;
+
+mod lifecycle;
 
 /// Most passes of the cache phase over the sub-frames (see [`IcRenderer::render`]).
 const MAX_CACHE_PASSES: u32 = 4;
@@ -57,6 +66,8 @@ pub struct IcRenderer {
     composite: CompositePass,
     emission: EmissionPass,
     state: IcState,
+    /// Temporal caching, when created with a time step.
+    temporal: Option<TemporalPass>,
     /// False until a frame has left records to keep.
     has_records: bool,
     /// Frames rendered (the last-use marks of `IcState::last_used`).
@@ -106,6 +117,16 @@ impl IcRenderer {
             composite: CompositePass::new(ctx, shaders, gpu, w, h)?,
             emission: EmissionPass::new(ctx, shaders, gpu)?,
             state: IcState::new(ctx, shaders, settings.record_capacity, w * h)?,
+            temporal: if settings.time_step_s > 0.0 {
+                Some(TemporalPass::new(
+                    ctx,
+                    shaders,
+                    gpu,
+                    settings.record_capacity,
+                )?)
+            } else {
+                None
+            },
             has_records: false,
             frames: 0,
         })
@@ -135,15 +156,23 @@ impl IcRenderer {
     ) -> Result<(FrameOutput, IcStats)> {
         if (settings.width, settings.height, settings.params)
             != (self.width, self.height, self.params)
+            || (settings.time_step_s > 0.0 && self.temporal.is_none())
         {
             return Err(Error::Invalid(format!(
-                "the renderer was made for {}x{} and {:?}, not {}x{} and {:?}",
+                "the renderer was made for {}x{} and {:?}{}, not {}x{} and {:?} with a time step \
+                 of {} s",
                 self.width,
                 self.height,
                 self.params,
+                if self.temporal.is_some() {
+                    " with temporal caching"
+                } else {
+                    ""
+                },
                 settings.width,
                 settings.height,
-                settings.params
+                settings.params,
+                settings.time_step_s
             )));
         }
         let mut clock = FrameClock::new();
@@ -177,10 +206,22 @@ impl IcRenderer {
                 .compact(ctx, |_, used| used != 0 && now - used <= limit)?;
             stats.records_evicted = u64::from(evicted);
         }
+        let kept = if self.has_records {
+            self.state.read_counters()?.counts[0]
+        } else {
+            0
+        };
+        let temporal = settings.time_step_s > 0.0;
         let mut rec = ctx.begin("ic.setup")?;
         gpu.record_update(ctx, &mut rec)?;
         if !self.has_records {
             self.state.record_reset(&mut rec)?;
+        }
+        if let Some(t) = self.temporal.as_mut().filter(|_| temporal) {
+            if !self.has_records {
+                t.forget();
+            }
+            t.record_advance(&mut rec, gpu, &self.state, now, kept)?;
         }
         self.neighbours
             .record_rebuild(&mut rec, &self.state, gpu.scene_scale())?;
@@ -188,6 +229,11 @@ impl IcRenderer {
         clock.submit(ctx, rec)?;
         stats.records_kept = u64::from(self.state.read_counters()?.counts[0]);
         clock.lap("setup");
+        let expired = if temporal {
+            self.refresh_expired(ctx, gpu, settings, &mut stats, &mut clock)?
+        } else {
+            0
+        };
 
         // Records created for a later sub-frame shrink earlier ones (neighbour clamping), which
         // can uncover a pixel an earlier sub-frame had covered: with `settle_records`, passes
@@ -210,6 +256,11 @@ impl IcRenderer {
             if stats.records_per_level.iter().sum::<u64>() == before {
                 break;
             }
+        }
+        if temporal {
+            self.look_ahead(
+                ctx, scene, gpu, settings, &view, expired, &mut stats, &mut clock,
+            )?;
         }
         *rays.entry("records".into()).or_default() += stats.record_rays;
         self.has_records = true;
@@ -272,6 +323,9 @@ impl IcRenderer {
         }
         let mut rec = ctx.begin("ic.emission")?;
         self.emission.record(&mut rec, gpu, &self.composite)?;
+        if let Some(t) = self.temporal.as_mut().filter(|_| temporal) {
+            t.record_keep_instances(&mut rec, gpu);
+        }
         clock.submit(ctx, rec)?;
         *rays.entry("emission".into()).or_default() += self.emission.rays()?;
         clock.lap("emission");

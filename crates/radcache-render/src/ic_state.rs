@@ -4,7 +4,7 @@
 //! dispatch or a draw.
 
 use bytemuck::{Pod, Zeroable};
-use radcache_shared::gpu::{GpuRecord, IcCounters};
+use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal, IcCounters};
 use radcache_vk::{
     vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, MemoryLocation, Pipeline,
     Recorder, Resource, ShaderCompiler,
@@ -67,6 +67,9 @@ pub struct IcState {
     /// Per record, the last frame (the renderer's count, from 1) whose final splat it weighed
     /// in; 0 = never.
     pub last_used: Buffer,
+    /// `GpuRecordTemporal[record_capacity]`: each record's temporal state (temporal caching,
+    /// `crate::temporal`).
+    pub temporal: Buffer,
     record_capacity: u32,
     request_capacity: u32,
 }
@@ -115,7 +118,7 @@ impl IcState {
             records: buffer(
                 "ic.records",
                 u64::from(record_capacity) * std::mem::size_of::<GpuRecord>() as u64,
-                storage,
+                storage | vk::BufferUsageFlags::TRANSFER_SRC,
                 MemoryLocation::GpuOnly,
             )?,
             requests: buffer(
@@ -146,6 +149,12 @@ impl IcState {
                 "ic.last_used",
                 u64::from(record_capacity.max(1)) * 4,
                 storage | vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC,
+                MemoryLocation::GpuOnly,
+            )?,
+            temporal: buffer(
+                "ic.temporal",
+                u64::from(record_capacity.max(1)) * std::mem::size_of::<GpuRecordTemporal>() as u64,
+                storage | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuOnly,
             )?,
             record_capacity,
@@ -200,7 +209,7 @@ impl IcState {
     }
 
     /// Keeps the records `keep` selects (by index and last use) and drops the others, moving the
-    /// kept ones to the front in their order; returns how many were dropped. The caller must
+    /// kept ones (with their temporal state) to the front in their order; returns how many were dropped. The caller must
     /// rebuild the neighbour grid afterwards. Rare (eviction), so it goes through the host.
     pub fn compact(&self, ctx: &Context, keep: impl Fn(usize, u32) -> bool) -> Result<u32> {
         let counters = self.read_counters()?;
@@ -215,6 +224,7 @@ impl IcState {
             return Ok(0);
         }
         let records: Vec<GpuRecord> = ctx.read_buffer(&self.records, count)?;
+        let temporal: Vec<GpuRecordTemporal> = ctx.read_buffer(&self.temporal, count)?;
         let mut rec = ctx.begin("ic.compact")?;
         let n = kept.len() as u32;
         let mut staging = Vec::new();
@@ -224,11 +234,15 @@ impl IcState {
             let src = vk::BufferUsageFlags::TRANSFER_SRC;
             let r = ctx.create_buffer_init("ic.compact.records", src, &new_records)?;
             let u = ctx.create_buffer_init("ic.compact.last_used", src, &new_used)?;
+            let new_temporal: Vec<GpuRecordTemporal> = kept.iter().map(|&i| temporal[i]).collect();
+            let t = ctx.create_buffer_init("ic.compact.temporal", src, &new_temporal)?;
             rec.barrier(Access::ALL, Access::TRANSFER_WRITE);
             let bytes = std::mem::size_of_val(&new_records[..]) as u64;
             rec.copy_buffer(&r, 0, &self.records, 0, bytes);
             rec.copy_buffer(&u, 0, &self.last_used, 0, u64::from(n) * 4);
-            staging.extend([r, u]);
+            let bytes = std::mem::size_of_val(&new_temporal[..]) as u64;
+            rec.copy_buffer(&t, 0, &self.temporal, 0, bytes);
+            staging.extend([r, u, t]);
         }
         // Slots past the kept records start again as never used.
         rec.fill_buffer(

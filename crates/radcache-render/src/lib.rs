@@ -31,6 +31,7 @@ mod render;
 mod scene_lights;
 mod scene_pack;
 mod splat;
+mod temporal;
 mod upload;
 
 pub use aov::{render_aovs, AovPass, Aovs};
@@ -50,11 +51,12 @@ pub use ic_state::IcState;
 pub use neighbours::NeighbourPass;
 pub use path_trace::PathTracer;
 pub use records::{
-    creation_seed, record_seed, DISPATCH_OFFSET, RECORD_BINDINGS_BASE, RECORD_FLAG_CLAMPED_DOWN,
-    RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED, RECORD_FLAG_INVALID_IRRADIANCE,
-    RECORD_FLAG_NO_SURFACE,
+    creation_seed, record_seed, DISPATCH_OFFSET, RECORD_BINDINGS_BASE, RECORD_FLAGS_MASK,
+    RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED,
+    RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE, RECORD_INSTANCE_SHIFT,
 };
 pub use records::{RecordPass, MAX_STRATA, R_EPS_REL};
 pub use render::{render_path, Budget, FrameOutput, PathSettings, Progress};
 pub use splat::{SplatPass, SplatScope, SplatWeights};
+pub use temporal::{Lifespans, TemporalPass};
 pub use upload::vulkan_clip_from_view;

@@ -54,6 +54,11 @@ pub const RECORD_FLAG_CLAMPED_UP: u32 = 4;
 pub const RECORD_FLAG_CLAMPED_DOWN: u32 = 8;
 /// `info.w`: some gather directions fell below the geometric surface and were mirrored into it.
 pub const RECORD_FLAG_FOLDED: u32 = 16;
+/// `info.w`'s flag bits; the bits above hold 1 + the record's mesh instance
+/// ([`RECORD_INSTANCE_SHIFT`]; 0 for a rejected record).
+pub const RECORD_FLAGS_MASK: u32 = 0xff;
+/// Shift of `1 + instance` in `info.w`.
+pub const RECORD_INSTANCE_SHIFT: u32 = 8;
 
 /// Push constants of `record.comp` (48 bytes).
 #[repr(C)]
@@ -68,7 +73,8 @@ struct Push {
     max_px: f32,
     v_scale: f32,
     r_eps_rel: f32,
-    /// 0: requests are pixels (new records); 1: requests are record indices (refresh in place).
+    /// 0: requests are pixels (new records); 1: requests are record indices (refresh in place);
+    /// 2: as 1, `R_orig` capped at the record's own.
     source: u32,
     pad: [u32; 3],
 }
@@ -224,6 +230,29 @@ impl RecordPass {
             samples: &self.no_samples,
         };
         self.record_io(rec, scene, gbuffer, &io, 0, 0, frame_seed, 1)
+    }
+
+    /// As [`RecordPass::record_refresh`], and the new `R_orig` is no larger than the record's
+    /// (temporal refresh: the radius neighbour clamping gave it stays an upper bound, so a
+    /// refresh never makes a record reach past a neighbour; a closer occluder still shrinks it).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_refresh_capped(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        requests: &Buffer,
+        counters: &Buffer,
+        records: &Buffer,
+        frame_seed: u32,
+    ) -> Result<()> {
+        let io = Io {
+            requests,
+            counters,
+            records,
+            samples: &self.no_samples,
+        };
+        self.record_io(rec, scene, gbuffer, &io, 0, 0, frame_seed, 2)
     }
 
     /// As [`RecordPass::record`], and request `i` also writes the samples of its strata,

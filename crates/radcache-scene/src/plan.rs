@@ -150,12 +150,22 @@ impl Scene {
 }
 
 impl ScenePlan {
-    /// Whether an animation's irradiance records stay valid from frame to frame: records are
-    /// world-space, so they do while nothing but the camera moves.
+    /// Whether an animation's irradiance records stay valid from frame to frame as they are:
+    /// records are world-space, so they do while nothing but the camera moves.
     pub fn keeps_records(&self) -> bool {
         matches!(
             self.animation.kind,
             AnimationKind::None | AnimationKind::CameraOnly
+        )
+    }
+
+    /// Whether kept records need temporal caching (IC reference §11.2): moving geometry or lights
+    /// change the irradiance, so records follow their instances, carry temporal gradients and
+    /// are refreshed in place when their lifespan ends.
+    pub fn needs_lifespans(&self) -> bool {
+        matches!(
+            self.animation.kind,
+            AnimationKind::LightsOnly | AnimationKind::Geometry
         )
     }
 }
@@ -218,7 +228,8 @@ impl fmt::Display for ScenePlan {
         let cache = if self.keeps_records() {
             "records kept from frame to frame (holes filled where the view uncovers new surfaces)"
         } else {
-            "rebuilt every frame (moving geometry or lights)"
+            "records kept with lifespans (moving geometry or lights: records follow their \
+             instances, are extrapolated in time and refreshed in place when they expire)"
         };
         writeln!(f, "  cache across frames: {cache}")
     }

@@ -263,7 +263,7 @@ fn animated_scene() {
         "{text}"
     );
     assert!(
-        text.contains("cache across frames: rebuilt every frame"),
+        text.contains("cache across frames: records kept with lifespans"),
         "{text}"
     );
 }

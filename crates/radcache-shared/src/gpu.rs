@@ -173,6 +173,26 @@ gpu_struct! {
     }
 }
 
+gpu_struct! {
+    /// A record's temporal state (temporal radiance caching, IC reference §11.2), 96 bytes, kept
+    /// beside its `GpuRecord` (same index). The record lives on its mesh instance: its point and
+    /// normals are stored in the instance's object space and moved with it every frame.
+    pub struct GpuRecordTemporal {
+        /// Object-space position (xyz); lifespan `Δt_i` in frames (w).
+        pub object_position: [f32; 4] => "vec4",
+        /// Object-space shading normal (xyz); unused (w).
+        pub object_normal: [f32; 4] => "vec4",
+        /// Object-space geometric normal (xyz); unused (w).
+        pub object_geometric: [f32; 4] => "vec4",
+        /// Irradiance at birth `E_i(t_i)` (rgb); unused (w).
+        pub birth_irradiance: [f32; 4] => "vec4",
+        /// Temporal gradient `∂E_i/∂t` per frame (rgb); luminance ratio `τ_i` (w).
+        pub gradient: [f32; 4] => "vec4",
+        /// Instance (x), birth frame `t_i` (y), flags (z: bit 0 = adopted), unused (w).
+        pub info: [u32; 4] => "uvec4",
+    }
+}
+
 /// Every shared struct's GLSL, in dependency order, with the generated-file header.
 pub fn generated_glsl() -> String {
     use crate::layout::glsl_struct;
@@ -192,6 +212,7 @@ pub fn generated_glsl() -> String {
         glsl_struct::<FrameConstants>(),
         glsl_struct::<GpuRecord>(),
         glsl_struct::<IcCounters>(),
+        glsl_struct::<GpuRecordTemporal>(),
     ] {
         s.push_str(&text);
         s.push('\n');
@@ -219,7 +240,9 @@ mod tests {
         errors.extend(std430_violations::<FrameConstants>());
         errors.extend(std430_violations::<GpuRecord>());
         errors.extend(std430_violations::<IcCounters>());
+        errors.extend(std430_violations::<GpuRecordTemporal>());
         assert_eq!(std::mem::size_of::<GpuRecord>(), 176);
+        assert_eq!(std::mem::size_of::<GpuRecordTemporal>(), 96);
         assert!(errors.is_empty(), "{}", errors.join("\n"));
     }
 

@@ -1,0 +1,117 @@
+//! The temporal steps of [`IcRenderer::render`] (`crate::temporal`): refreshing the records whose
+//! lifespan ended, and the look-ahead evaluation of the frame's new and refreshed records.
+
+use radcache_scene::{CameraView, Scene};
+use radcache_vk::Context;
+
+use super::IcRenderer;
+use crate::clock::FrameClock;
+use crate::error::{Error, Result};
+use crate::gpu_scene::GpuScene;
+use crate::ic::{IcSettings, IcStats};
+use crate::temporal::{Lifespans, TemporalPass};
+
+impl IcRenderer {
+    fn temporal_pass(&self) -> Result<&TemporalPass> {
+        self.temporal.as_ref().ok_or_else(|| {
+            Error::Invalid("temporal caching needs a renderer created with a time step".into())
+        })
+    }
+
+    /// Recomputes in place the records the advance listed as expired (at their moved points,
+    /// with their own seeds); returns how many.
+    pub(super) fn refresh_expired(
+        &self,
+        ctx: &Context,
+        gpu: &GpuScene,
+        settings: &IcSettings,
+        stats: &mut IcStats,
+        clock: &mut FrameClock,
+    ) -> Result<u32> {
+        let t = self.temporal_pass()?;
+        let expired = t.listed()?;
+        if expired == 0 {
+            return Ok(0);
+        }
+        let mut rec = ctx.begin("ic.refresh")?;
+        self.records.record_refresh_capped(
+            &mut rec,
+            gpu,
+            &self.gbuffer,
+            &t.list,
+            &t.list_counters,
+            &self.state.records,
+            settings.seed,
+        )?;
+        clock.submit(ctx, rec)?;
+        let rays = self.records.rays()?;
+        stats.records_refreshed = u64::from(expired);
+        stats.refresh_rays += rays;
+        stats.record_rays += rays;
+        clock.lap("refresh");
+        Ok(expired)
+    }
+
+    /// Makes the frame's new records and the `expired` refreshed ones born now, evaluates them
+    /// again with the scene at `settings.time + settings.time_step_s` and derives their temporal
+    /// gradients and lifespans; the scene is back at the frame's time (and `view`) afterwards.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn look_ahead(
+        &self,
+        ctx: &Context,
+        scene: &Scene,
+        gpu: &mut GpuScene,
+        settings: &IcSettings,
+        view: &CameraView,
+        expired: u32,
+        stats: &mut IcStats,
+        clock: &mut FrameClock,
+    ) -> Result<()> {
+        let t = self.temporal_pass()?;
+        let count = self.state.read_counters()?.counts[0];
+        let first = stats.records_kept as u32;
+        let listed = expired
+            .saturating_add(count.saturating_sub(first))
+            .min(self.state.record_capacity());
+        let frame = self.frames;
+        let mut rec = ctx.begin("ic.adopt")?;
+        t.record_adopt(&mut rec, gpu, &self.state, frame, first, count, listed)?;
+        clock.submit(ctx, rec)?;
+        if listed == 0 {
+            clock.lap("lookahead");
+            return Ok(());
+        }
+        let (w, h) = (self.width, self.height);
+        gpu.set_time(scene, settings.time + settings.time_step_s)?;
+        gpu.set_view(view, w, h, settings.frame, settings.seed)?;
+        let mut rec = ctx.begin("ic.lookahead")?;
+        gpu.record_update(ctx, &mut rec)?;
+        t.record_shift(&mut rec, gpu, &self.state, listed)?;
+        self.records.record_refresh(
+            &mut rec,
+            gpu,
+            &self.gbuffer,
+            &t.list,
+            &t.list_counters,
+            &t.lookahead,
+            settings.seed,
+        )?;
+        let lifespans = Lifespans {
+            accuracy: self.params.temporal_accuracy,
+            max_age: self.params.max_age_frames,
+        };
+        t.record_finish(&mut rec, gpu, &self.state, listed, lifespans)?;
+        clock.submit(ctx, rec)?;
+        let rays = self.records.rays()?;
+        stats.lookahead_rays += rays;
+        stats.record_rays += rays;
+
+        gpu.set_time(scene, settings.time)?;
+        gpu.set_view(view, w, h, settings.frame, settings.seed)?;
+        let mut rec = ctx.begin("ic.restore")?;
+        gpu.record_update(ctx, &mut rec)?;
+        clock.submit(ctx, rec)?;
+        clock.lap("lookahead");
+        Ok(())
+    }
+}

@@ -1,0 +1,314 @@
+//! Temporal radiance caching (`shaders/passes/temporal.comp`; IC reference §11.2, §11.3): records
+//! kept across the frames of an animation whose geometry or lights move.
+//!
+//! Every record lives on the mesh instance it was created on (object-space point and normals in
+//! `IcState::temporal`) and follows it. When a record is born (created, or refreshed in place),
+//! it is evaluated a second time, with the same rays (deterministic per-record seeds), in the
+//! scene of the next frame ("look-ahead"); the pair gives its temporal gradient `∂E/∂t` and its
+//! lifespan `min(a_t / |τ − 1|, Δt_max)` (`radcache_cache::temporal`), `Δt_max` staggered by
+//! ±20 % per record so refreshes do not come in waves. A living record takes the extrapolated
+//! value `max(0, E(t_i) + age·∂E/∂t)` (exact at age 1: the look-ahead value); an expired one is
+//! recomputed at its own point, with its own seeds, at the start of the frame.
+//!
+//! [`crate::IcRenderer`] drives it: [`TemporalPass::record_advance`] at the start of a frame (then
+//! the refresh of the listed records), the cache's hole filling, then
+//! [`TemporalPass::record_adopt`] for the frame's new and refreshed records, the look-ahead
+//! ([`TemporalPass::record_shift`], the record pass on [`TemporalPass::lookahead`],
+//! [`TemporalPass::record_finish`]) with the scene at the next frame's time, and
+//! [`TemporalPass::record_keep_instances`] at the end.
+
+use bytemuck::{Pod, Zeroable};
+use radcache_shared::gpu::{GpuInstance, GpuRecord, IcCounters};
+use radcache_vk::{
+    vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, MemoryLocation, Pipeline,
+    Recorder, Resource, ShaderCompiler,
+};
+
+use crate::bindings::{with_scene, PASS_BASE};
+use crate::error::Result;
+use crate::gpu_scene::GpuScene;
+use crate::ic_state::IcState;
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Push {
+    mode: u32,
+    frame: u32,
+    first: u32,
+    has_previous: u32,
+    accuracy: f32,
+    max_age: f32,
+    capacity: u32,
+    pad: u32,
+}
+
+/// The shader's steps.
+#[derive(Clone, Copy)]
+enum Mode {
+    Begin = 0,
+    Advance = 1,
+    Append = 2,
+    Adopt = 3,
+    Shift = 4,
+    Finish = 5,
+}
+
+/// The temporal pipeline, the list of records to evaluate this frame, the look-ahead copy of the
+/// records and the previous frame's instances.
+pub struct TemporalPass {
+    pipeline: Pipeline,
+    /// Record indices to evaluate this frame (`uint[capacity]`).
+    pub list: Buffer,
+    /// The list's `IcCounters` (counts.x = records, counts.y = listed, dispatch = one workgroup
+    /// per listed record): the record pass's refresh reads it as its requests' counters.
+    pub list_counters: Buffer,
+    /// The records evaluated at the next frame's time (same indices as the cache's).
+    pub lookahead: Buffer,
+    previous: Buffer,
+    has_previous: bool,
+    capacity: u32,
+}
+
+impl std::fmt::Debug for TemporalPass {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TemporalPass")
+            .field("capacity", &self.capacity)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Temporal accuracy and largest lifespan of the cache's parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lifespans {
+    /// `a_t`.
+    pub accuracy: f32,
+    /// `Δt_max` in frames.
+    pub max_age: f32,
+}
+
+impl TemporalPass {
+    /// Compiles the pass for `record_capacity` records of `scene`.
+    pub fn new(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        scene: &GpuScene,
+        record_capacity: u32,
+    ) -> Result<TemporalPass> {
+        let spirv = shaders.compile("passes/temporal.comp", &scene.defines())?;
+        let pass: Vec<BindingLayout> = (0..7)
+            .map(|k| BindingLayout::new(PASS_BASE + k, BindingKind::StorageBuffer))
+            .collect();
+        let pipeline = Pipeline::compute(
+            ctx,
+            "temporal",
+            &spirv,
+            &with_scene(&pass),
+            std::mem::size_of::<Push>() as u32,
+        )?;
+        let buffer = |name, size: u64, usage, location| {
+            Buffer::new(
+                ctx,
+                &BufferDesc {
+                    name,
+                    size: size.max(16),
+                    usage,
+                    location,
+                    alignment: 0,
+                },
+            )
+        };
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let capacity = record_capacity.max(1);
+        let (_, instances) = scene.instances();
+        Ok(TemporalPass {
+            pipeline,
+            list: buffer(
+                "temporal.list",
+                u64::from(capacity) * 4,
+                storage,
+                MemoryLocation::GpuOnly,
+            )?,
+            list_counters: buffer(
+                "temporal.counters",
+                std::mem::size_of::<IcCounters>() as u64,
+                storage | vk::BufferUsageFlags::INDIRECT_BUFFER,
+                MemoryLocation::GpuToCpu,
+            )?,
+            lookahead: buffer(
+                "temporal.lookahead",
+                u64::from(capacity) * std::mem::size_of::<GpuRecord>() as u64,
+                storage | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            )?,
+            previous: buffer(
+                "temporal.previous_instances",
+                u64::from(instances.max(1)) * std::mem::size_of::<GpuInstance>() as u64,
+                storage | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            )?,
+            has_previous: false,
+            capacity,
+        })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn dispatch(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        state: &IcState,
+        mode: Mode,
+        push: Push,
+        invocations: u32,
+    ) -> Result<()> {
+        let mut bindings = scene.bindings();
+        bindings.extend([
+            (PASS_BASE, Resource::Buffer(&state.counters)),
+            (PASS_BASE + 1, Resource::Buffer(&state.records)),
+            (PASS_BASE + 2, Resource::Buffer(&state.temporal)),
+            (PASS_BASE + 3, Resource::Buffer(&self.list)),
+            (PASS_BASE + 4, Resource::Buffer(&self.list_counters)),
+            (PASS_BASE + 5, Resource::Buffer(&self.lookahead)),
+            (PASS_BASE + 6, Resource::Buffer(&self.previous)),
+        ]);
+        let push = Push {
+            mode: mode as u32,
+            capacity: self.capacity,
+            ..push
+        };
+        rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
+        rec.pass("temporal", |rec| {
+            rec.bind_pipeline(&self.pipeline);
+            rec.push_bindings(&bindings);
+            rec.push_constants(&push);
+            rec.dispatch(invocations.div_ceil(64).max(1), 1, 1)
+        })?;
+        rec.barrier(
+            Access::COMPUTE_WRITE,
+            Access::ALL.union(Access::INDIRECT).union(Access::HOST_READ),
+        );
+        Ok(())
+    }
+
+    fn push(frame: u32) -> Push {
+        Push {
+            mode: 0,
+            frame,
+            first: 0,
+            has_previous: 0,
+            accuracy: 0.0,
+            max_age: 0.0,
+            capacity: 0,
+            pad: 0,
+        }
+    }
+
+    /// Records emptying the list, then (with `records` kept from earlier frames) moving every
+    /// record with its instance and extrapolating it to `frame`, or listing it when it expired.
+    /// The scene must be at the frame's time; the neighbour grid must be rebuilt afterwards.
+    pub fn record_advance(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        state: &IcState,
+        frame: u32,
+        records: u32,
+    ) -> Result<()> {
+        let push = Self::push(frame);
+        self.dispatch(rec, scene, state, Mode::Begin, push, 1)?;
+        if records > 0 {
+            let push = Push {
+                has_previous: u32::from(self.has_previous),
+                ..push
+            };
+            self.dispatch(rec, scene, state, Mode::Advance, push, records)?;
+        }
+        Ok(())
+    }
+
+    /// Records listing the records `first .. records` (created this frame) after the expired ones
+    /// and making every listed record born at `frame` (at the scene's current time); `listed` is
+    /// the list's length afterwards (expired + new, at most the capacity). Then copies the
+    /// records to the look-ahead buffer.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_adopt(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        state: &IcState,
+        frame: u32,
+        first: u32,
+        records: u32,
+        listed: u32,
+    ) -> Result<()> {
+        let push = Push {
+            first,
+            ..Self::push(frame)
+        };
+        if records > first {
+            self.dispatch(rec, scene, state, Mode::Append, push, records - first)?;
+        }
+        self.dispatch(rec, scene, state, Mode::Adopt, push, listed)?;
+        let bytes = u64::from(records) * std::mem::size_of::<GpuRecord>() as u64;
+        if bytes > 0 {
+            rec.barrier(Access::ALL_WRITES, Access::TRANSFER_READ);
+            rec.copy_buffer(&state.records, 0, &self.lookahead, 0, bytes);
+            rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
+        }
+        Ok(())
+    }
+
+    /// Records moving the listed look-ahead records to the instances' current transforms (the
+    /// scene must be at the next frame's time).
+    pub fn record_shift(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        state: &IcState,
+        listed: u32,
+    ) -> Result<()> {
+        self.dispatch(rec, scene, state, Mode::Shift, Self::push(0), listed)
+    }
+
+    /// Records the temporal gradient and lifespan of every listed record from its value and its
+    /// look-ahead value.
+    pub fn record_finish(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        state: &IcState,
+        listed: u32,
+        lifespans: Lifespans,
+    ) -> Result<()> {
+        let push = Push {
+            accuracy: lifespans.accuracy,
+            max_age: lifespans.max_age,
+            ..Self::push(0)
+        };
+        self.dispatch(rec, scene, state, Mode::Finish, push, listed)
+    }
+
+    /// Records keeping the scene's current instances as the previous frame's (the next advance
+    /// rotates gradients by the change since).
+    pub fn record_keep_instances(&mut self, rec: &mut Recorder, scene: &GpuScene) {
+        let (buffer, count) = scene.instances();
+        let bytes = u64::from(count) * std::mem::size_of::<GpuInstance>() as u64;
+        if bytes > 0 {
+            rec.barrier(Access::ALL_WRITES, Access::TRANSFER_READ);
+            rec.copy_buffer(buffer, 0, &self.previous, 0, bytes);
+            rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
+            self.has_previous = true;
+        }
+    }
+
+    /// Forgets the previous frame's instances (the next frame starts a new cache).
+    pub fn forget(&mut self) {
+        self.has_previous = false;
+    }
+
+    /// Listed records after the last submission (expired, then new).
+    pub fn listed(&self) -> Result<u32> {
+        let c = self.list_counters.read::<IcCounters>(1)?[0];
+        Ok(c.counts[1].min(self.capacity))
+    }
+}

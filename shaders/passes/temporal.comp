@@ -1,0 +1,208 @@
+// Temporal radiance caching (IC reference §11.2; crates/radcache-render/src/temporal.rs): records
+// live on their mesh instance, carry the change of their irradiance to the next frame and a
+// lifespan, are extrapolated in time while they live and refreshed in place when they expire.
+//
+// Buffers: the cache's counters (read) and records, the records' temporal state (same index), the
+// list of records to evaluate this frame with its own IcCounters (counts.x = records, counts.y =
+// listed, dispatch = one workgroup per listed record, as the record pass's refresh reads it),
+// the record copy evaluated at the next frame's time, and the instances of the previous frame.
+//
+// Modes (push constant `mode`):
+//   0 begin     (1 invocation)   empty list
+//   1 advance   (per record)     move adopted records with their instance (point, normals; the
+//                                gradients rotate with the instance's change since the previous
+//                                frame); a living record takes its extrapolated value
+//                                max(0, E(t_i) + age·∂E/∂t), an expired one is listed for refresh
+//   2 append    (per new record) list records [first, count) and mark them not adopted
+//   3 adopt     (per listed)     store the point and normals in object space (new records) and the
+//                                irradiance at birth, birth frame = this frame
+//   4 shift     (per listed)     move the copy's point and normals to the instances' current
+//                                transforms (the next frame's, when this runs)
+//   5 finish    (per listed)     ∂E/∂t = E(t_i + 1) − E(t_i) and the lifespan
+//                                min(a_t·Y₀/|Y₁ − Y₀|, Δt_max·(1 ± 20 %)), the stagger hashed
+//                                from the record and its birth (radcache_cache::temporal)
+// A record at age 1 has the exact value E(t_i + 1) (it was evaluated with the same rays), so it
+// is refreshed only once its age exceeds max(lifespan, 1).
+#version 460
+#extension GL_GOOGLE_include_directive : require
+
+#include "../common/scene.glsl"
+#include "../common/ircache_math.glsl"
+
+layout(local_size_x = 64) in;
+
+layout(binding = B_PASS_BASE, std430) readonly buffer Counters { IcCounters counters; };
+layout(binding = B_PASS_BASE + 1, std430) buffer Records { GpuRecord records[]; };
+layout(binding = B_PASS_BASE + 2, std430) buffer Temporal { GpuRecordTemporal temporal[]; };
+layout(binding = B_PASS_BASE + 3, std430) buffer List { uint list[]; };
+layout(binding = B_PASS_BASE + 4, std430) buffer ListCounters { IcCounters list_counters; };
+layout(binding = B_PASS_BASE + 5, std430) buffer Lookahead { GpuRecord lookahead[]; };
+layout(binding = B_PASS_BASE + 6, std430) readonly buffer Previous { GpuInstance previous[]; };
+
+layout(push_constant) uniform Push {
+    uint mode;
+    uint frame;          // this frame's number (birth frames count in it)
+    uint first;          // append: first new record
+    uint has_previous;   // advance: `previous` holds the instances of the frame before
+    float accuracy;      // a_t
+    float max_age;       // Δt_max in frames
+    uint capacity;       // list capacity
+    uint pad;
+} pc;
+
+const uint ADOPTED = 1u;
+const uint INSTANCE_SHIFT = 8u;  // records.rs RECORD_INSTANCE_SHIFT
+
+vec3 to_world_point(GpuInstance inst, vec3 p) { return (inst.world_from_object * vec4(p, 1.0)).xyz; }
+
+vec3 to_world_normal(GpuInstance inst, vec3 n) {
+    return normalize_or_z(mat3(inst.normal_to_world) * n);
+}
+
+// Inverse of the normal transform: n_obj ∝ Aᵀ·n_world for A the linear part of world_from_object.
+vec3 to_object_normal(GpuInstance inst, vec3 n) {
+    return normalize_or_z(transpose(mat3(inst.world_from_object)) * n);
+}
+
+vec3 finite_or(vec3 v, vec3 fallback) {
+    return (any(isnan(v)) || any(isinf(v))) ? fallback : v;
+}
+
+void append(uint index) {
+    uint slot = atomicAdd(list_counters.counts.y, 1u);
+    if (slot < pc.capacity) {
+        list[slot] = index;
+        atomicAdd(list_counters.dispatch.x, 1u);
+    }
+}
+
+void move_record(uint i, GpuRecordTemporal tr) {
+    GpuInstance inst = instances[tr.info.x];
+    GpuRecord r = records[i];
+    vec3 ng = to_world_normal(inst, tr.object_geometric.xyz);
+    r.position_radius.xyz = to_world_point(inst, tr.object_position.xyz);
+    r.normal_rorig.xyz = to_world_normal(inst, tr.object_normal.xyz);
+    if (pc.has_previous != 0u) {
+        // The instance's linear change since the previous frame, L = A_t·A_prev⁻¹: the
+        // translational gradients are covectors (L⁻ᵀ), the rotational ones rotate with the surface
+        // (L⁻ᵀ rescaled to keep their length under a uniform scale).
+        mat3 a_prev = mat3(previous[tr.info.x].world_from_object);
+        mat3 a_now = mat3(inst.world_from_object);
+        float det_prev = determinant(a_prev);
+        if (det_prev != 0.0 && a_prev != a_now) {
+            mat3 l = a_now * inverse(a_prev);
+            float det = determinant(l);
+            if (det != 0.0 && !isnan(det) && !isinf(det)) {
+                mat3 cov = transpose(inverse(l));
+                float scale = pow(abs(det), 1.0 / 3.0);
+                r.grad_t_red.xyz = finite_or(cov * r.grad_t_red.xyz, vec3(0.0));
+                r.grad_t_green.xyz = finite_or(cov * r.grad_t_green.xyz, vec3(0.0));
+                r.grad_t_blue.xyz = finite_or(cov * r.grad_t_blue.xyz, vec3(0.0));
+                r.grad_r_red.xyz = finite_or(scale * (cov * r.grad_r_red.xyz), vec3(0.0));
+                r.grad_r_green.xyz = finite_or(scale * (cov * r.grad_r_green.xyz), vec3(0.0));
+                r.grad_r_blue.xyz = finite_or(scale * (cov * r.grad_r_blue.xyz), vec3(0.0));
+            }
+        }
+    }
+    r.grad_r_red.w = ng.x;
+    r.grad_r_green.w = ng.y;
+    r.grad_r_blue.w = ng.z;
+    records[i] = r;
+}
+
+void main() {
+    uint gid = gl_GlobalInvocationID.x;
+    if (pc.mode == 0u) {
+        if (gid == 0u) {
+            list_counters.counts = uvec4(counters.counts.x, 0u, 0u, 0u);
+            list_counters.dispatch = uvec4(0u, 1u, 1u, 0u);
+            list_counters.limits = uvec4(pc.capacity, pc.capacity, 0u, 0u);
+        }
+        return;
+    }
+    if (pc.mode == 1u) {
+        if (gid >= counters.counts.x) {
+            return;
+        }
+        GpuRecordTemporal tr = temporal[gid];
+        if ((tr.info.z & ADOPTED) == 0u) {
+            return;
+        }
+        move_record(gid, tr);
+        float age = float(pc.frame - tr.info.y);
+        if (age > max(tr.object_position.w, 1.0)) {
+            append(gid);
+        } else {
+            vec3 e0 = tr.birth_irradiance.rgb;
+            vec3 e = max(e0 + age * tr.gradient.rgb, vec3(0.0));
+            records[gid].irradiance.rgb = finite_or(e, e0);
+        }
+        return;
+    }
+    if (pc.mode == 2u) {
+        uint i = pc.first + gid;
+        if (i >= counters.counts.x) {
+            return;
+        }
+        if (gid == 0u) {
+            list_counters.counts.x = counters.counts.x;
+        }
+        temporal[i].info = uvec4(0u);
+        append(i);
+        return;
+    }
+    if (gid >= min(list_counters.counts.y, pc.capacity)) {
+        return;
+    }
+    uint i = list[gid];
+    if (pc.mode == 3u) {
+        GpuRecord r = records[i];
+        GpuRecordTemporal tr = temporal[i];
+        uint bits = r.info.w >> INSTANCE_SHIFT;
+        if ((tr.info.z & ADOPTED) == 0u) {
+            if (bits == 0u || dot(r.normal_rorig.xyz, r.normal_rorig.xyz) == 0.0) {
+                temporal[i].info = uvec4(0u);  // rejected: never weighs, never refreshed
+                return;
+            }
+            GpuInstance inst = instances[bits - 1u];
+            vec3 ng = vec3(r.grad_r_red.w, r.grad_r_green.w, r.grad_r_blue.w);
+            tr.object_position.xyz = (inverse(inst.world_from_object) * vec4(r.position_radius.xyz, 1.0)).xyz;
+            tr.object_normal.xyz = to_object_normal(inst, r.normal_rorig.xyz);
+            tr.object_geometric.xyz = to_object_normal(inst, ng);
+            tr.info.x = bits - 1u;
+        }
+        tr.object_position.w = 0.0;
+        tr.birth_irradiance = vec4(r.irradiance.rgb, 0.0);
+        tr.gradient = vec4(0.0);
+        tr.info.y = pc.frame;
+        tr.info.z = ADOPTED;
+        temporal[i] = tr;
+        return;
+    }
+    GpuRecordTemporal tr = temporal[i];
+    if ((tr.info.z & ADOPTED) == 0u) {
+        return;
+    }
+    if (pc.mode == 4u) {
+        GpuInstance inst = instances[tr.info.x];
+        vec3 ng = to_world_normal(inst, tr.object_geometric.xyz);
+        lookahead[i].position_radius.xyz = to_world_point(inst, tr.object_position.xyz);
+        lookahead[i].normal_rorig.xyz = to_world_normal(inst, tr.object_normal.xyz);
+        lookahead[i].grad_r_red.w = ng.x;
+        lookahead[i].grad_r_green.w = ng.y;
+        lookahead[i].grad_r_blue.w = ng.z;
+        return;
+    }
+    // mode 5
+    vec3 e0 = tr.birth_irradiance.rgb;
+    vec3 e1 = finite_or(lookahead[i].irradiance.rgb, e0);
+    float y0 = max(luminance_rec709(e0), 0.0);
+    float y1 = max(luminance_rec709(e1), 0.0);
+    float dy = abs(y1 - y0);
+    uint h = ircache_hash(i * 0x9e3779b9u ^ ircache_hash(tr.info.y));
+    float max_age = max(pc.max_age, 0.0) * (0.8 + 0.4 * unit_float_from_bits(h));
+    float num = max(pc.accuracy, 0.0) * y0;
+    tr.object_position.w = num >= max_age * dy ? max_age : num / dy;
+    tr.gradient = vec4(e1 - e0, y0 > 0.0 ? y1 / y0 : 1.0);
+    temporal[i] = tr;
+}

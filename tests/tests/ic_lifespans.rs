@@ -1,0 +1,282 @@
+//! Temporal radiance caching (`TemporalPass`, IC reference §11.2) on lavapipe: in a room where a
+//! box slides along the floor, records follow their instance, only records near the box are
+//! refreshed, lifespans follow the CPU formula (`radcache_cache::temporal`), and a frame
+//! rendered with kept records stays as close to a path-traced reference of that frame as a
+//! fresh cache.
+
+use glam::{Quat, Vec3};
+use radcache_cache::temporal::temporal_lifespan;
+use radcache_cache::IcParams;
+use radcache_image::{compare, Image};
+use radcache_render::{
+    render_path, Budget, GpuScene, IcRenderer, IcSettings, IcStats, PathSettings,
+};
+use radcache_scene::writer::{ChannelDesc, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
+use radcache_scene::{AnimationKind, Interpolation, Property, Scene};
+use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
+use radcache_tests::geometry::room;
+use radcache_tests::scenes::{camera_node, cube, plane_y, temp_dir, write_and_load};
+use radcache_tests::{context, finish, shaders};
+use radcache_vk::Context;
+
+const SIZE: u32 = 48;
+const FPS: f32 = 24.0;
+const HALF: f32 = 0.25;
+const Z_BOX: f32 = -1.6;
+/// Records this far from the box's path (m; the room is 4 m × 6 m) see it under a small solid
+/// angle: their indirect light changes by well under 1 % per frame.
+const FAR: f32 = 3.0;
+/// Records this close to the box's path see it large (m).
+const NEAR: f32 = 0.8;
+
+/// The box's centre at time `t`: x from −1.6 to −0.4 over 0.5 s (0.1 m per frame at 24 fps).
+fn box_centre(t: f32) -> Vec3 {
+    let s = (t / 0.5).clamp(0.0, 1.0);
+    Vec3::new(-1.6 + 1.2 * s, HALF, Z_BOX)
+}
+
+/// Distance from `p` to the segment the box's centre sweeps.
+fn distance_to_path(p: Vec3) -> f32 {
+    let (a, b) = (box_centre(0.0), box_centre(1.0));
+    let s = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+    (p - (a + (b - a) * s)).length()
+}
+
+/// A 4 × 2.5 × 6 m grey room lit by a ceiling panel, a red box sliding along the floor, and a
+/// static camera near one wall looking across the room.
+fn sliding_box_scene(tag: &str) -> Scene {
+    let mut b = GltfBuilder::new();
+    let grey = b.add_material(&MaterialDesc::diffuse("grey", [0.7; 3]));
+    let red = b.add_material(&MaterialDesc::diffuse("red", [0.8, 0.15, 0.1]));
+    let mut light = MaterialDesc::diffuse("light", [0.0; 3]);
+    light.emissive = [6.0; 3];
+    let light = b.add_material(&light);
+    let walls = room(Vec3::new(-2.0, 0.0, -2.0), Vec3::new(2.0, 2.5, 4.0));
+    let corners: Vec<[f32; 3]> = walls.positions.iter().map(|p| p.to_array()).collect();
+    let room_mesh = b.add_mesh(
+        "room",
+        &[PrimitiveDesc::triangles(
+            corners,
+            None,
+            walls.indices,
+            Some(grey),
+        )],
+    );
+    let boxy = b.add_mesh("box", &[cube(HALF, red)]);
+    let panel = b.add_mesh("panel", &[plane_y([-0.5, 0.5], [-0.5, 0.5], 0.0, light)]);
+    let room_node = b.add_node(&NodeDesc {
+        mesh: Some(room_mesh),
+        ..Default::default()
+    });
+    let box_node = b.add_node(&NodeDesc {
+        name: Some("box".into()),
+        mesh: Some(boxy),
+        translation: Some(box_centre(0.0).to_array()),
+        ..Default::default()
+    });
+    let panel_node = b.add_node(&NodeDesc {
+        mesh: Some(panel),
+        translation: Some([0.0, 2.45, 0.0]),
+        rotation: Some(Quat::from_rotation_x(std::f32::consts::PI).to_array()),
+        ..Default::default()
+    });
+    let camera = camera_node(
+        &mut b,
+        Vec3::new(0.0, 1.6, 3.9),
+        Quat::from_rotation_x(-0.45),
+        1.2,
+    );
+    let (a, e) = (box_centre(0.0), box_centre(0.5));
+    b.add_animation(
+        "slide",
+        &[ChannelDesc {
+            node: box_node,
+            property: Property::Translation,
+            interpolation: Interpolation::Linear,
+            times: vec![0.0, 0.5],
+            values: [a, e].iter().flat_map(|v| v.to_array()).collect(),
+        }],
+    );
+    b.add_scene("slide", &[room_node, box_node, panel_node, camera], None);
+    let scene = write_and_load(&b, &temp_dir(tag), "slide");
+    assert_eq!(scene.plan().animation.kind, AnimationKind::Geometry);
+    assert!(scene.plan().needs_lifespans());
+    scene
+}
+
+fn settings(frame: u32) -> IcSettings {
+    IcSettings {
+        width: SIZE,
+        height: SIZE,
+        params: IcParams::draft(),
+        sub_frames: 4,
+        direct_samples: 4,
+        seed: 3,
+        frame,
+        time: (frame - 1) as f32 / FPS,
+        record_capacity: 1 << 14,
+        settle_records: true,
+        time_step_s: 1.0 / FPS,
+        ..IcSettings::default()
+    }
+}
+
+struct Cache {
+    records: Vec<GpuRecord>,
+    temporal: Vec<GpuRecordTemporal>,
+}
+
+fn read(ctx: &Context, r: &IcRenderer, stats: &IcStats) -> Cache {
+    let n = stats.records as usize;
+    Cache {
+        records: ctx.read_buffer(&r.state().records, n).unwrap(),
+        temporal: ctx.read_buffer(&r.state().temporal, n).unwrap(),
+    }
+}
+
+fn xyz(v: [f32; 4]) -> Vec3 {
+    Vec3::new(v[0], v[1], v[2])
+}
+
+#[test]
+fn records_follow_their_instance_and_only_records_near_the_box_are_refreshed() {
+    let scene = sliding_box_scene("ic-lifespans-follow");
+    let (ctx, shaders) = (context(), shaders());
+    let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
+    let mut r = IcRenderer::new(&ctx, &shaders, &gpu, &settings(1)).unwrap();
+    let params = IcParams::draft();
+    let (mut near, mut far, mut on_box) = (0usize, 0usize, 0usize);
+    let (mut near_kept, mut far_kept) = (0usize, 0usize);
+    let mut refreshed_total = 0u64;
+    for frame in 1..=8u32 {
+        let s = settings(frame);
+        let (out, stats) = r.render(&ctx, &scene, &mut gpu, &s, &mut |_| {}).unwrap();
+        assert_eq!(out.nonfinite_pixels, 0);
+        let c = read(&ctx, &r, &stats);
+        let centre = box_centre(s.time);
+        for (i, (rec, tr)) in c.records.iter().zip(&c.temporal).enumerate() {
+            if tr.info[2] & 1 == 0 {
+                continue; // rejected
+            }
+            let p = xyz(rec.position_radius);
+            let d = distance_to_path(p);
+            if frame > 1 && (i as u64) < stats.records_kept {
+                // Kept from the frame before: may be refreshed this frame.
+                near_kept += usize::from(d <= NEAR);
+                far_kept += usize::from(d >= FAR);
+            }
+            // Records on the box (which only translates) keep their offset from its centre.
+            let local = xyz(tr.object_position);
+            if local.abs().max_element() <= HALF * 1.001 && (p - centre).length() < 2.0 * HALF {
+                on_box += 1;
+                let moved = (p - (centre + local)).length();
+                assert!(
+                    moved <= 1e-4,
+                    "record {i} on the box is {moved} m off its point"
+                );
+            }
+            // The lifespan of a record born this frame is the CPU formula's (stagger ±20 %).
+            if tr.info[1] == frame {
+                let (e0, de) = (xyz(tr.birth_irradiance), xyz(tr.gradient));
+                let life = tr.object_position[3];
+                let max_age = params.max_age_frames;
+                let formula = temporal_lifespan(e0, e0 + de, params.temporal_accuracy, 1e30);
+                assert!(life <= 1.2 * max_age + 1e-3, "record {i}: lifespan {life}");
+                if life < 0.8 * max_age - 1e-3 {
+                    let tol = 1e-3 * formula.max(1.0);
+                    assert!((life - formula).abs() <= tol, "{i}: {life} vs {formula}");
+                } else {
+                    assert!(formula >= 0.8 * max_age * 0.999, "{i}: {life} vs {formula}");
+                }
+                if (i as u64) < stats.records_kept {
+                    // Refreshed in place this frame.
+                    near += usize::from(d <= NEAR);
+                    far += usize::from(d >= FAR);
+                }
+            }
+        }
+        refreshed_total += stats.records_refreshed;
+        if frame == 1 {
+            assert_eq!(stats.records_refreshed, 0);
+            assert!(stats.lookahead_rays > 0, "{stats:?}");
+        }
+    }
+    // Refreshes per kept record and frame, near the box and far from it.
+    let near_rate = near as f64 / near_kept.max(1) as f64;
+    let far_rate = far as f64 / far_kept.max(1) as f64;
+    eprintln!(
+        "refreshed {refreshed_total}: near the box {near} of {near_kept} ({near_rate:.3}), \
+         far {far} of {far_kept} ({far_rate:.3}); {on_box} records on the box"
+    );
+    assert!(on_box > 0, "no record on the box");
+    assert!(
+        near_kept >= 50 && far_kept >= 100,
+        "{near_kept} near, {far_kept} far"
+    );
+    // Near the box irradiance changes by several % per frame: lifespans of a few frames.
+    assert!(near_rate >= 0.06, "near rate {near_rate}");
+    // Far away only the look-ahead's noise (paths that touch the box diverge) can shorten a
+    // lifespan: rare.
+    assert!(far_rate <= 0.02, "far rate {far_rate}");
+    assert!(far_rate * 8.0 <= near_rate, "{far_rate} vs {near_rate}");
+    drop((r, gpu));
+    finish(ctx);
+}
+
+#[test]
+fn a_frame_with_kept_records_is_as_close_to_the_reference_as_a_fresh_cache() {
+    let scene = sliding_box_scene("ic-lifespans-reference");
+    let (ctx, shaders) = (context(), shaders());
+    let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
+    let last = 8u32;
+    let mut kept = IcRenderer::new(&ctx, &shaders, &gpu, &settings(1)).unwrap();
+    let mut out = None;
+    let mut refreshed = 0;
+    for frame in 1..=last {
+        let (o, stats) = kept
+            .render(&ctx, &scene, &mut gpu, &settings(frame), &mut |_| {})
+            .unwrap();
+        refreshed += stats.records_refreshed;
+        out = Some(o);
+    }
+    assert!(refreshed > 0);
+    let out = out.unwrap();
+    let fresh_settings = IcSettings {
+        time_step_s: 0.0,
+        ..settings(last)
+    };
+    let mut fresh = IcRenderer::new(&ctx, &shaders, &gpu, &fresh_settings).unwrap();
+    let (fresh_out, _) = fresh
+        .render(&ctx, &scene, &mut gpu, &fresh_settings, &mut |_| {})
+        .unwrap();
+    let path = PathSettings {
+        width: SIZE,
+        height: SIZE,
+        budget: Budget::Samples(1024),
+        seed: 11,
+        frame: last,
+        time: settings(last).time,
+        ..PathSettings::default()
+    };
+    let reference = render_path(&ctx, &shaders, &scene, &mut gpu, &path, &mut |_| {}).unwrap();
+    let image = |o: &radcache_render::FrameOutput| {
+        Image::from_pixels(o.width, o.height, o.pixels.clone()).unwrap()
+    };
+    let reference = image(&reference);
+    let m_kept = compare(&reference, &image(&out)).unwrap();
+    let m_fresh = compare(&reference, &image(&fresh_out)).unwrap();
+    eprintln!("kept records: {m_kept}\nfresh cache: {m_fresh}");
+    assert_eq!(m_kept.nonfinite_candidate, 0);
+    assert!(m_kept.relmse <= 0.01, "relMSE {}", m_kept.relmse);
+    assert!(
+        m_kept.relmse <= 1.5 * m_fresh.relmse + 1e-3,
+        "kept {} vs fresh {}",
+        m_kept.relmse,
+        m_fresh.relmse
+    );
+    for (c, r) in m_kept.mean_ratio.iter().enumerate() {
+        assert!((r - 1.0).abs() <= 0.03, "channel {c} mean ratio {r}");
+    }
+    drop((kept, fresh, gpu));
+    finish(ctx);
+}
