@@ -25,6 +25,7 @@ Tasks:
   bench ic          the cache on the Cornell box: time, records, rays, error, speed-up over the path tracer
   bench pt          path tracer on the Cornell box at 256² and 512²: samples/s and rays/s
   bench scaling     the cache's frame time and records against resolution and triangle count
+  bench temporal    an animation with kept records against a per-frame rebuild: rays, time, error, flicker
   help              this text
 
 Benchmarks append their figures to bench/results.csv.

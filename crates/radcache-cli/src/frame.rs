@@ -213,18 +213,23 @@ pub fn method_name(method: Method) -> &'static str {
     }
 }
 
-/// Writes the frame to `output` (EXR, or PNG when the path says so; a PNG preview beside the EXR
-/// with `--png`), each file atomically.
-pub fn write(args: &RenderArgs, output: &Path, image: &Image, meta: &Metadata) -> Result<()> {
-    crate::output::make_parent(output, "output")?;
-    let png_options = PngOptions {
+/// The PNG previews' exposure and tone curve.
+pub fn png_options(args: &RenderArgs) -> PngOptions {
+    PngOptions {
         exposure: args.exposure,
         tone_map: if args.tonemap == "filmic" {
             ToneMap::Filmic
         } else {
             ToneMap::None
         },
-    };
+    }
+}
+
+/// Writes the frame to `output` (EXR, or PNG when the path says so; a PNG preview beside the EXR
+/// with `--png`), each file atomically.
+pub fn write(args: &RenderArgs, output: &Path, image: &Image, meta: &Metadata) -> Result<()> {
+    crate::output::make_parent(output, "output")?;
+    let png_options = png_options(args);
     let png_only = output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("png"));

@@ -19,7 +19,7 @@ use serde_json::json;
 use crate::frame::{self, FrameSetup};
 use crate::ic_args::IcArgs;
 use crate::profile::Profile;
-use crate::sequence::{FrameArgs, Sequence, SequenceProgress};
+use crate::sequence::{ContactSheet, FrameArgs, Sequence, SequenceProgress};
 
 /// Environment overrides shared by `render` and `info`.
 #[derive(Args, Debug, Clone)]
@@ -151,6 +151,10 @@ pub struct RenderArgs {
     /// Also write a PNG preview beside the EXR.
     #[arg(long)]
     pub(crate) png: bool,
+    /// After a sequence, write its frames (rendered or already on disk as EXR) reduced to at
+    /// most 160 pixels and tiled into this PNG.
+    #[arg(long, value_name = "FILE.png")]
+    pub(crate) contact_sheet: Option<PathBuf>,
     /// Exposure of the PNG preview, in stops.
     #[arg(long, default_value_t = 0.0)]
     pub(crate) exposure: f32,
@@ -264,6 +268,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let mut entries = Vec::new();
     let mut write_s = 0.0;
     let mut stopped = false;
+    let mut sheet = ContactSheet::new(args.contact_sheet.clone());
     for &(number, time) in &sequence.frames {
         if stop.load(Ordering::SeqCst) {
             stopped = true;
@@ -276,6 +281,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         };
         if pattern && !args.overwrite && output.exists() {
             progress.skipped(number, &output);
+            sheet.add_file(&output)?;
             continue;
         }
         let t_frame = Instant::now();
@@ -296,6 +302,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         let t_write = Instant::now();
         profile.cpu("image + metadata", t_image, t_write, Some(number));
         frame::write(args, &output, &image, &meta)?;
+        sheet.add(&image);
         profile.cpu("write", t_write, Instant::now(), Some(number));
         let mut entry = frame::stats_entry(&rendered, number, time);
         entry["device_memory_bytes"] = json!(ctx.memory_by_category());
@@ -321,6 +328,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         progress.rendered(number, t_frame.elapsed().as_secs_f64());
     }
     progress.finish(stopped);
+    sheet.write(&frame::png_options(args))?;
     if let Some(path) = &args.profile {
         profile.write(path)?;
     }

@@ -1,5 +1,5 @@
-//! Frame sequences of `radcache render`: which frames, at which scene times, and the progress
-//! line across them.
+//! Frame sequences of `radcache render`: which frames, at which scene times, the progress
+//! line across them and the optional contact sheet.
 //!
 //! Frames are numbered like Blender's: `--frames 1..120` is inclusive. Frame `f` of a sequence
 //! starting at frame `first` shows the scene at `start + (f − first) / fps` (a single `--frame N`
@@ -9,9 +9,78 @@
 //! first to its last key at `fps`); anything else renders frame 1.
 
 use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
+use radcache_image::PngOptions;
+use radcache_image::{contact_sheet, read_exr, reduce, reduction_factor, write_png, Image};
+
+/// Largest side of a contact sheet's cell, in pixels.
+pub const CONTACT_CELL: u32 = 160;
+
+/// The frames of a sequence, reduced, for `--contact-sheet` (nothing is kept without it).
+#[derive(Debug)]
+pub struct ContactSheet {
+    path: Option<PathBuf>,
+    cells: Vec<Image>,
+}
+
+impl ContactSheet {
+    /// A sheet written to `path` at the end, or none.
+    pub fn new(path: Option<PathBuf>) -> Self {
+        ContactSheet {
+            path,
+            cells: Vec::new(),
+        }
+    }
+
+    /// Adds a rendered frame.
+    pub fn add(&mut self, image: &Image) {
+        if self.path.is_some() {
+            let f = reduction_factor(image.width(), image.height(), CONTACT_CELL);
+            self.cells.push(reduce(image, f));
+        }
+    }
+
+    /// Adds a frame already on disk (skipped by a resumed run): an EXR is read back; a PNG-only
+    /// output cannot be, and leaves its cell out with a warning.
+    pub fn add_file(&mut self, path: &Path) -> Result<()> {
+        if self.path.is_none() {
+            return Ok(());
+        }
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+        {
+            log::warn!(
+                "contact sheet: {} is a PNG and is left out (only EXR frames are read back)",
+                path.display()
+            );
+            return Ok(());
+        }
+        let (image, _) =
+            read_exr(path).with_context(|| format!("reading {} back", path.display()))?;
+        self.add(&image);
+        Ok(())
+    }
+
+    /// Writes the sheet (when asked for and any frame was added).
+    pub fn write(&self, options: &PngOptions) -> Result<()> {
+        let Some(path) = &self.path else {
+            return Ok(());
+        };
+        if self.cells.is_empty() {
+            log::warn!("contact sheet {}: no frame to show", path.display());
+            return Ok(());
+        }
+        crate::output::make_parent(path, "contact sheet")?;
+        let sheet = contact_sheet(&self.cells)?;
+        write_png(path, &sheet, options)
+            .with_context(|| format!("writing the contact sheet {}", path.display()))?;
+        Ok(())
+    }
+}
 
 /// The frames to render and their scene times.
 #[derive(Debug, Clone, PartialEq)]

@@ -144,7 +144,28 @@ fn a_killed_sequence_resumes_to_the_same_frames() {
         before.len()
     );
     let stats = cut.join("stats.json");
-    assert_ok(&run(&cut, &["--stats", &stats.display().to_string()]));
+    let sheet = cut.join("sheet").join("contact.png");
+    assert_ok(&run(
+        &cut,
+        &[
+            "--stats",
+            &stats.display().to_string(),
+            "--contact-sheet",
+            &sheet.display().to_string(),
+        ],
+    ));
+    // The contact sheet shows every frame, the ones read back from disk included: 24-pixel
+    // cells in ⌈√FRAMES⌉ columns with 2-pixel gaps.
+    let png = std::fs::read(&sheet).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    let size = |at: usize| u32::from_be_bytes(png[at..at + 4].try_into().unwrap());
+    let columns = (f64::from(FRAMES).sqrt().ceil()) as u32;
+    let rows = FRAMES.div_ceil(columns);
+    assert_eq!(
+        (size(16), size(20)),
+        (columns * 26 + 2, rows * 26 + 2),
+        "contact sheet size"
+    );
     // Frames already on disk were kept as they were, and only the others were rendered.
     for (n, modified) in &before {
         let now = std::fs::metadata(frame(&cut, *n))

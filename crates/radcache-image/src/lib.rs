@@ -5,6 +5,7 @@
 //!   or `f16` samples; AOVs as `<layer>.<channel>` channels. The writer never stores NaN or
 //!   ±inf: it fails with [`Error::NonFinite`] unless [`ExrOptions::sanitize`] is set. The reader
 //!   also reads plain RGB(A) EXRs from other tools (e.g. environment maps).
+//! - [`contact_sheet`]: a sequence's frames reduced and tiled into one image.
 //! - [`write_png`]: 8-bit sRGB preview with exposure and an optional filmic curve ([`ToneMap`]).
 //! - [`frame_path`], [`output_path`], [`png_beside`]: output path patterns (`frame_####.exr`).
 //! - [`compare`] → [`Metrics`] (RMSE, relMSE, MAE, 8×8 block RMSE, mean ratios, FLIP,
@@ -16,6 +17,7 @@
 
 mod atomic;
 mod color;
+mod contact;
 mod error;
 mod exr_read;
 mod exr_write;
@@ -33,6 +35,7 @@ pub use color::{
     aces_filmic, display_u8, exposure_scale, srgb_decode, srgb_encode, srgb_to_u8, tone_map,
     ToneMap,
 };
+pub use contact::{contact_sheet, reduce, reduction_factor, GAP as CONTACT_SHEET_GAP};
 pub use error::{Error, Result};
 pub use exr_read::read_exr;
 pub use exr_write::{write_exr, ExrOptions};

@@ -8,6 +8,7 @@ mod pt;
 mod rays;
 mod scaling;
 mod scene_rays;
+mod temporal;
 mod tessellate;
 
 use anyhow::{bail, Result};
@@ -21,9 +22,12 @@ pub fn run(args: &[&str]) -> Result<()> {
         ["pt", rest @ ..] => pt::run(rest),
         ["ic", rest @ ..] => ic::run(rest),
         ["scaling", rest @ ..] => scaling::run(rest),
+        ["temporal", rest @ ..] => temporal::run(rest),
         _ => bail!(
             "usage: cargo xtask bench rays [--rays N] | pt [--spp N] | ic \
-             | scaling [--preset draft|default|high] [--max-size N]"
+             | scaling [--preset draft|default|high] [--max-size N] \
+             | temporal [--frames N] [--size S] [--preset P] [--reference-frames K] \
+             [--reference-spp SPP]"
         ),
     }
 }

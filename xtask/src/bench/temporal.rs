@@ -1,0 +1,268 @@
+//! `cargo xtask bench temporal [--frames N] [--size S] [--preset P] [--reference-frames K]
+//! [--reference-spp SPP]`: temporal radiance caching on the bundled animated scene
+//! (`assets/animated`: the camera flies in, a box slides and turns, a cube bounces).
+//!
+//! The sequence (frames 1 … N at 24 fps, time (f − 1)/24 s, default 60 frames at 256², draft) is
+//! rendered twice with the irradiance cache: **kept** records (temporal caching: records follow
+//! their instances, carry look-ahead gradients and lifespans, expired ones are refreshed in place;
+//! what `radcache render --frames` does) and **rebuilt** every frame (`--no-temporal`). Per run:
+//! time per frame, record rays (creation, refreshes, look-ahead) and all rays per frame after the
+//! first, records created and refreshed. Then K consecutive frames from the middle of the sequence
+//! are path traced at SPP samples as a reference: each run's relMSE against it and its flicker
+//! (`radcache_image::flicker`, reference mode: the RMS of frame-to-frame changes the reference
+//! does not have, relative to the reference's RMS; the reference's own noise adds to both runs).
+
+use anyhow::{bail, Result};
+use radcache_cache::{IcParams, Preset};
+use radcache_image::{compare, flicker, Image};
+use radcache_render::{
+    render_path, Budget, FrameOutput, GpuScene, IcRenderer, IcSettings, PathSettings,
+};
+use radcache_scene::{LoadOptions, Scene};
+use radcache_vk::{Context, ShaderCompiler};
+
+use crate::results::{append, Figure};
+
+const FPS: f32 = 24.0;
+
+struct Options {
+    frames: u32,
+    size: u32,
+    preset: Preset,
+    reference_frames: u32,
+    reference_spp: u32,
+}
+
+fn parse(args: &[&str]) -> Result<Options> {
+    let mut o = Options {
+        frames: 60,
+        size: 256,
+        preset: Preset::Draft,
+        reference_frames: 4,
+        reference_spp: 256,
+    };
+    let mut it = args.iter();
+    while let Some(&a) = it.next() {
+        let Some(&v) = it.next() else {
+            bail!("{a} needs a value");
+        };
+        match a {
+            "--frames" => o.frames = v.parse()?,
+            "--size" => o.size = v.parse()?,
+            "--reference-frames" => o.reference_frames = v.parse()?,
+            "--reference-spp" => o.reference_spp = v.parse()?,
+            "--preset" => {
+                o.preset = match v {
+                    "draft" => Preset::Draft,
+                    "default" => Preset::Default,
+                    "high" => Preset::High,
+                    _ => bail!("--preset draft|default|high, not {v}"),
+                }
+            }
+            _ => bail!("unknown option {a}"),
+        }
+    }
+    anyhow::ensure!(
+        o.frames >= 2 && o.reference_frames >= 2 && o.reference_frames <= o.frames,
+        "need at least 2 frames and 2 ≤ reference frames ≤ frames"
+    );
+    Ok(o)
+}
+
+/// What one run of the sequence measured.
+#[derive(Default)]
+struct Run {
+    time_s: Vec<f64>,
+    record_rays: Vec<u64>,
+    rays: Vec<u64>,
+    created: u64,
+    refreshed: u64,
+    last_records: u64,
+    /// The frames the reference covers.
+    images: Vec<Image>,
+}
+
+impl Run {
+    /// Mean of `v` over the frames after the first.
+    fn later(v: &[u64]) -> f64 {
+        v[1..].iter().sum::<u64>() as f64 / (v.len() - 1) as f64
+    }
+    fn later_time(&self) -> f64 {
+        self.time_s[1..].iter().sum::<f64>() / (self.time_s.len() - 1) as f64
+    }
+}
+
+fn image(out: &FrameOutput) -> Result<Image> {
+    Ok(Image::from_pixels(
+        out.width,
+        out.height,
+        out.pixels.clone(),
+    )?)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_sequence(
+    ctx: &Context,
+    shaders: &ShaderCompiler,
+    scene: &Scene,
+    gpu: &mut GpuScene,
+    o: &Options,
+    keep: bool,
+    reference_range: std::ops::RangeInclusive<u32>,
+) -> Result<Run> {
+    let settings = |frame: u32| IcSettings {
+        width: o.size,
+        height: o.size,
+        params: IcParams::preset(o.preset),
+        seed: 1,
+        frame,
+        time: (frame - 1) as f32 / FPS,
+        settle_records: keep,
+        time_step_s: if keep { 1.0 / FPS } else { 0.0 },
+        ..IcSettings::default()
+    };
+    let mut renderer = IcRenderer::new(ctx, shaders, gpu, &settings(1))?;
+    let mut run = Run::default();
+    for frame in 1..=o.frames {
+        if !keep {
+            renderer.forget();
+        }
+        let (out, stats) = renderer.render(ctx, scene, gpu, &settings(frame), &mut |_| {})?;
+        anyhow::ensure!(
+            out.nonfinite_pixels == 0,
+            "frame {frame}: non-finite pixels"
+        );
+        run.time_s.push(out.time_s);
+        run.record_rays.push(stats.record_rays);
+        run.rays.push(out.rays.values().sum());
+        if frame > 1 {
+            run.created += stats.records_per_level.iter().sum::<u64>();
+            run.refreshed += stats.records_refreshed;
+        }
+        run.last_records = stats.records;
+        if reference_range.contains(&frame) {
+            run.images.push(image(&out)?);
+        }
+        if frame % 10 == 0 {
+            println!(
+                "  {} frame {frame}: {:.2} s, {} records ({} kept, {} refreshed), {:.2} M record rays",
+                if keep { "kept" } else { "rebuilt" },
+                out.time_s,
+                stats.records,
+                stats.records_kept,
+                stats.records_refreshed,
+                stats.record_rays as f64 / 1e6
+            );
+        }
+    }
+    Ok(run)
+}
+
+pub fn run(args: &[&str]) -> Result<()> {
+    let o = parse(args)?;
+    let root = crate::root();
+    let (scene, _) = Scene::load(
+        &root.join("assets/animated/animated.gltf"),
+        &LoadOptions::default(),
+    )?;
+    let ctx = Context::new()?;
+    let device = ctx.info().name.clone();
+    let shaders = ShaderCompiler::new(root.join("shaders"))?;
+    let mut gpu = GpuScene::new(&ctx, &scene, None)?;
+    let first_ref = (o.frames - o.reference_frames) / 2 + 1;
+    let range = first_ref..=first_ref + o.reference_frames - 1;
+    let name = format!("{:?}", o.preset).to_lowercase();
+    println!(
+        "device: {device}; animated scene, {} frames at {}², {name}, {FPS} fps",
+        o.frames, o.size
+    );
+    // Warm-up: shader compilation is not part of the figures.
+    let warm = IcSettings {
+        width: 16,
+        height: 16,
+        params: IcParams::preset(o.preset),
+        sub_frames: 1,
+        time_step_s: 1.0 / FPS,
+        ..IcSettings::default()
+    };
+    IcRenderer::new(&ctx, &shaders, &gpu, &warm)?.render(
+        &ctx,
+        &scene,
+        &mut gpu,
+        &warm,
+        &mut |_| {},
+    )?;
+
+    let kept = run_sequence(&ctx, &shaders, &scene, &mut gpu, &o, true, range.clone())?;
+    let rebuilt = run_sequence(&ctx, &shaders, &scene, &mut gpu, &o, false, range.clone())?;
+
+    let mut references = Vec::new();
+    for frame in range.clone() {
+        let settings = PathSettings {
+            width: o.size,
+            height: o.size,
+            budget: Budget::Samples(o.reference_spp),
+            seed: 4242,
+            frame,
+            time: (frame - 1) as f32 / FPS,
+            ..PathSettings::default()
+        };
+        let out = render_path(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
+        references.push(image(&out)?);
+    }
+
+    let case = format!("animated_{}_{name}_{}f", o.size, o.frames);
+    let mut figures = Vec::new();
+    println!(
+        "| run | s/frame (after 1st) | record rays/frame | all rays/frame | created | refreshed | \
+         relMSE (frames {}–{}) | flicker vs {}-spp PT |",
+        range.start(),
+        range.end(),
+        o.reference_spp
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    let mut record_rays = [0.0; 2];
+    for (k, (label, r)) in [("kept", &kept), ("rebuilt", &rebuilt)]
+        .into_iter()
+        .enumerate()
+    {
+        let mut relmse = 0.0;
+        for (img, reference) in r.images.iter().zip(&references) {
+            relmse += compare(reference, img)?.relmse / references.len() as f64;
+        }
+        let f = flicker(&r.images, Some(&references))?;
+        record_rays[k] = Run::later(&r.record_rays);
+        println!(
+            "| {label} | {:.2} | {:.3} M | {:.2} M | {} | {} | {relmse:.3e} | {:.4} |",
+            r.later_time(),
+            record_rays[k] / 1e6,
+            Run::later(&r.rays) / 1e6,
+            r.created,
+            r.refreshed,
+            f.flicker
+        );
+        let c = format!("{case}_{label}");
+        figures.extend([
+            Figure::new(&c, "time_per_frame_s", r.later_time(), "s"),
+            Figure::new(&c, "first_frame_s", r.time_s[0], "s"),
+            Figure::new(&c, "record_rays_per_frame", record_rays[k], "rays"),
+            Figure::new(&c, "rays_per_frame", Run::later(&r.rays), "rays"),
+            Figure::new(&c, "records_created", r.created as f64, "records"),
+            Figure::new(&c, "records_refreshed", r.refreshed as f64, "records"),
+            Figure::new(&c, "records_last", r.last_records as f64, "records"),
+            Figure::new(&c, "relmse", relmse, "relMSE"),
+            Figure::new(&c, "flicker", f.flicker, "ratio"),
+        ]);
+    }
+    let share = record_rays[0] / record_rays[1].max(1.0);
+    println!(
+        "kept records need {:.1}% of the record rays of a per-frame rebuild after the first frame \
+         (target ≤ 15%); time per frame {:.2} s vs {:.2} s",
+        100.0 * share,
+        kept.later_time(),
+        rebuilt.later_time()
+    );
+    figures.push(Figure::new(&case, "record_ray_share", share, "ratio"));
+    append("temporal", &device, &figures)?;
+    Ok(())
+}
