@@ -12,7 +12,11 @@
 //   1 advance   (per record)     move adopted records with their instance (point, normals; the
 //                                gradients rotate with the instance's change since the previous
 //                                frame); a living record takes its extrapolated value
-//                                max(0, E(t_i) + age·∂E/∂t), an expired one is listed for refresh
+//                                max(0, E(t_i) + age·∂E/∂t), an expired one is listed for refresh;
+//                                with `reclamp` (the camera moved) every record in front of the
+//                                camera takes the [R⁻, R⁺] clamp of its pixel footprint in this
+//                                view, as a record created now would (records kept from a distant
+//                                view would otherwise stay many R⁺ wide on screen)
 //   2 append    (per new record) list records [first, count) and mark them not adopted
 //   3 adopt     (per listed)     store the point and normals in object space (new records) and the
 //                                irradiance at birth, birth frame = this frame
@@ -44,10 +48,14 @@ layout(push_constant) uniform Push {
     uint frame;          // this frame's number (birth frames count in it)
     uint first;          // append: first new record
     uint has_previous;   // advance: `previous` holds the instances of the frame before
+    uint has_lifespans;  // advance: records carry temporal state (a time step was given)
     float accuracy;      // a_t
     float max_age;       // Δt_max in frames
     uint capacity;       // list capacity
-    uint pad;
+    uint reclamp;        // advance: clamp radii to this view's footprints
+    float min_px;        // R⁻ in pixel footprints (IcParams)
+    float max_px;        // R⁺
+    float v_scale;       // validity radius / R
 } pc;
 
 const uint ADOPTED = 1u;
@@ -110,6 +118,34 @@ void move_record(uint i, GpuRecordTemporal tr) {
     records[i] = r;
 }
 
+// The [R⁻, R⁺] clamp of record i for the current view (record.comp's, from the footprint of a
+// pixel at the record's point), with the gradient attenuation that goes with it.
+void reclamp_record(uint i) {
+    GpuRecord r = records[i];
+    if (dot(r.normal_rorig.xyz, r.normal_rorig.xyz) == 0.0) {
+        return;  // rejected
+    }
+    vec3 p = r.position_radius.xyz;
+    float depth = (frame.clip_from_world * vec4(p, 1.0)).w;
+    if (!(depth > 0.0)) {
+        return;  // behind the camera: keeps its clamp until it is seen again
+    }
+    vec3 row_y = vec3(frame.clip_from_world[0][1], frame.clip_from_world[1][1],
+                      frame.clip_from_world[2][1]);
+    vec3 to_camera = frame.camera_position.xyz - p;
+    float dist = length(to_camera);
+    vec3 ng = vec3(r.grad_r_red.w, r.grad_r_green.w, r.grad_r_blue.w);
+    float cos_view = dist > 0.0 ? dot(ng, to_camera) / dist : 1.0;
+    float footprint = pixel_footprint(depth, 1.0 / length(row_y), float(frame.resolution.y),
+                                      cos_view);
+    float lo, hi;
+    radius_bounds(footprint, pc.min_px, pc.max_px, pc.v_scale, lo, hi);
+    float r_orig = r.normal_rorig.w;
+    records[i].position_radius.w = clamp_radius(r_orig, lo, hi);
+    records[i].bounds.xy = vec2(lo, hi);
+    records[i].irradiance.w = gradient_attenuation(r_orig, lo);
+}
+
 void main() {
     uint gid = gl_GlobalInvocationID.x;
     if (pc.mode == 0u) {
@@ -125,17 +161,19 @@ void main() {
             return;
         }
         GpuRecordTemporal tr = temporal[gid];
-        if ((tr.info.z & ADOPTED) == 0u) {
-            return;
+        if (pc.has_lifespans != 0u && (tr.info.z & ADOPTED) != 0u) {
+            move_record(gid, tr);
+            float age = float(pc.frame - tr.info.y);
+            if (age > max(tr.object_position.w, 1.0)) {
+                append(gid);
+            } else {
+                vec3 e0 = tr.birth_irradiance.rgb;
+                vec3 e = max(e0 + age * tr.gradient.rgb, vec3(0.0));
+                records[gid].irradiance.rgb = finite_or(e, e0);
+            }
         }
-        move_record(gid, tr);
-        float age = float(pc.frame - tr.info.y);
-        if (age > max(tr.object_position.w, 1.0)) {
-            append(gid);
-        } else {
-            vec3 e0 = tr.birth_irradiance.rgb;
-            vec3 e = max(e0 + age * tr.gradient.rgb, vec3(0.0));
-            records[gid].irradiance.rgb = finite_or(e, e0);
+        if (pc.reclamp != 0u) {
+            reclamp_record(gid);
         }
         return;
     }

@@ -1,8 +1,10 @@
 //! Records kept across frames (`IcRenderer`) on lavapipe: a static scene renders identical
 //! frames without creating records; under camera motion, later frames create few records and
-//! the kept ones keep their irradiance and gradients bit for bit; `forget` rebuilds.
+//! the kept ones keep their irradiance and gradients bit for bit (their radius takes the new
+//! view's clamp); `forget` rebuilds.
 
 use glam::{Quat, Vec3};
+use radcache_cache::radius::{pixel_footprint, radius_bounds};
 use radcache_cache::IcParams;
 use radcache_render::{GpuScene, IcRenderer, IcSettings, IcStats};
 use radcache_scene::writer::{ChannelDesc, GltfBuilder, MaterialDesc, NodeDesc};
@@ -178,14 +180,41 @@ fn camera_motion_reuses_records_unchanged() {
     for (k, (a, b)) in before.iter().zip(&after).enumerate() {
         let same = a.position_radius[..3] == b.position_radius[..3]
             && a.normal_rorig[..3] == b.normal_rorig[..3]
-            && a.irradiance == b.irradiance
+            && a.irradiance[..3] == b.irradiance[..3]
             && [a.grad_r_red, a.grad_r_green, a.grad_r_blue]
                 == [b.grad_r_red, b.grad_r_green, b.grad_r_blue]
             && [a.grad_t_red, a.grad_t_green, a.grad_t_blue]
                 == [b.grad_t_red, b.grad_t_green, b.grad_t_blue];
         assert!(same, "record {k} changed: {a:?} -> {b:?}");
-        // Only a new neighbour may shrink a kept record's radius.
+        // Only a new neighbour may shrink a kept record's unclamped radius; the radius used
+        // takes the [R⁻, R⁺] clamp of the new view (the gradient attenuation in irradiance.w
+        // follows it).
         assert!(b.normal_rorig[3] <= a.normal_rorig[3]);
+        let (lo, hi, used) = (b.bounds[0], b.bounds[1], b.position_radius[3]);
+        assert!(
+            lo <= used && used <= hi,
+            "record {k}: {used} outside [{lo}, {hi}]"
+        );
+        // The clamp is the one of the pixel footprint at the record's point in frame 2's view
+        // (radcache_cache::radius, the CPU twin of the shader's functions).
+        let view = scene.camera_at(1.0 / 24.0);
+        let p = Vec3::from_slice(&b.position_radius[..3]);
+        let depth = view.view_from_world().transform_point3(p).z.abs();
+        let ng = Vec3::new(b.grad_r_red[3], b.grad_r_green[3], b.grad_r_blue[3]);
+        let cos_view = ng.dot((view.position - p).normalize());
+        let tan = (view.perspective.yfov * 0.5).tan();
+        let f = pixel_footprint(depth, tan, SIZE as f32, cos_view);
+        let p = IcParams::draft();
+        let (lo_cpu, hi_cpu) =
+            radius_bounds(f, p.min_spacing_px, p.max_spacing_px, p.validity_scale());
+        assert!(
+            (lo - lo_cpu).abs() <= 1e-4 * lo_cpu,
+            "record {k}: R⁻ {lo} vs {lo_cpu}"
+        );
+        assert!(
+            (hi - hi_cpu).abs() <= 1e-4 * hi_cpu,
+            "record {k}: R⁺ {hi} vs {hi_cpu}"
+        );
     }
     drop((r, gpu));
     finish(ctx);

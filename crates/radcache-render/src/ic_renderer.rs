@@ -66,8 +66,10 @@ pub struct IcRenderer {
     composite: CompositePass,
     emission: EmissionPass,
     state: IcState,
-    /// Temporal caching, when created with a time step.
+    /// Records kept across frames (created for sequences: `settle_records` or a time step).
     temporal: Option<TemporalPass>,
+    /// The previous frame's `clip_from_world` (kept records are re-clamped when it changes).
+    last_view: Option<[[f32; 4]; 4]>,
     /// False until a frame has left records to keep.
     has_records: bool,
     /// Frames rendered (the last-use marks of `IcState::last_used`).
@@ -117,16 +119,14 @@ impl IcRenderer {
             composite: CompositePass::new(ctx, shaders, gpu, w, h)?,
             emission: EmissionPass::new(ctx, shaders, gpu)?,
             state: IcState::new(ctx, shaders, settings.record_capacity, w * h)?,
-            temporal: if settings.time_step_s > 0.0 {
-                Some(TemporalPass::new(
-                    ctx,
-                    shaders,
-                    gpu,
-                    settings.record_capacity,
-                )?)
+            temporal: if settings.time_step_s > 0.0 || settings.settle_records {
+                let lifespans = settings.time_step_s > 0.0;
+                let capacity = settings.record_capacity;
+                Some(TemporalPass::new(ctx, shaders, gpu, capacity, lifespans)?)
             } else {
                 None
             },
+            last_view: None,
             has_records: false,
             frames: 0,
         })
@@ -156,7 +156,8 @@ impl IcRenderer {
     ) -> Result<(FrameOutput, IcStats)> {
         if (settings.width, settings.height, settings.params)
             != (self.width, self.height, self.params)
-            || (settings.time_step_s > 0.0 && self.temporal.is_none())
+            || (settings.time_step_s > 0.0
+                && !self.temporal.as_ref().is_some_and(|t| t.lifespans()))
         {
             return Err(Error::Invalid(format!(
                 "the renderer was made for {}x{} and {:?}{}, not {}x{} and {:?} with a time step \
@@ -217,11 +218,18 @@ impl IcRenderer {
         if !self.has_records {
             self.state.record_reset(&mut rec)?;
         }
-        if let Some(t) = self.temporal.as_mut().filter(|_| temporal) {
+        // Kept records take the radius clamp of the new view when the camera moved.
+        let clip = gpu.constants().clip_from_world;
+        let view_changed = self.last_view.is_some_and(|v| v != clip);
+        self.last_view = Some(clip);
+        if let Some(t) = self.temporal.as_mut() {
             if !self.has_records {
                 t.forget();
             }
-            t.record_advance(&mut rec, gpu, &self.state, now, kept)?;
+            if temporal || view_changed {
+                let reclamp = view_changed.then_some(&self.params);
+                t.record_advance(&mut rec, gpu, &self.state, now, kept, temporal, reclamp)?;
+            }
         }
         self.neighbours
             .record_rebuild(&mut rec, &self.state, gpu.scene_scale())?;

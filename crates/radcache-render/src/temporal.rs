@@ -18,6 +18,7 @@
 //! [`TemporalPass::record_keep_instances`] at the end.
 
 use bytemuck::{Pod, Zeroable};
+use radcache_cache::IcParams;
 use radcache_shared::gpu::{GpuInstance, GpuRecord, IcCounters};
 use radcache_vk::{
     vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, MemoryLocation, Pipeline,
@@ -36,10 +37,14 @@ struct Push {
     frame: u32,
     first: u32,
     has_previous: u32,
+    has_lifespans: u32,
     accuracy: f32,
     max_age: f32,
     capacity: u32,
-    pad: u32,
+    reclamp: u32,
+    min_px: f32,
+    max_px: f32,
+    v_scale: f32,
 }
 
 /// The shader's steps.
@@ -66,6 +71,7 @@ pub struct TemporalPass {
     pub lookahead: Buffer,
     previous: Buffer,
     has_previous: bool,
+    lifespans: bool,
     capacity: u32,
 }
 
@@ -87,12 +93,14 @@ pub struct Lifespans {
 }
 
 impl TemporalPass {
-    /// Compiles the pass for `record_capacity` records of `scene`.
+    /// Compiles the pass for `record_capacity` records of `scene`; the look-ahead copy of the
+    /// records is allocated only with `lifespans` (a scene whose lighting changes).
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
         record_capacity: u32,
+        lifespans: bool,
     ) -> Result<TemporalPass> {
         let spirv = shaders.compile("passes/temporal.comp", &scene.defines())?;
         let pass: Vec<BindingLayout> = (0..7)
@@ -136,7 +144,8 @@ impl TemporalPass {
             )?,
             lookahead: buffer(
                 "temporal.lookahead",
-                u64::from(capacity) * std::mem::size_of::<GpuRecord>() as u64,
+                u64::from(if lifespans { capacity } else { 1 })
+                    * std::mem::size_of::<GpuRecord>() as u64,
                 storage | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuOnly,
             )?,
@@ -147,6 +156,7 @@ impl TemporalPass {
                 MemoryLocation::GpuOnly,
             )?,
             has_previous: false,
+            lifespans,
             capacity,
         })
     }
@@ -196,16 +206,23 @@ impl TemporalPass {
             frame,
             first: 0,
             has_previous: 0,
+            has_lifespans: 0,
             accuracy: 0.0,
             max_age: 0.0,
             capacity: 0,
-            pad: 0,
+            reclamp: 0,
+            min_px: 0.0,
+            max_px: 0.0,
+            v_scale: 1.0,
         }
     }
 
-    /// Records emptying the list, then (with `records` kept from earlier frames) moving every
-    /// record with its instance and extrapolating it to `frame`, or listing it when it expired.
-    /// The scene must be at the frame's time; the neighbour grid must be rebuilt afterwards.
+    /// Records emptying the list, then, over the `records` kept from earlier frames: with
+    /// `lifespans`, moving every record with its instance and extrapolating it to `frame`, or
+    /// listing it when it expired; with `reclamp` (the camera moved), clamping every radius to
+    /// `params`' [R⁻, R⁺] at the record's pixel footprint in the current view. The scene and view
+    /// must be the frame's; the neighbour grid must be rebuilt afterwards.
+    #[allow(clippy::too_many_arguments)]
     pub fn record_advance(
         &self,
         rec: &mut Recorder,
@@ -213,14 +230,23 @@ impl TemporalPass {
         state: &IcState,
         frame: u32,
         records: u32,
+        lifespans: bool,
+        reclamp: Option<&IcParams>,
     ) -> Result<()> {
         let push = Self::push(frame);
         self.dispatch(rec, scene, state, Mode::Begin, push, 1)?;
-        if records > 0 {
-            let push = Push {
+        if records > 0 && (lifespans || reclamp.is_some()) {
+            let mut push = Push {
                 has_previous: u32::from(self.has_previous),
+                has_lifespans: u32::from(lifespans),
                 ..push
             };
+            if let Some(p) = reclamp {
+                push.reclamp = 1;
+                push.min_px = p.min_spacing_px;
+                push.max_px = p.max_spacing_px;
+                push.v_scale = p.validity_scale();
+            }
             self.dispatch(rec, scene, state, Mode::Advance, push, records)?;
         }
         Ok(())
@@ -299,6 +325,11 @@ impl TemporalPass {
             rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
             self.has_previous = true;
         }
+    }
+
+    /// Whether records carry lifespans (the pass was made for a scene whose lighting changes).
+    pub fn lifespans(&self) -> bool {
+        self.lifespans
     }
 
     /// Forgets the previous frame's instances (the next frame starts a new cache).
