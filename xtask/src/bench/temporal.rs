@@ -10,7 +10,10 @@
 //! first, records created and refreshed. Then K consecutive frames from the middle of the sequence
 //! are path traced at SPP samples as a reference: each run's relMSE against it and its flicker
 //! (`radcache_image::flicker`, reference mode: the RMS of frame-to-frame changes the reference
-//! does not have, relative to the reference's RMS; the reference's own noise adds to both runs).
+//! does not have, relative to the reference's RMS). The reference's own noise adds to both
+//! figures; a second path-traced sequence with other seeds measures it (its error and squared
+//! flicker against the reference are twice the reference's own), and the runs' own figures are
+//! given net of it.
 
 use anyhow::{bail, Result};
 use radcache_cache::{IcParams, Preset};
@@ -39,7 +42,7 @@ fn parse(args: &[&str]) -> Result<Options> {
         size: 256,
         preset: Preset::Draft,
         reference_frames: 4,
-        reference_spp: 256,
+        reference_spp: 512,
     };
     let mut it = args.iter();
     while let Some(&a) = it.next() {
@@ -196,26 +199,45 @@ pub fn run(args: &[&str]) -> Result<()> {
     let kept = run_sequence(&ctx, &shaders, &scene, &mut gpu, &o, true, range.clone())?;
     let rebuilt = run_sequence(&ctx, &shaders, &scene, &mut gpu, &o, false, range.clone())?;
 
+    // The reference, and a second path-traced sequence with other seeds: its error and flicker
+    // against the reference are twice the reference's own (independent noise adds), which is
+    // taken off both runs' figures.
     let mut references = Vec::new();
+    let mut twins = Vec::new();
     for frame in range.clone() {
-        let settings = PathSettings {
-            width: o.size,
-            height: o.size,
-            budget: Budget::Samples(o.reference_spp),
-            seed: 4242,
-            frame,
-            time: (frame - 1) as f32 / FPS,
-            ..PathSettings::default()
-        };
-        let out = render_path(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
-        references.push(image(&out)?);
+        for (seed, into) in [(4242, &mut references), (977, &mut twins)] {
+            let settings = PathSettings {
+                width: o.size,
+                height: o.size,
+                budget: Budget::Samples(o.reference_spp),
+                seed,
+                frame,
+                time: (frame - 1) as f32 / FPS,
+                ..PathSettings::default()
+            };
+            let out = render_path(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
+            into.push(image(&out)?);
+        }
     }
+    let mut twin_relmse = 0.0;
+    for (img, reference) in twins.iter().zip(&references) {
+        twin_relmse += compare(reference, img)?.relmse / references.len() as f64;
+    }
+    let twin_flicker = flicker(&twins, Some(&references))?.flicker;
+    // The reference's own share: half of the twin's (squared for flicker, a relative RMS).
+    let (ref_relmse, ref_flicker2) = (twin_relmse / 2.0, twin_flicker * twin_flicker / 2.0);
+    println!(
+        "reference noise ({} spp): relMSE {ref_relmse:.3e}, flicker {:.4} (from a second \
+         path-traced sequence)",
+        o.reference_spp,
+        ref_flicker2.sqrt()
+    );
 
     let case = format!("animated_{}_{name}_{}f", o.size, o.frames);
     let mut figures = Vec::new();
     println!(
         "| run | s/frame (after 1st) | record rays/frame | all rays/frame | created | refreshed | \
-         relMSE (frames {}–{}) | flicker vs {}-spp PT |",
+         relMSE (frames {}–{}; own) | flicker vs {}-spp PT (own) |",
         range.start(),
         range.end(),
         o.reference_spp
@@ -230,16 +252,18 @@ pub fn run(args: &[&str]) -> Result<()> {
         for (img, reference) in r.images.iter().zip(&references) {
             relmse += compare(reference, img)?.relmse / references.len() as f64;
         }
-        let f = flicker(&r.images, Some(&references))?;
+        let f = flicker(&r.images, Some(&references))?.flicker;
+        let own_relmse = (relmse - ref_relmse).max(0.0);
+        let own_flicker = (f * f - ref_flicker2).max(0.0).sqrt();
         record_rays[k] = Run::later(&r.record_rays);
         println!(
-            "| {label} | {:.2} | {:.3} M | {:.2} M | {} | {} | {relmse:.3e} | {:.4} |",
+            "| {label} | {:.2} | {:.3} M | {:.2} M | {} | {} | {relmse:.3e} ({own_relmse:.3e}) | \
+             {f:.4} ({own_flicker:.4}) |",
             r.later_time(),
             record_rays[k] / 1e6,
             Run::later(&r.rays) / 1e6,
             r.created,
             r.refreshed,
-            f.flicker
         );
         let c = format!("{case}_{label}");
         figures.extend([
@@ -251,7 +275,9 @@ pub fn run(args: &[&str]) -> Result<()> {
             Figure::new(&c, "records_refreshed", r.refreshed as f64, "records"),
             Figure::new(&c, "records_last", r.last_records as f64, "records"),
             Figure::new(&c, "relmse", relmse, "relMSE"),
-            Figure::new(&c, "flicker", f.flicker, "ratio"),
+            Figure::new(&c, "own_relmse", own_relmse, "relMSE"),
+            Figure::new(&c, "flicker", f, "ratio"),
+            Figure::new(&c, "own_flicker", own_flicker, "ratio"),
         ]);
     }
     let share = record_rays[0] / record_rays[1].max(1.0);
