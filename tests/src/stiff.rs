@@ -6,9 +6,10 @@
 //! RMSE, the non-finite pixel count (pixels the readback found non-finite, plus any left in the
 //! output: both must be 0), and the **leak**: the candidate's mean luminance over the pixels that
 //! must be dark. For a [`StiffCheck::Dark`] scene that is every pixel and the leak is absolute
-//! (W/(sr·m²)); for a path-traced reference the dark pixels are those whose reference luminance
-//! is at most 1 % of the reference's mean, and the leak is relative to that mean (the reference's
-//! own value over the same pixels is subtracted, so an exact render leaks 0 within noise).
+//! (W/(sr·m²)); for a path-traced reference the dark pixels are the 8×8 blocks whose reference
+//! mean luminance is at most 2 % of the reference's image mean, and the leak is relative to that
+//! mean (the reference's own value over the same pixels is subtracted, so an exact render leaks 0
+//! within noise).
 //! Scenes without dark pixels, and analytic ones, have no leak figure.
 
 use std::time::Instant;
@@ -152,10 +153,12 @@ pub fn leak(check: &StiffCheck, reference: &Image, candidate: &Image) -> Option<
             if mean <= 0.0 {
                 return Some(mean_luminance(candidate));
             }
+            let dark = dark_blocks(reference, DARK_FRACTION * mean);
             let (mut sum_c, mut sum_r, mut n) = (0.0, 0.0, 0u64);
-            for (r, c) in reference.pixels().zip(candidate.pixels()) {
+            for (i, (r, c)) in reference.pixels().zip(candidate.pixels()).enumerate() {
+                let (x, y) = (i as u32 % reference.width(), i as u32 / reference.width());
                 let (lr, lc) = (luminance(r), luminance(c));
-                if lr.is_finite() && lc.is_finite() && lr <= 0.01 * mean {
+                if dark.contains(&(x / BLOCK, y / BLOCK)) && lr.is_finite() && lc.is_finite() {
                     sum_c += lc;
                     sum_r += lr;
                     n += 1;
@@ -165,6 +168,38 @@ pub fn leak(check: &StiffCheck, reference: &Image, candidate: &Image) -> Option<
         }
         _ => None,
     }
+}
+
+/// Side of the blocks of the dark region, pixels.
+const BLOCK: u32 = 8;
+/// A block is dark when its reference mean luminance is at most this fraction of the image's.
+pub const DARK_FRACTION: f64 = 0.02;
+
+/// The 8×8 blocks (block coordinates) whose mean luminance is at most `threshold`. Blocks, not
+/// pixels: a noisy reference has many pixels near zero by chance, and picking them would bias the
+/// figure; a block's mean carries 64 samples.
+fn dark_blocks(image: &Image, threshold: f64) -> Vec<(u32, u32)> {
+    let (bw, bh) = (
+        image.width().div_ceil(BLOCK),
+        image.height().div_ceil(BLOCK),
+    );
+    let mut sums = vec![(0.0f64, 0u32); (bw * bh) as usize];
+    for (i, p) in image.pixels().enumerate() {
+        let (x, y) = (i as u32 % image.width(), i as u32 / image.width());
+        let l = luminance(p);
+        if l.is_finite() {
+            let s = &mut sums[((y / BLOCK) * bw + x / BLOCK) as usize];
+            s.0 += l;
+            s.1 += 1;
+        }
+    }
+    (0..bw * bh)
+        .filter(|&b| {
+            let (sum, n) = sums[b as usize];
+            n > 0 && sum / f64::from(n) <= threshold
+        })
+        .map(|b| (b % bw, b / bw))
+        .collect()
 }
 
 /// The figures of one render against its reference.

@@ -280,8 +280,9 @@ fn markdown(
          sub-frame; references: analytic (furnaces), black (`two_rooms`, `inside_object`), \
          else the path tracer at {} spp (`cornell_1e-3` and `cornell_1e4` against \
          `cornell_1`'s). relMSE = Σ(c−r)²/(r²+0.01)/3N; block RMSE over 8×8-block means; leak: \
-         mean luminance over the pixels that must be dark (absolute for the black scenes, else \
-         the excess over the reference's there, relative to the reference's mean; see \
+         mean luminance over what must be dark (absolute for the black scenes; else the excess \
+         over the reference's in the 8×8 blocks whose reference mean is at most 2 % of the \
+         image's, relative to the image's mean; — where there are none; see \
          `tests/src/stiff.rs`); NaN: non-finite pixels found at readback. Time: wall time of \
          the frame, pipelines included.\n",
         o.size, o.size, o.ref_spp
