@@ -103,6 +103,16 @@ void main() {
     float cos_view = dist > 0.0 ? dot(ng, to_camera) / dist : 1.0;
     float footprint = pixel_footprint(view_depth, 1.0 / length(row_y),
                                       float(frame.resolution.y), cos_view);
+    // The stored point moves a hair toward the camera, into the free space the camera ray came
+    // through: a sample exactly on an edge of a closed object seen from inside (the stiff suite's
+    // `inside_object`, whose image diagonals run along the cube's edges) lies on the plane of the
+    // other face too, and rays from it (offset only along its own face's normal) slipped through
+    // that face at t = 0 and saw the lit room. Relative to the distance and to the position's
+    // magnitude, so it survives f32 rounding at any scale; never more than half the distance.
+    float step_len = min(max(1e-5 * dist, 1e-6 * max(abs(position.x), max(abs(position.y),
+                                                                        abs(position.z)))),
+                         0.5 * dist);
+    position += dist > 0.0 ? to_camera * (step_len / dist) : vec3(0.0);
     o_position = vec4(position, 1.0);
     o_normal = vec4(ns, footprint);
     o_geometric = vec4(ng, float(material));
