@@ -194,7 +194,8 @@ pub fn run(args: &[&str]) -> Result<()> {
     let first_error = ctx.first_validation_error();
     let report = ctx.shutdown();
     let total = start.elapsed().as_secs_f64();
-    let md = markdown(&o, &rows, &notes, &device, validation, &report, total);
+    let mut md = markdown(&o, &rows, &notes, &device, validation, &report, total);
+    md.push_str(&kept_notes(&o.out));
     print!("{md}");
     std::fs::write(&o.out, &md).with_context(|| format!("writing {}", o.out.display()))?;
     eprintln!("wrote {}", o.out.display());
@@ -207,6 +208,18 @@ pub fn run(args: &[&str]) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The line after which `bench/stiff.md` holds hand-written findings, kept across runs.
+const NOTES_MARKER: &str = "<!-- findings: written by hand, kept by cargo xtask stiff -->";
+
+/// The hand-written part of the existing report (from the marker on), or just the marker.
+fn kept_notes(path: &std::path::Path) -> String {
+    let old = std::fs::read_to_string(path).unwrap_or_default();
+    match old.find(NOTES_MARKER) {
+        Some(i) => format!("\n{}", &old[i..]),
+        None => format!("\n{NOTES_MARKER}\n"),
+    }
 }
 
 fn load_row(s: &StiffScene, named: bool, msg: &str) -> Row {
