@@ -3,7 +3,9 @@
 // it, as glTF's winding rule says); both normals are turned toward the camera, and the front
 // face (for the emission rule) is the side the camera sees. The pixel footprint is the pinhole
 // `pixel_footprint` of ircache_math.glsl (its cosine clamp keeps grazing surfaces bounded, where
-// screen-space derivatives would grow without limit).
+// screen-space derivatives would grow without limit). Each fragment checks with one ray query
+// that nothing stands between it and the camera (`occluder`): rasterization's edge snapping must
+// not let a sample see through the seam of a zero-thickness wall.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -22,6 +24,34 @@ layout(location = 2) out vec4 o_geometric;
 layout(location = 3) out vec4 o_albedo;
 layout(location = 4) out vec4 o_emission;
 
+// The first surface along the camera ray to this fragment, when it is not the fragment's own:
+// rasterization snaps edges to the sub-pixel grid (1/256 px on lavapipe), so where a
+// zero-thickness wall stands on a floor that runs on under it, a sample within that snapping
+// distance of the seam misses the wall and lands on the floor behind it, on the wall's other side
+// (measured: the `two_rooms` scene of the stiff suite, 0.8 mm behind the wall at 2.8 m, lit by
+// the other room's lights). The ray stops 1e-5 of the distance short of the fragment (relative,
+// so any scene scale works); a hit there is the surface the camera really sees.
+bool occluder(vec3 to_fragment, out Surface s, out uint instance) {
+    float dist = length(to_fragment);
+    if (!(dist > 0.0)) {
+        return false;
+    }
+    vec3 dir = to_fragment / dist;
+    rayQueryEXT q;
+    rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, frame.camera_position.xyz, 0.0, dir,
+                          dist * (1.0 - 1e-5));
+    while (rayQueryProceedEXT(q)) {
+    }
+    if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
+        return false;
+    }
+    instance = uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true));
+    s = surface_at(instance,
+                   uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
+                   rayQueryGetIntersectionBarycentricsEXT(q, true), dir);
+    return true;
+}
+
 void main() {
     GpuInstance inst = instances[pc.instance];
     uint first = inst.mesh.z + 3u * v_triangle;
@@ -36,7 +66,8 @@ void main() {
     if (inst.normal_to_world[3][3] < 0.0) {
         ng = -ng;
     }
-    vec3 to_camera = frame.camera_position.xyz - v_position;
+    vec3 position = v_position;
+    vec3 to_camera = frame.camera_position.xyz - position;
     bool front = dot(ng, to_camera) >= 0.0;
     if (!front) {
         ng = -ng;
@@ -51,17 +82,45 @@ void main() {
         ns = ng;
     }
     uint material = tri_materials[inst.mesh.w + v_triangle];
-    // View depth = clip w = 1 / gl_FragCoord.w. The y row of clip_from_world is the projection's
-    // ±1/tan(fov_y/2) times a row of the view rotation (a unit vector).
+    vec2 uv = v_uv;
+    float view_depth = 1.0 / gl_FragCoord.w;
+    Surface hit;
+    uint instance = pc.instance;
+    uint hit_instance;
+    if (occluder(-to_camera, hit, hit_instance)) {
+        instance = hit_instance;
+        // Same ray: the view depth scales with the distance along it.
+        view_depth *= length(frame.camera_position.xyz - hit.position) / max(length(to_camera), 1e-30);
+        position = hit.position;
+        to_camera = frame.camera_position.xyz - position;
+        ng = hit.geometric_normal;
+        ns = hit.shading_normal;
+        front = hit.front_face;
+        material = hit.material;
+        uv = hit.uv;
+    }
+    // View depth = clip w = 1 / gl_FragCoord.w (scaled above for an occluder). The y row of
+    // clip_from_world is the projection's ±1/tan(fov_y/2) times a row of the view rotation (a unit
+    // vector).
     vec3 row_y = vec3(frame.clip_from_world[0][1], frame.clip_from_world[1][1],
                       frame.clip_from_world[2][1]);
     float dist = length(to_camera);
     float cos_view = dist > 0.0 ? dot(ng, to_camera) / dist : 1.0;
-    float footprint = pixel_footprint(1.0 / gl_FragCoord.w, 1.0 / length(row_y),
+    float footprint = pixel_footprint(view_depth, 1.0 / length(row_y),
                                       float(frame.resolution.y), cos_view);
-    o_position = vec4(v_position, 1.0);
+    // The stored point moves a hair toward the camera, into the free space the camera ray came
+    // through: a sample exactly on an edge of a closed object seen from inside (the stiff suite's
+    // `inside_object`, whose image diagonals run along the cube's edges) lies on the plane of the
+    // other face too, and rays from it (offset only along its own face's normal) slipped through
+    // that face at t = 0 and saw the lit room. Relative to the distance and to the position's
+    // magnitude, so it survives f32 rounding at any scale; never more than half the distance.
+    float step_len = min(max(1e-5 * dist, 1e-6 * max(abs(position.x), max(abs(position.y),
+                                                                        abs(position.z)))),
+                         0.5 * dist);
+    position += dist > 0.0 ? to_camera * (step_len / dist) : vec3(0.0);
+    o_position = vec4(position, 1.0);
     o_normal = vec4(ns, footprint);
     o_geometric = vec4(ng, float(material));
-    o_albedo = vec4(material_albedo(material, v_uv), float(pc.instance));
-    o_emission = vec4(material_emission(material, v_uv, front), 0.0);
+    o_albedo = vec4(material_albedo(material, uv), float(instance));
+    o_emission = vec4(material_emission(material, uv, front), 0.0);
 }

@@ -8,6 +8,7 @@ pub mod geometry;
 pub mod ic_fixture;
 pub mod scenes;
 pub mod shader_check;
+pub mod stiff;
 
 use std::path::PathBuf;
 use std::sync::Once;

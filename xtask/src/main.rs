@@ -6,6 +6,7 @@ mod codegen;
 mod refs;
 mod results;
 mod shaders;
+mod stiff;
 mod test;
 
 use std::path::PathBuf;
@@ -26,6 +27,9 @@ Tasks:
   bench pt          path tracer on the Cornell box at 256² and 512²: samples/s and rays/s
   bench scaling     the cache's frame time and records against resolution and triangle count
   bench temporal    an animation with kept records against a per-frame rebuild: rays, time, error, flicker
+  stiff [--size N] [--ref-spp N] [--spp N] [--scenes a,b]
+                    the stiff and extreme suite: every method on furnaces, slits, thin walls,
+                    corners, extreme scales and radiance, degenerate input; writes bench/stiff.md
   help              this text
 
 Benchmarks append their figures to bench/results.csv.
@@ -60,6 +64,7 @@ fn try_main() -> Result<()> {
         }
         ["bench", rest @ ..] => bench::run(rest),
         ["refs", rest @ ..] => refs::run(rest),
+        ["stiff", rest @ ..] => stiff::run(rest),
         [] | ["help"] | ["--help"] | ["-h"] => {
             print!("{HELP}");
             Ok(())

@@ -5,7 +5,10 @@
 //! Writes the five attachments of `shaders/common/gbuffer.glsl` (position, shading normal +
 //! footprint, geometric normal + material, albedo, emission), zero on the background, and clears
 //! the direct-light image. Reads the scene bindings 0–13 (vertex and fragment stages; nothing is
-//! written from the vertex stage).
+//! written from the vertex stage). Each fragment traces one ray query from the camera to itself:
+//! a surface hit before it (rasterization snapped a zero-thickness wall's edge away from the
+//! sample, so the sample sees the floor behind the wall) replaces it, so the G-buffer never holds
+//! a point the camera cannot see (the stiff suite's `two_rooms`).
 
 use bytemuck::{Pod, Zeroable};
 use radcache_vk::{

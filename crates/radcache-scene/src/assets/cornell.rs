@@ -246,6 +246,40 @@ pub fn cornell_builder() -> GltfBuilder {
     b
 }
 
+/// The Cornell box scaled by `scale` about the origin (`scale = 1` gives the same scene as
+/// [`cornell_builder`]): the meshes hang under one node of uniform scale `scale`; the camera's
+/// position, near and far planes are multiplied by `scale` (its view is the same). Used by the
+/// stiff suite's scale-invariance cases.
+pub fn cornell_scaled_builder(scale: f32) -> GltfBuilder {
+    let mut b = GltfBuilder::new();
+    let m = add_materials(&mut b);
+    let mut children = add_room(&mut b, m);
+    let short = add_block(&mut b, "short_block", &SHORT_BLOCK, m.white);
+    children.push(node(&mut b, "short_block", short));
+    let world = b.add_node(&NodeDesc {
+        name: Some("scaled".into()),
+        scale: Some([scale; 3]),
+        children,
+        ..NodeDesc::default()
+    });
+    let cam = b.add_perspective_camera(
+        "camera",
+        CORNELL_YFOV,
+        Some(1.0),
+        0.01 * scale,
+        Some(100.0 * scale),
+    );
+    let camera = b.add_node(&NodeDesc {
+        name: Some("camera".into()),
+        translation: Some(CAMERA_POSITION.map(|c| c * scale)),
+        rotation: Some(yaw(180.0)),
+        camera: Some(cam),
+        ..NodeDesc::default()
+    });
+    b.add_scene("cornell_box", &[world, camera], None);
+    b
+}
+
 /// Writes `dir/cornell/cornell.gltf` (+ `.bin`).
 pub fn write_cornell(dir: &Path) -> Result<PathBuf> {
     write_named(&cornell_builder(), dir, "cornell")

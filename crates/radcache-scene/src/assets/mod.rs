@@ -10,6 +10,7 @@
 
 mod animated;
 mod cornell;
+pub mod stiff;
 
 use std::path::{Path, PathBuf};
 
@@ -19,7 +20,7 @@ use crate::error::{Error, Result};
 use crate::writer::{BufferLayout, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
 
 pub use animated::{animated_builder, write_animated, ANIMATED_DURATION};
-pub use cornell::{cornell_builder, write_cornell, CORNELL_YFOV};
+pub use cornell::{cornell_builder, cornell_scaled_builder, write_cornell, CORNELL_YFOV};
 
 /// Default furnace albedo.
 pub const FURNACE_ALBEDO: f32 = 0.5;

@@ -1,0 +1,123 @@
+//! Furnaces (analytic), the Cornell box at extreme scales, a tiny very bright emitter, and a
+//! grazing view with geometry through the near plane.
+
+use glam::Vec3;
+use serde_json::json;
+
+use super::{camera, mesh_node, rect, StiffCheck, StiffScene};
+use crate::assets::{cornell_scaled_builder, furnace_builder, QuadSoup};
+use crate::writer::{GltfBuilder, MaterialDesc};
+
+/// The furnaces: albedo 0.5, 0.9, 0.99 (analytic) and exactly 1 (unbounded), emission 1.
+pub(super) fn furnaces() -> Vec<StiffScene> {
+    let analytic = |name, albedo: f32| {
+        StiffScene::new(
+            name,
+            "closed box, uniform albedo and emission 1: Le/(1-ρ)",
+            StiffCheck::Analytic(1.0 / (1.0 - albedo)),
+            furnace_builder(albedo, 1.0),
+        )
+    };
+    vec![
+        analytic("furnace_0.5", 0.5),
+        analytic("furnace_0.9", 0.9),
+        analytic("furnace_0.99", 0.99),
+        StiffScene::new(
+            "furnace_1.0",
+            "closed box of albedo exactly 1: the radiance is infinite; output must stay finite",
+            StiffCheck::Unbounded,
+            furnace_builder(1.0, 1.0),
+        ),
+    ]
+}
+
+/// The scale cases, the tiny bright emitter and the grazing view.
+pub(super) fn scenes() -> Vec<StiffScene> {
+    vec![
+        StiffScene::new(
+            "cornell_1",
+            "the Cornell box at scale 1 (the scale cases' reference)",
+            StiffCheck::Reference(None),
+            cornell_scaled_builder(1.0),
+        ),
+        StiffScene::new(
+            "cornell_1e-3",
+            "the Cornell box scaled by 1e-3 (0.55 mm)",
+            StiffCheck::Reference(Some("cornell_1")),
+            cornell_scaled_builder(1e-3),
+        ),
+        StiffScene::new(
+            "cornell_1e4",
+            "the Cornell box scaled by 1e4 (5.5 km)",
+            StiffCheck::Reference(Some("cornell_1")),
+            cornell_scaled_builder(1e4),
+        ),
+        StiffScene::new(
+            "tiny_bright",
+            "a 1 cm emitter of radiance 1e6 in a 4 m room",
+            StiffCheck::Reference(None),
+            tiny_bright(),
+        ),
+        StiffScene::new(
+            "grazing",
+            "a 200 m floor seen from 30 cm under a sky, boxes, a plank through the near plane",
+            StiffCheck::Reference(None),
+            grazing(),
+        ),
+    ]
+}
+
+/// A 4 m × 3 m × 4 m room (albedo 0.5, inward) with a 1 cm × 1 cm emitter of radiance 1e6 just
+/// below the ceiling, facing down; the camera looks across the room.
+fn tiny_bright() -> GltfBuilder {
+    let mut b = GltfBuilder::new();
+    let wall = b.add_material(&MaterialDesc::diffuse("wall", [0.5; 3]));
+    let lamp = b.add_material(&MaterialDesc::emitter("lamp", [0.0; 3], [1e6; 3]));
+    let mut room = QuadSoup::default();
+    room.cuboid(Vec3::new(0.0, 1.5, 0.0), Vec3::new(2.0, 1.5, 2.0), true);
+    let mut light = QuadSoup::default();
+    light.quad(rect(1, 2.99, [-0.005, 0.005], [-0.005, 0.005]), Vec3::NEG_Y);
+    let room = b.add_mesh("room", &[room.primitive(wall)]);
+    let light = b.add_mesh("lamp", &[light.primitive(lamp)]);
+    let nodes = vec![
+        mesh_node(&mut b, "room", room),
+        mesh_node(&mut b, "lamp", light),
+        camera(&mut b, Vec3::new(0.0, 1.6, 1.9), 0.0, -20.0, 75.0, 0.01),
+    ];
+    b.add_scene("tiny_bright", &nodes, None);
+    b
+}
+
+/// A 200 m × 200 m floor (albedo 0.5) under a uniform sky of radiance 1, five 1 m boxes along
+/// the view at 2–40 m, and a plank (0.18 m × 0.06 m × 2 m) from behind the camera into the view,
+/// crossing the near plane (0.05 m). The camera sits 0.3 m above the floor, pitched 5° down.
+fn grazing() -> GltfBuilder {
+    let mut b = GltfBuilder::new();
+    let grey = b.add_material(&MaterialDesc::diffuse("floor", [0.5; 3]));
+    let white = b.add_material(&MaterialDesc::diffuse("box", [0.8, 0.7, 0.6]));
+    let mut floor = QuadSoup::default();
+    floor.quad(rect(1, 0.0, [-100.0, 100.0], [-100.0, 100.0]), Vec3::Y);
+    let mut boxes = QuadSoup::default();
+    for (i, z) in [2.0f32, 5.0, 10.0, 20.0, 40.0].into_iter().enumerate() {
+        let x = if i % 2 == 0 { -0.8 } else { 0.9 };
+        boxes.cuboid(Vec3::new(x, 0.5, -z), Vec3::splat(0.5), false);
+    }
+    boxes.cuboid(
+        Vec3::new(0.11, 0.23, -0.5),
+        Vec3::new(0.09, 0.03, 1.0),
+        false,
+    );
+    let floor = b.add_mesh("floor", &[floor.primitive(grey)]);
+    let boxes = b.add_mesh("boxes", &[boxes.primitive(white)]);
+    let nodes = vec![
+        mesh_node(&mut b, "floor", floor),
+        mesh_node(&mut b, "boxes", boxes),
+        camera(&mut b, Vec3::new(0.0, 0.3, 0.0), 0.0, -5.0, 60.0, 0.05),
+    ];
+    b.add_scene(
+        "grazing",
+        &nodes,
+        Some(json!({"environment": {"radiance": [1.0, 1.0, 1.0]}})),
+    );
+    b
+}
