@@ -282,11 +282,8 @@ fn check_record(
     assert!(!down || r_orig > r_used);
     let up_flag = if up { RECORD_FLAG_CLAMPED_UP } else { 0 };
     let flags = up_flag | if down { RECORD_FLAG_CLAMPED_DOWN } else { 0 };
-    assert_eq!(
-        rec.info[3] & RECORD_FLAGS_MASK & !RECORD_FLAG_FOLDED,
-        flags,
-        "{rec:?}"
-    );
+    let own_flags = rec.info[3] & RECORD_FLAGS_MASK & !RECORD_FLAG_FOLDED;
+    assert_eq!(own_flags, flags, "{rec:?}");
     assert_eq!(rec.info[..3], [q.index(), level, sub_frame]);
     est
 }

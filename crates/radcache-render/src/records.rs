@@ -60,6 +60,17 @@ pub const RECORD_FLAGS_MASK: u32 = 0xff;
 /// Shift of `1 + instance` in `info.w`.
 pub const RECORD_INSTANCE_SHIFT: u32 = 8;
 
+/// The radius of a refreshed record ([`RecordPass::record_refresh`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RefreshRadius {
+    /// As computed, before neighbour clamping (what a new record gets).
+    Free,
+    /// No larger than the record's own `R_orig` (temporal refresh: the radius neighbour clamping
+    /// gave it stays an upper bound, so a refresh never makes a record reach past a neighbour;
+    /// a closer occluder still shrinks it).
+    Capped,
+}
+
 /// Push constants of `record.comp` (48 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -209,8 +220,9 @@ impl RecordPass {
     /// `i` of `requests` (`i < min(counts.y, limits.y)`, dispatched from `counters`) is a record
     /// index; that record is computed again at its own point, normal and footprint, with its own
     /// pixel, level and sub-frame, and the pass seed [`creation_seed`]`(frame_seed, sub-frame)`,
-    /// so under unchanged lighting its irradiance and gradients come out bit for bit as they were
-    /// (its radius comes back before neighbour clamping). Rejected records are left as they are.
+    /// so under unchanged lighting its irradiance and gradients come out bit for bit as they were.
+    /// Its radius comes back before neighbour clamping ([`RefreshRadius::Free`]) or no larger
+    /// than the record's ([`RefreshRadius::Capped`]). Rejected records are left as they are.
     /// `gbuffer` is bound but not read.
     #[allow(clippy::too_many_arguments)]
     pub fn record_refresh(
@@ -222,6 +234,7 @@ impl RecordPass {
         counters: &Buffer,
         records: &Buffer,
         frame_seed: u32,
+        radius: RefreshRadius,
     ) -> Result<()> {
         let io = Io {
             requests,
@@ -229,30 +242,11 @@ impl RecordPass {
             records,
             samples: &self.no_samples,
         };
-        self.record_io(rec, scene, gbuffer, &io, 0, 0, frame_seed, 1)
-    }
-
-    /// As [`RecordPass::record_refresh`], and the new `R_orig` is no larger than the record's
-    /// (temporal refresh: the radius neighbour clamping gave it stays an upper bound, so a
-    /// refresh never makes a record reach past a neighbour; a closer occluder still shrinks it).
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_refresh_capped(
-        &self,
-        rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        requests: &Buffer,
-        counters: &Buffer,
-        records: &Buffer,
-        frame_seed: u32,
-    ) -> Result<()> {
-        let io = Io {
-            requests,
-            counters,
-            records,
-            samples: &self.no_samples,
+        let source = match radius {
+            RefreshRadius::Free => 1,
+            RefreshRadius::Capped => 2,
         };
-        self.record_io(rec, scene, gbuffer, &io, 0, 0, frame_seed, 2)
+        self.record_io(rec, scene, gbuffer, &io, 0, 0, frame_seed, source)
     }
 
     /// As [`RecordPass::record`], and request `i` also writes the samples of its strata,

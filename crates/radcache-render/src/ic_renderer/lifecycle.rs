@@ -9,6 +9,7 @@ use crate::clock::FrameClock;
 use crate::error::{Error, Result};
 use crate::gpu_scene::GpuScene;
 use crate::ic::{IcSettings, IcStats};
+use crate::records::RefreshRadius;
 use crate::temporal::{Lifespans, TemporalPass};
 
 impl IcRenderer {
@@ -34,7 +35,7 @@ impl IcRenderer {
             return Ok(0);
         }
         let mut rec = ctx.begin("ic.refresh")?;
-        self.records.record_refresh_capped(
+        self.records.record_refresh(
             &mut rec,
             gpu,
             &self.gbuffer,
@@ -42,6 +43,7 @@ impl IcRenderer {
             &t.list_counters,
             &self.state.records,
             settings.seed,
+            RefreshRadius::Capped,
         )?;
         clock.submit(ctx, rec)?;
         let rays = self.records.rays()?;
@@ -95,6 +97,7 @@ impl IcRenderer {
             &t.list_counters,
             &t.lookahead,
             settings.seed,
+            RefreshRadius::Free,
         )?;
         let lifespans = Lifespans {
             accuracy: self.params.temporal_accuracy,
