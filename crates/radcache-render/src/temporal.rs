@@ -6,9 +6,10 @@
 //! it is evaluated a second time, with the same rays (deterministic per-record seeds), in the
 //! scene of the next frame ("look-ahead"); the pair gives its temporal gradient `∂E/∂t` and its
 //! lifespan `min(a_t / |τ − 1|, Δt_max)` (`radcache_cache::temporal`), `Δt_max` staggered by
-//! ±20 % per record so refreshes do not come in waves. A living record takes the extrapolated
-//! value `max(0, E(t_i) + age·∂E/∂t)` (exact at age 1: the look-ahead value); an expired one is
-//! recomputed at its own point, with its own seeds, at the start of the frame.
+//! ±20 % per record so refreshes do not come in waves. A living record takes its newest known
+//! value, the look-ahead `E(t_i + 1)` from age 1 on (linear extrapolation `E(t_i) + age·∂E/∂t`
+//! amplifies the look-ahead's noise with age: measured worse, see `temporal.comp`); an expired one
+//! is recomputed at its own point, with its own seeds, at the start of the frame.
 //!
 //! [`crate::IcRenderer`] drives it: [`TemporalPass::record_advance`] at the start of a frame (then
 //! the refresh of the listed records), the cache's hole filling, then
