@@ -69,8 +69,7 @@ layout(push_constant) uniform Push {
     float max_px;          // R⁺ likewise
     float v_scale;         // validity radius / R (IcParams::validity_scale)
     float r_eps_rel;       // r_eps = r_eps_rel × scene scale (frame.camera_position.w)
-    uint source;           // 0: pixel requests (G-buffer); 1: record indices, refreshed in place;
-                           // 2: as 1, the new R_orig no larger than the record's (temporal refresh)
+    uint source;           // 0: pixel requests (G-buffer); 1: record indices, refreshed in place
     uint pad0;
     uint pad1;
     uint pad2;
@@ -80,8 +79,6 @@ layout(push_constant) uniform Push {
 uint g_level_subframe;
 // 1 + its instance, shifted into place (a refreshed record keeps its own).
 uint g_instance_bits = 0u;
-// Upper bound of R_orig (source 2: the record's own, so a refresh never undoes neighbour clamping).
-float g_r_orig_cap = IC_FAR;
 
 // Radiance per stratum as three float arrays (vec3 arrays would pad to 16 bytes: 1728 strata
 // must fit the 32 KiB of shared memory every device offers).
@@ -156,7 +153,7 @@ void main() {
     uint pass_seed = pc.seed;
     GSample g;
     g_level_subframe = pc.level_subframe;
-    if (pc.source != 0u) {
+    if (pc.source == 1u) {
         // Refresh in place: the surface point, normal and footprint are the record's own, and
         // so are its pixel, level and sub-frame, hence its seeds (records.rs creation_seed): under
         // unchanged lighting the refreshed record reproduces its value.
@@ -169,7 +166,6 @@ void main() {
             return;  // a rejected record stays rejected
         }
         g_instance_bits = old.info.w & ~((1u << INSTANCE_SHIFT) - 1u);
-        g_r_orig_cap = pc.source == 2u ? old.normal_rorig.w : IC_FAR;
         pixel_index = old.info.x;
         g_level_subframe = old.info.y | (old.info.z << 16u);
         pass_seed = (pc.seed * 0x9e3779b9u) ^ old.info.z;
@@ -309,7 +305,7 @@ void main() {
     float r_lo, r_hi;
     radius_bounds(g.footprint, pc.min_px, pc.max_px, pc.v_scale, r_lo, r_hi);
     float r_orig, r_used, lo, hi, att;
-    finalize_radius(r_raw, e, gt[0], gt[1], gt[2], g_r_orig_cap, r_lo, r_hi, r_orig, r_used, lo, hi, att);
+    finalize_radius(r_raw, e, gt[0], gt[1], gt[2], IC_FAR, r_lo, r_hi, r_orig, r_used, lo, hi, att);
     flags |= r_orig < lo ? FLAG_CLAMPED_UP : 0u;
     flags |= r_orig > hi ? FLAG_CLAMPED_DOWN : 0u;
 

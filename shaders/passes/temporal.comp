@@ -11,27 +11,30 @@
 //   0 begin     (1 invocation)   empty list
 //   1 advance   (per record)     move adopted records with their instance (point, normals; the
 //                                gradients rotate with the instance's change since the previous
-//                                frame); a living record takes its newest known value, E(t_i + 1)
-//                                = E(t_i) + ∂E/∂t from age 1 on (not the extrapolation
-//                                E(t_i) + age·∂E/∂t: a one-frame difference carries the noise of
-//                                the paths that diverge between the two scenes, and extrapolating
-//                                it over tens of frames raised the animated scene's relMSE by 12 %,
-//                                cargo xtask bench temporal at 128², 32 frames); an expired one is
-//                                listed for refresh;
-//                                with `reclamp` (the camera moved) every record in front of the
-//                                camera takes the [R⁻, R⁺] clamp of its pixel footprint in this
-//                                view, as a record created now would (records kept from a distant
-//                                view would otherwise stay many R⁺ wide on screen)
+//                                frame); a record shows its newest known value E_k (exact at frame
+//                                t_k), carried at most one frame forward at its measured rate; one
+//                                whose E_k is older than its lifespan is listed: it is evaluated
+//                                again one frame ahead, and shows E_k once more this frame; with
+//                                `reclamp` (the camera moved) every record in front of the camera
+//                                takes the [R⁻, R⁺] clamp of its pixel footprint in this view, as a
+//                                record created now would (records kept from a distant view would
+//                                otherwise stay many R⁺ wide on screen)
 //   2 append    (per new record) list records [first, count) and mark them not adopted
-//   3 adopt     (per listed)     store the point and normals in object space (new records) and the
-//                                irradiance at birth, birth frame = this frame
+//   3 adopt     (per listed)     new records: the point and normals in object space, E_k = the
+//                                creation value, t_k = this frame (listed expired records keep theirs)
 //   4 shift     (per listed)     move the copy's point and normals to the instances' current
 //                                transforms (the next frame's, when this runs)
-//   5 finish    (per listed)     ∂E/∂t = E(t_i + 1) − E(t_i) and the lifespan
-//                                min(a_t·Y₀/|Y₁ − Y₀|, Δt_max·(1 ± 20 %)), the stagger hashed
-//                                from the record and its birth (radcache_cache::temporal)
-// A record at age 1 has the exact value E(t_i + 1) (it was evaluated with the same rays), so it
-// is refreshed only once its age exceeds max(lifespan, 1).
+//   5 finish    (per listed)     with E(t + 1) from the record pass on the copy, over the span
+//                                s = t + 1 − t_k: rate (E(t + 1) − E_k)/s, lifespan
+//                                min(s·a_t·Y_k/|Y(t+1) − Y_k|, Δt_max·(1 ± 20 %)) (the stagger
+//                                hashed from the record and the frame; radcache_cache::temporal),
+//                                then E_k = E(t + 1), t_k = t + 1; a recomputed kept record also
+//                                takes its new gradients and its radius if smaller
+// Every evaluation is one frame ahead: a record shows values that were exact at most `lifespan`
+// frames ago (one frame more while its next evaluation is made), and costs one evaluation per
+// refresh. Carrying E_k forward more than one frame at the rate (linear extrapolation, §11.2)
+// measured worse: a difference between two evaluations carries the noise of the paths that
+// diverge between the two scenes (relMSE +12 % on the animated scene with one-frame gradients).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -168,15 +171,16 @@ void main() {
         GpuRecordTemporal tr = temporal[gid];
         if (pc.has_lifespans != 0u && (tr.info.z & ADOPTED) != 0u) {
             move_record(gid, tr);
-            float age = float(pc.frame - tr.info.y);
-            if (age > max(tr.object_position.w, 1.0)) {
+            // The newest known value E_k is exact at frame t_k (info.y) and `age` frames old.
+            float age = float(pc.frame) - float(tr.info.y);
+            if (age >= 1.0 && age > tr.object_position.w) {
                 append(gid);
-            } else {
-                vec3 e0 = tr.birth_irradiance.rgb;
-                // The look-ahead value from age 1 on (see the header).
-                vec3 e = max(e0 + min(age, 1.0) * tr.gradient.rgb, vec3(0.0));
-                records[gid].irradiance.rgb = finite_or(e, e0);
             }
+            // The known value, carried at most one frame forward at the measured rate (see the
+            // header).
+            vec3 ek = tr.birth_irradiance.rgb;
+            vec3 e = max(ek + clamp(age, 0.0, 1.0) * tr.gradient.rgb, vec3(0.0));
+            records[gid].irradiance.rgb = finite_or(e, ek);
         }
         if (pc.reclamp != 0u) {
             reclamp_record(gid);
@@ -214,14 +218,15 @@ void main() {
             tr.object_normal.xyz = to_object_normal(inst, r.normal_rorig.xyz);
             tr.object_geometric.xyz = to_object_normal(inst, ng);
             tr.info.x = bits - 1u;
+            // A new record's known value is its creation value, exact now.
+            tr.object_position.w = 0.0;
+            tr.birth_irradiance = vec4(r.irradiance.rgb, 0.0);
+            tr.gradient = vec4(0.0);
+            tr.info.y = pc.frame;
+            tr.info.z = ADOPTED;
+            temporal[i] = tr;
         }
-        tr.object_position.w = 0.0;
-        tr.birth_irradiance = vec4(r.irradiance.rgb, 0.0);
-        tr.gradient = vec4(0.0);
-        tr.info.y = pc.frame;
-        tr.info.z = ADOPTED;
-        temporal[i] = tr;
-        return;
+        return;  // an expired record keeps its known value until the look-ahead replaces it
     }
     GpuRecordTemporal tr = temporal[i];
     if ((tr.info.z & ADOPTED) == 0u) {
@@ -237,16 +242,37 @@ void main() {
         lookahead[i].grad_r_blue.w = ng.z;
         return;
     }
-    // mode 5
+    // mode 5: the look-ahead value E(t + 1) against the known value E_k of frame t_k.
     vec3 e0 = tr.birth_irradiance.rgb;
     vec3 e1 = finite_or(lookahead[i].irradiance.rgb, e0);
+    float span = max(float(pc.frame + 1u) - float(tr.info.y), 1.0);
     float y0 = max(luminance_rec709(e0), 0.0);
     float y1 = max(luminance_rec709(e1), 0.0);
     float dy = abs(y1 - y0);
-    uint h = ircache_hash(i * 0x9e3779b9u ^ ircache_hash(tr.info.y));
+    uint h = ircache_hash(i * 0x9e3779b9u ^ ircache_hash(pc.frame));
     float max_age = max(pc.max_age, 0.0) * (0.8 + 0.4 * unit_float_from_bits(h));
-    float num = max(pc.accuracy, 0.0) * y0;
+    // Lifespan = span · a_t·Y₀/|Y₁ − Y₀| (the change per frame over the span), at most Δt_max.
+    float num = span * max(pc.accuracy, 0.0) * y0;
     tr.object_position.w = num >= max_age * dy ? max_age : num / dy;
-    tr.gradient = vec4(e1 - e0, y0 > 0.0 ? y1 / y0 : 1.0);
+    tr.gradient = vec4((e1 - e0) / span, span);
+    tr.birth_irradiance = vec4(e1, 0.0);
+    tr.info.y = pc.frame + 1u;
     temporal[i] = tr;
+    if (span > 1.0) {
+        // A kept record recomputed: its newest gradients, and a radius no larger than the one
+        // neighbour clamping left it (a closer occluder may shrink it).
+        GpuRecord a = lookahead[i];
+        GpuRecord r = records[i];
+        r.grad_r_red.xyz = a.grad_r_red.xyz;
+        r.grad_r_green.xyz = a.grad_r_green.xyz;
+        r.grad_r_blue.xyz = a.grad_r_blue.xyz;
+        r.grad_t_red.xyz = a.grad_t_red.xyz;
+        r.grad_t_green.xyz = a.grad_t_green.xyz;
+        r.grad_t_blue.xyz = a.grad_t_blue.xyz;
+        float r_orig = min(r.normal_rorig.w, sanitize_radius(a.normal_rorig.w));
+        r.normal_rorig.w = r_orig;
+        r.position_radius.w = clamp_radius(r_orig, r.bounds.x, r.bounds.y);
+        r.irradiance.w = gradient_attenuation(r_orig, r.bounds.x);
+        records[i] = r;
+    }
 }

@@ -175,12 +175,16 @@ fn records_follow_their_instance_and_only_records_near_the_box_are_refreshed() {
                     "record {i} on the box is {moved} m off its point"
                 );
             }
-            // The lifespan of a record born this frame is the CPU formula's (stagger ±20 %).
-            if tr.info[1] == frame {
-                let (e0, de) = (xyz(tr.birth_irradiance), xyz(tr.gradient));
+            // A record evaluated this frame (new, or expired and evaluated again) now knows its
+            // value at the next frame, E_k, and has the CPU formula's lifespan over the span since
+            // its previous known value (stagger ±20 %).
+            if tr.info[1] == frame + 1 {
+                let (ek, rate, span) = (xyz(tr.birth_irradiance), xyz(tr.gradient), tr.gradient[3]);
                 let life = tr.object_position[3];
                 let max_age = params.max_age_frames;
-                let formula = temporal_lifespan(e0, e0 + de, params.temporal_accuracy, 1e30);
+                let e_prev = ek - rate * span;
+                let formula = span * temporal_lifespan(e_prev, ek, params.temporal_accuracy, 1e30);
+                assert!(span >= 1.0, "record {i}: span {span}");
                 assert!(life <= 1.2 * max_age + 1e-3, "record {i}: lifespan {life}");
                 if life < 0.8 * max_age - 1e-3 {
                     let tol = 1e-3 * formula.max(1.0);
@@ -189,7 +193,7 @@ fn records_follow_their_instance_and_only_records_near_the_box_are_refreshed() {
                     assert!(formula >= 0.8 * max_age * 0.999, "{i}: {life} vs {formula}");
                 }
                 if (i as u64) < stats.records_kept {
-                    // Refreshed in place this frame.
+                    // Expired this frame and evaluated again.
                     near += usize::from(d <= NEAR);
                     far += usize::from(d >= FAR);
                 }

@@ -4,7 +4,7 @@
 //! draws other samples (the comparison can fail) and stays within noise.
 
 use radcache_cache::IcParams;
-use radcache_render::{GBuffer, GpuScene, IcRenderer, IcSettings, RecordPass, RefreshRadius};
+use radcache_render::{GBuffer, GpuScene, IcRenderer, IcSettings, RecordPass};
 use radcache_shared::gpu::{GpuRecord, IcCounters};
 use radcache_tests::scenes::load;
 use radcache_tests::{context, finish, shaders};
@@ -39,7 +39,6 @@ fn refresh(
         &state.counters,
         &state.records,
         seed,
-        RefreshRadius::Free,
     )
     .unwrap();
     ctx.submit(rec).unwrap().wait().unwrap();

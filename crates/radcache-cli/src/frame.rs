@@ -266,7 +266,6 @@ pub fn stats_entry(r: &Rendered, frame: u32, time: f32) -> Value {
         entry["records_evicted"] = json!(ic.records_evicted);
         entry["records_refreshed"] = json!(ic.records_refreshed);
         entry["record_rays"] = json!(ic.record_rays);
-        entry["refresh_rays"] = json!(ic.refresh_rays);
         entry["lookahead_rays"] = json!(ic.lookahead_rays);
         entry["cache_passes"] = json!(ic.cache_passes);
         entry["records_created"] = json!(ic.records_per_level.iter().sum::<u64>());

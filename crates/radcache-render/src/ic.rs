@@ -103,11 +103,10 @@ pub struct IcStats {
     pub record_pass_s: f64,
     /// Ray queries of the record pass (new records, refreshes and look-ahead evaluations).
     pub record_rays: u64,
-    /// Records whose lifespan ended, recomputed in place at the start of the frame.
+    /// Records whose lifespan ended this frame, evaluated again (at their own points, one frame
+    /// ahead) by the look-ahead.
     pub records_refreshed: u64,
-    /// Ray queries of those refreshes (part of `record_rays`).
-    pub refresh_rays: u64,
-    /// Ray queries of the look-ahead evaluations of the frame's new and refreshed records at the
+    /// Ray queries of the look-ahead evaluations of the frame's new and expired records at the
     /// next frame's time (part of `record_rays`).
     pub lookahead_rays: u64,
     /// Wall time of each phase of the frame, s: `pipelines` (creating the passes, [`render_ic`]

@@ -17,9 +17,8 @@
 //!
 //! With `IcSettings::time_step_s` (animated geometry or lights), records also carry temporal
 //! state (`crate::temporal`, steps in `ic_renderer/lifecycle.rs`): the setup moves them with
-//! their instances and extrapolates them in time, expired ones are refreshed in place before the
-//! cache phase, and the frame's new and refreshed records are evaluated once more at the next
-//! frame's time after it.
+//! their instances and lists the expired ones, and after the cache phase the frame's new and
+//! expired records are evaluated (again, at their own points) at the next frame's time.
 
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -238,7 +237,7 @@ impl IcRenderer {
         stats.records_kept = u64::from(self.state.read_counters()?.counts[0]);
         clock.lap("setup");
         let expired = if temporal {
-            self.refresh_expired(ctx, gpu, settings, &mut stats, &mut clock)?
+            self.expired(&mut stats)?
         } else {
             0
         };

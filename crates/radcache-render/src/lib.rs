@@ -55,7 +55,7 @@ pub use records::{
     RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED,
     RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE, RECORD_INSTANCE_SHIFT,
 };
-pub use records::{RecordPass, RefreshRadius, MAX_STRATA, R_EPS_REL};
+pub use records::{RecordPass, MAX_STRATA, R_EPS_REL};
 pub use render::{render_path, Budget, FrameOutput, PathSettings, Progress};
 pub use splat::{SplatPass, SplatScope, SplatWeights};
 pub use temporal::{Lifespans, TemporalPass};

@@ -60,17 +60,6 @@ pub const RECORD_FLAGS_MASK: u32 = 0xff;
 /// Shift of `1 + instance` in `info.w`.
 pub const RECORD_INSTANCE_SHIFT: u32 = 8;
 
-/// The radius of a refreshed record ([`RecordPass::record_refresh`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RefreshRadius {
-    /// As computed, before neighbour clamping (what a new record gets).
-    Free,
-    /// No larger than the record's own `R_orig` (temporal refresh: the radius neighbour clamping
-    /// gave it stays an upper bound, so a refresh never makes a record reach past a neighbour;
-    /// a closer occluder still shrinks it).
-    Capped,
-}
-
 /// Push constants of `record.comp` (48 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -84,8 +73,7 @@ struct Push {
     max_px: f32,
     v_scale: f32,
     r_eps_rel: f32,
-    /// 0: requests are pixels (new records); 1: requests are record indices (refresh in place);
-    /// 2: as 1, `R_orig` capped at the record's own.
+    /// 0: requests are pixels (new records); 1: requests are record indices (refresh in place).
     source: u32,
     pad: [u32; 3],
 }
@@ -220,9 +208,8 @@ impl RecordPass {
     /// `i` of `requests` (`i < min(counts.y, limits.y)`, dispatched from `counters`) is a record
     /// index; that record is computed again at its own point, normal and footprint, with its own
     /// pixel, level and sub-frame, and the pass seed [`creation_seed`]`(frame_seed, sub-frame)`,
-    /// so under unchanged lighting its irradiance and gradients come out bit for bit as they were.
-    /// Its radius comes back before neighbour clamping ([`RefreshRadius::Free`]) or no larger
-    /// than the record's ([`RefreshRadius::Capped`]). Rejected records are left as they are.
+    /// so under unchanged lighting its irradiance and gradients come out bit for bit as they were
+    /// (its radius comes back before neighbour clamping). Rejected records are left as they are.
     /// `gbuffer` is bound but not read.
     #[allow(clippy::too_many_arguments)]
     pub fn record_refresh(
@@ -234,7 +221,6 @@ impl RecordPass {
         counters: &Buffer,
         records: &Buffer,
         frame_seed: u32,
-        radius: RefreshRadius,
     ) -> Result<()> {
         let io = Io {
             requests,
@@ -242,11 +228,7 @@ impl RecordPass {
             records,
             samples: &self.no_samples,
         };
-        let source = match radius {
-            RefreshRadius::Free => 1,
-            RefreshRadius::Capped => 2,
-        };
-        self.record_io(rec, scene, gbuffer, &io, 0, 0, frame_seed, source)
+        self.record_io(rec, scene, gbuffer, &io, 0, 0, frame_seed, 1)
     }
 
     /// As [`RecordPass::record`], and request `i` also writes the samples of its strata,

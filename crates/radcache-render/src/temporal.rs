@@ -297,20 +297,22 @@ impl TemporalPass {
         self.dispatch(rec, scene, state, Mode::Shift, Self::push(0), listed)
     }
 
-    /// Records the temporal gradient and lifespan of every listed record from its value and its
-    /// look-ahead value.
+    /// Records the rate and lifespan of every listed record from its known value and its
+    /// look-ahead value, which becomes its known value for frame `frame + 1`.
+    #[allow(clippy::too_many_arguments)]
     pub fn record_finish(
         &self,
         rec: &mut Recorder,
         scene: &GpuScene,
         state: &IcState,
+        frame: u32,
         listed: u32,
         lifespans: Lifespans,
     ) -> Result<()> {
         let push = Push {
             accuracy: lifespans.accuracy,
             max_age: lifespans.max_age,
-            ..Self::push(0)
+            ..Self::push(frame)
         };
         self.dispatch(rec, scene, state, Mode::Finish, push, listed)
     }

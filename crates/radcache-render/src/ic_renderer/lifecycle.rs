@@ -9,7 +9,6 @@ use crate::clock::FrameClock;
 use crate::error::{Error, Result};
 use crate::gpu_scene::GpuScene;
 use crate::ic::{IcSettings, IcStats};
-use crate::records::RefreshRadius;
 use crate::temporal::{Lifespans, TemporalPass};
 
 impl IcRenderer {
@@ -19,44 +18,16 @@ impl IcRenderer {
         })
     }
 
-    /// Recomputes in place the records the advance listed as expired (at their moved points,
-    /// with their own seeds); returns how many.
-    pub(super) fn refresh_expired(
-        &self,
-        ctx: &Context,
-        gpu: &GpuScene,
-        settings: &IcSettings,
-        stats: &mut IcStats,
-        clock: &mut FrameClock,
-    ) -> Result<u32> {
-        let t = self.temporal_pass()?;
-        let expired = t.listed()?;
-        if expired == 0 {
-            return Ok(0);
-        }
-        let mut rec = ctx.begin("ic.refresh")?;
-        self.records.record_refresh(
-            &mut rec,
-            gpu,
-            &self.gbuffer,
-            &t.list,
-            &t.list_counters,
-            &self.state.records,
-            settings.seed,
-            RefreshRadius::Capped,
-        )?;
-        clock.submit(ctx, rec)?;
-        let rays = self.records.rays()?;
+    /// The records the advance listed as expired (evaluated again by [`Self::look_ahead`]).
+    pub(super) fn expired(&self, stats: &mut IcStats) -> Result<u32> {
+        let expired = self.temporal_pass()?.listed()?;
         stats.records_refreshed = u64::from(expired);
-        stats.refresh_rays += rays;
-        stats.record_rays += rays;
-        clock.lap("refresh");
         Ok(expired)
     }
 
-    /// Makes the frame's new records and the `expired` refreshed ones born now, evaluates them
-    /// again with the scene at `settings.time + settings.time_step_s` and derives their temporal
-    /// gradients and lifespans; the scene is back at the frame's time (and `view`) afterwards.
+    /// Adopts the frame's new records, evaluates them and the `expired` ones (listed by the
+    /// advance) with the scene at `settings.time + settings.time_step_s`, and derives their rates
+    /// and lifespans; the scene is back at the frame's time (and `view`) afterwards.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn look_ahead(
         &self,
@@ -97,13 +68,12 @@ impl IcRenderer {
             &t.list_counters,
             &t.lookahead,
             settings.seed,
-            RefreshRadius::Free,
         )?;
         let lifespans = Lifespans {
             accuracy: self.params.temporal_accuracy,
             max_age: self.params.max_age_frames,
         };
-        t.record_finish(&mut rec, gpu, &self.state, listed, lifespans)?;
+        t.record_finish(&mut rec, gpu, &self.state, frame, listed, lifespans)?;
         clock.submit(ctx, rec)?;
         let rays = self.records.rays()?;
         stats.lookahead_rays += rays;
