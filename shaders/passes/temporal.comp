@@ -1,6 +1,6 @@
 // Temporal radiance caching (IC reference §11.2; crates/radcache-render/src/temporal.rs): records
 // live on their mesh instance, carry the change of their irradiance to the next frame and a
-// lifespan, are extrapolated in time while they live and refreshed in place when they expire.
+// lifespan, and are evaluated again (at their own points, one frame ahead) when they expire.
 //
 // Buffers: the cache's counters (read) and records, the records' temporal state (same index), the
 // list of records to evaluate this frame with its own IcCounters (counts.x = records, counts.y =

@@ -2,18 +2,22 @@
 //! kept across the frames of an animation whose geometry or lights move.
 //!
 //! Every record lives on the mesh instance it was created on (object-space point and normals in
-//! `IcState::temporal`) and follows it. When a record is born (created, or refreshed in place),
-//! it is evaluated a second time, with the same rays (deterministic per-record seeds), in the
-//! scene of the next frame ("look-ahead"); the pair gives its temporal gradient `∂E/∂t` and its
-//! lifespan `min(a_t / |τ − 1|, Δt_max)` (`radcache_cache::temporal`), `Δt_max` staggered by
-//! ±20 % per record so refreshes do not come in waves. A living record takes its newest known
-//! value, the look-ahead `E(t_i + 1)` from age 1 on (linear extrapolation `E(t_i) + age·∂E/∂t`
-//! amplifies the look-ahead's noise with age: measured worse, see `temporal.comp`); an expired one
-//! is recomputed at its own point, with its own seeds, at the start of the frame.
+//! `IcState::temporal`) and follows it. Records are evaluated **one frame ahead**: after the
+//! cache phase of frame t, the frame's new records and the records whose lifespan ended are
+//! evaluated (again), at their own points and with their own rays (deterministic per-record
+//! seeds), in the scene of frame t + 1 ("look-ahead"). Against the record's previous known value
+//! E_k (exact at frame t_k) this gives its rate over the span s = t + 1 − t_k and its lifespan
+//! `min(s · a_t / |τ − 1|, Δt_max)` (τ the luminance ratio; `radcache_cache::temporal`), `Δt_max`
+//! staggered by ±20 % per record so refreshes do not come in waves; the look-ahead value becomes
+//! E_k. A record shows E_k, carried at most one frame forward at its rate (an expired record
+//! shows it once more while its next value is computed). So a refresh costs one evaluation, and a
+//! record whose light changes quickly is evaluated every other frame. Linear extrapolation over
+//! the whole lifespan (§11.2) measured worse: a difference of two evaluations carries the noise of
+//! the paths that diverge between the two scenes.
 //!
-//! [`crate::IcRenderer`] drives it: [`TemporalPass::record_advance`] at the start of a frame (then
-//! the refresh of the listed records), the cache's hole filling, then
-//! [`TemporalPass::record_adopt`] for the frame's new and refreshed records, the look-ahead
+//! [`crate::IcRenderer`] drives it: [`TemporalPass::record_advance`] at the start of a frame (it
+//! also re-clamps kept records' radii when the camera moved), the cache's hole filling, then
+//! [`TemporalPass::record_adopt`] for the frame's new records, the look-ahead
 //! ([`TemporalPass::record_shift`], the record pass on [`TemporalPass::lookahead`],
 //! [`TemporalPass::record_finish`]) with the scene at the next frame's time, and
 //! [`TemporalPass::record_keep_instances`] at the end.

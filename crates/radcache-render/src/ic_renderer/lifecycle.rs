@@ -1,5 +1,5 @@
-//! The temporal steps of [`IcRenderer::render`] (`crate::temporal`): refreshing the records whose
-//! lifespan ended, and the look-ahead evaluation of the frame's new and refreshed records.
+//! The temporal steps of [`IcRenderer::render`] (`crate::temporal`): the records whose lifespan
+//! ended, and the look-ahead evaluation of them and of the frame's new records.
 
 use radcache_scene::{CameraView, Scene};
 use radcache_vk::Context;
