@@ -1,37 +1,16 @@
 //! The `radcache` binary end to end on lavapipe: render with metadata, AOVs and stats; compare
 //! with limits and JSON; info; bad input gives one clear error and no panic.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::PathBuf;
+use std::process::Output;
 
 use radcache_image::read_exr;
 
-fn radcache(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_radcache"))
-        .args(args)
-        .output()
-        .expect("running radcache")
-}
-
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn cornell() -> String {
-    repo()
-        .join("assets/cornell/cornell.gltf")
-        .display()
-        .to_string()
-}
+mod common;
+use common::{cornell, fresh_dir, radcache, text};
 
 fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("radcache-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn text(p: &Path) -> String {
-    p.display().to_string()
+    fresh_dir("cli", name)
 }
 
 fn assert_ok(out: &Output) {

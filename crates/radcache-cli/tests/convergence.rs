@@ -6,26 +6,11 @@
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn radcache(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_radcache"))
-        .args(args)
-        .output()
-        .expect("running radcache")
-}
-
-fn cornell() -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../assets/cornell/cornell.gltf")
-        .display()
-        .to_string()
-}
+mod common;
+use common::{bin, cornell, fresh_path, radcache};
 
 fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("radcache-conv-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    fresh_path("conv", name)
 }
 
 type Row = HashMap<String, String>;
@@ -288,7 +273,7 @@ fn a_missing_scene_is_one_clear_error() {
     );
 
     // A font file that is not a font fails before any rendering, naming the file.
-    let out = Command::new(env!("CARGO_BIN_EXE_radcache"))
+    let out = bin()
         .args(["convergence", &cornell(), "-o", &dir.display().to_string()])
         .env("RADCACHE_FONT", cornell())
         .output()

@@ -3,28 +3,16 @@
 //! input giving one clear error.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use radcache_image::{write_exr, ExrOptions, Image, Layer, Metadata};
 use serde_json::Value;
 
-fn radcache(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_radcache"))
-        .args(args)
-        .output()
-        .expect("running radcache")
-}
+mod common;
+use common::{fresh_dir, radcache, text};
 
 /// A fresh, empty directory for one test.
 fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("radcache-flicker-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn text(p: &Path) -> String {
-    p.display().to_string()
+    fresh_dir("flicker", name)
 }
 
 /// Writes a 2×1 frame with grey pixels `values` and, when given, a depth AOV.

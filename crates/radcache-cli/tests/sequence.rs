@@ -8,24 +8,13 @@ use std::time::{Duration, Instant, SystemTime};
 
 use radcache_image::read_exr;
 
+mod common;
+use common::{bin, cornell, fresh_dir};
+
 const FRAMES: u32 = 10;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_radcache"))
-}
-
-fn cornell() -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../assets/cornell/cornell.gltf")
-        .display()
-        .to_string()
-}
-
 fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("radcache-seq-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    fresh_dir("seq", name)
 }
 
 /// The arguments of a sequence render of the (static) Cornell box into `dir`.
