@@ -2,12 +2,19 @@
 // a handful of jittered sub-frames leaves its edges visibly stepped (all pixels of a sub-frame
 // share one jitter, so the errors along an edge are correlated and survive block averaging).
 // Where a pixel or one of its 8 neighbours saw emission in any sub-frame, the pixel's emission is
-// recomputed from GRID×GRID stratified camera rays over the pixel (the reference's box filter);
+// recomputed from COUNT camera rays over the pixel (the reference's box filter);
 // elsewhere the sub-frames' mean is kept (it is 0 or exact). The result, times the sub-frame
 // count, is added to the frame accumulator, whose mean is the image.
+//
+// The rays form a Hammersley (0,6,2)-net, digitally shifted per pixel: every 8×8 stratum and
+// every 1/64-wide row and column of the pixel holds one ray, so an axis-aligned edge's coverage
+// is exact to 1/64 (a plain 8×8 grid quantises it to 1/8: the Cornell box's light edge was 32 %
+// too bright, 60 % of the default preset's error), and the shift decorrelates neighbouring
+// pixels along an edge.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
+#include "../common/hash.glsl"
 #include "../common/path.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -16,7 +23,8 @@ layout(binding = B_PASS_BASE, std430) buffer Accum { vec4 accum[]; };
 layout(binding = B_PASS_BASE + 1, std430) readonly buffer EmissionAccum { vec4 emission_accum[]; };
 layout(binding = B_PASS_BASE + 2, std430) buffer RayCount { uint ray_count; };
 
-const uint GRID = 8u;
+const uint BITS = 6u;            // 64 rays per pixel
+const uint COUNT = 1u << BITS;
 
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
@@ -37,8 +45,12 @@ void main() {
     vec3 e = own.rgb / subframes;
     if (near_emitter) {
         vec3 sum = vec3(0.0);
-        for (uint k = 0u; k < GRID * GRID; ++k) {
-            vec2 jitter = (vec2(k % GRID, k / GRID) + 0.5) / float(GRID);
+        uint shift = pcg_hash(index ^ pcg_hash(frame.resolution.w));
+        uint shift_x = shift & (COUNT - 1u);
+        uint shift_y = (shift >> 16) & (COUNT - 1u);
+        for (uint k = 0u; k < COUNT; ++k) {
+            uint row = bitfieldReverse(k) >> (32u - BITS);
+            vec2 jitter = (vec2(k ^ shift_x, row ^ shift_y) + 0.5) / float(COUNT);
             Ray r = camera_ray(uvec2(pixel), jitter);
             rays_traced++;
             rayQueryEXT q;
@@ -52,7 +64,7 @@ void main() {
                 sum += material_emission(s.material, s.uv, s.front_face);
             }
         }
-        e = sum / float(GRID * GRID);
+        e = sum / float(COUNT);
         atomicAdd(ray_count, rays_traced);
     }
     if (any(isnan(e)) || any(isinf(e))) {

@@ -14,8 +14,8 @@ fn presets_are_valid_and_ordered() {
     assert_eq!(IcParams::preset(Preset::Default), n);
     assert_eq!(
         (n.strata_m, n.strata_n, n.accuracy, n.kappa),
-        (16, 48, 0.15, 1.0),
-        "§19 starting values"
+        (16, 48, 0.15, 0.5),
+        "§19 starting values; κ measured (params.rs)"
     );
     assert_eq!(
         (
@@ -30,15 +30,18 @@ fn presets_are_valid_and_ordered() {
     assert_eq!((d.strata_m, d.strata_n), (8, 24), "§3.2 interactive");
     assert!(d.sample_count() < n.sample_count() && n.sample_count() < h.sample_count());
     assert!(d.accuracy > n.accuracy && n.accuracy > h.accuracy);
-    assert!(d.kappa < n.kappa && n.kappa < h.kappa);
+    assert!(
+        n.kappa < h.kappa && d.kappa < h.kappa,
+        "high has the smallest zones"
+    );
     assert!(d.max_spacing_px > n.max_spacing_px && n.max_spacing_px > h.max_spacing_px);
 }
 
 #[test]
 fn derived_quantities() {
     let p = IcParams::default();
-    assert_eq!(p.weight_param(), 1.0);
-    assert_eq!(p.validity_scale(), 0.5);
+    assert_eq!(p.weight_param(), 0.5);
+    assert_eq!(p.validity_scale(), 1.0);
     assert_eq!(p.coverage_threshold(), 0.5);
     assert_eq!(
         (

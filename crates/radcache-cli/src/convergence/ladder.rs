@@ -371,13 +371,13 @@ mod tests {
                 "draft",
                 "default",
                 "high",
-                "kappa=0.5",
-                "kappa=2",
+                "kappa=0.25",
+                "kappa=1",
                 "strata 4x12",
                 "strata 8x24"
             ]
         );
-        assert_eq!(tl[3].params.kappa, 0.5);
+        assert_eq!(tl[3].params.kappa, IcParams::default().kappa / 2.0);
         assert_eq!(tl[3].params.accuracy, IcParams::default().accuracy);
         let ward = ic_cases(WeightKind::Ward, false);
         let sweep: Vec<f32> = ward
