@@ -88,6 +88,7 @@ shared float s_lb[MAX_STRATA];
 shared float s_r[MAX_STRATA];
 shared uint s_rays;
 shared uint s_folded;
+shared uint s_next;  // the next stratum no invocation has taken
 
 vec3 stratum_l(uint i) {
     return vec3(s_lr[i], s_lg[i], s_lb[i]);
@@ -215,11 +216,15 @@ void main() {
     if (lid == 0u) {
         s_rays = 0u;
         s_folded = 0u;
+        s_next = GROUP;
     }
     barrier();
 
-    // Path regeneration: an invocation whose path ends starts its next stratum at once, so the
-    // invocations of a SIMD group stay busy although their paths have different lengths.
+    // Path regeneration: an invocation whose path ends takes the next untaken stratum at once, so
+    // the invocations of a SIMD group stay busy although their paths have different lengths and
+    // finish together (with a fixed share of strata per invocation, a group waits for its longest
+    // share; on lavapipe the two measured within noise). A stratum's random numbers come from its
+    // own index, so the record does not depend on which invocation traced what.
     uint i = lid;
     Rng rng;
     PathState st;
@@ -238,7 +243,7 @@ void main() {
             if (dump) {
                 samples[request * count + i] = vec4(l, r);
             }
-            i += GROUP;
+            i = atomicAdd(s_next, 1u);
             if (i < count) {
                 st = begin_stratum(i, n, m, origin, t, b, nn, ng, record_seed, pass_seed, rng);
             }
