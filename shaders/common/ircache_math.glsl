@@ -331,4 +331,17 @@ bool temporal_is_valid(float age, float lifespan) { return age <= lifespan; }
 
 vec3 temporal_extrapolate(vec3 e_t0, vec3 de_dt, float age) { return max(e_t0 + de_dt * max(age, 0.0), vec3(0.0)); }
 
+float moving_cover(vec3 p, vec3 n, vec4 sphere) {
+    vec3 v = sphere.xyz - p;
+    float d = length(v);
+    float r = max(sphere.w, 0.0);
+    if (d <= r) {
+        return r > 0.0 ? 1.0 : 0.0;
+    }
+    float k = r / d;
+    float c = dot(n, v) / d;
+    float f = c >= k ? k * k * c : (c > -k ? 0.25 * k * (c + k) * (c + k) : 0.0);
+    return min(f, 1.0);
+}
+
 #endif // IRCACHE_MATH_GLSL

@@ -5,7 +5,9 @@
 // Buffers: the cache's counters (read) and records, the records' temporal state (same index), the
 // list of records to evaluate this frame with its own IcCounters (counts.x = records, counts.y =
 // listed, dispatch = one workgroup per listed record, as the record pass's refresh reads it),
-// the record copy evaluated at the next frame's time, and the instances of the previous frame.
+// the record copy evaluated at the next frame's time, the instances of the previous frame, and the
+// bounding spheres of the scene's moving instances at the scene's current time (two vec4 each:
+// centre and radius, then the instance index).
 //
 // Modes (push constant `mode`):
 //   0 begin     (1 invocation)   empty list
@@ -13,8 +15,10 @@
 //                                gradients rotate with the instance's change since the previous
 //                                frame); a record shows its newest known value E_k (exact at frame
 //                                t_k), carried at most one frame forward at its measured rate; one
-//                                whose E_k is older than its lifespan is listed: it is evaluated
-//                                again one frame ahead, and shows E_k once more this frame; with
+//                                whose E_k is older than its lifespan, or whose view of the other
+//                                moving instances changed by more than a_t since t_k (below), is
+//                                listed: it is evaluated again one frame ahead, and shows E_k once
+//                                more this frame; with
 //                                `reclamp` (the camera moved) every record in front of the camera
 //                                takes the [R⁻, R⁺] clamp of its pixel footprint in this view, as a
 //                                record created now would (records kept from a distant view would
@@ -28,8 +32,14 @@
 //                                s = t + 1 − t_k: rate (E(t + 1) − E_k)/s, lifespan
 //                                min(s·a_t·Y_k/|Y(t+1) − Y_k|, Δt_max·(1 ± 20 %)) (the stagger
 //                                hashed from the record and the frame; radcache_cache::temporal),
-//                                then E_k = E(t + 1), t_k = t + 1; a recomputed kept record also
-//                                takes its new gradients and its radius if smaller
+//                                then E_k = E(t + 1), t_k = t + 1, and the moving cover at t + 1;
+//                                a recomputed kept record also takes its new gradients and its
+//                                radius if smaller
+// Motion-aware expiry: the lifespan is measured from one frame's change, so it misses what comes
+// later — an object that approaches a record slowly at first. Each record keeps the cover C of
+// the other moving instances at t_k (Σ over their bounding spheres of the cosine-weighted fraction
+// of its hemisphere each covers, radcache_cache::moving_cover) and expires when |C(t) − C_k| > a_t:
+// a change of that fraction of the incident light is what the lifespan allows.
 // Every evaluation is one frame ahead: a record shows values that were exact at most `lifespan`
 // frames ago (one frame more while its next evaluation is made), and costs one evaluation per
 // refresh. Carrying E_k forward more than one frame at the rate (linear extrapolation, §11.2)
@@ -50,6 +60,7 @@ layout(binding = B_PASS_BASE + 3, std430) buffer List { uint list[]; };
 layout(binding = B_PASS_BASE + 4, std430) buffer ListCounters { IcCounters list_counters; };
 layout(binding = B_PASS_BASE + 5, std430) buffer Lookahead { GpuRecord lookahead[]; };
 layout(binding = B_PASS_BASE + 6, std430) readonly buffer Previous { GpuInstance previous[]; };
+layout(binding = B_PASS_BASE + 7, std430) readonly buffer Moving { vec4 moving[]; };
 
 layout(push_constant) uniform Push {
     uint mode;
@@ -64,6 +75,7 @@ layout(push_constant) uniform Push {
     float min_px;        // R⁻ in pixel footprints (IcParams)
     float max_px;        // R⁺
     float v_scale;       // validity radius / R
+    uint moving_count;   // advance, finish: moving instances in `moving`
 } pc;
 
 const uint ADOPTED = 1u;
@@ -78,6 +90,17 @@ vec3 to_world_normal(GpuInstance inst, vec3 n) {
 // Inverse of the normal transform: n_obj ∝ Aᵀ·n_world for A the linear part of world_from_object.
 vec3 to_object_normal(GpuInstance inst, vec3 n) {
     return normalize_or_z(transpose(mat3(inst.world_from_object)) * n);
+}
+
+// The cover of the moving instances other than `own` over the hemisphere of (p, n) (header).
+float cover_of_moving(vec3 p, vec3 n, uint own) {
+    float sum = 0.0;
+    for (uint j = 0u; j < pc.moving_count; ++j) {
+        if (uint(moving[2u * j + 1u].x) != own) {
+            sum += moving_cover(p, n, moving[2u * j]);
+        }
+    }
+    return sum;
 }
 
 vec3 finite_or(vec3 v, vec3 fallback) {
@@ -173,8 +196,13 @@ void main() {
             move_record(gid, tr);
             // The newest known value E_k is exact at frame t_k (info.y) and `age` frames old.
             float age = float(pc.frame) - float(tr.info.y);
-            if (age >= 1.0 && age > tr.object_position.w) {
-                append(gid);
+            if (age >= 1.0) {
+                float cover = cover_of_moving(records[gid].position_radius.xyz,
+                                              records[gid].normal_rorig.xyz, tr.info.x);
+                if (age > tr.object_position.w ||
+                    abs(cover - tr.birth_irradiance.w) > max(pc.accuracy, 0.0)) {
+                    append(gid);
+                }
             }
             // The known value, carried at most one frame forward at the measured rate (see the
             // header).
@@ -255,7 +283,8 @@ void main() {
     float num = span * max(pc.accuracy, 0.0) * y0;
     tr.object_position.w = num >= max_age * dy ? max_age : num / dy;
     tr.gradient = vec4((e1 - e0) / span, span);
-    tr.birth_irradiance = vec4(e1, 0.0);
+    tr.birth_irradiance = vec4(e1, cover_of_moving(lookahead[i].position_radius.xyz,
+                                                   lookahead[i].normal_rorig.xyz, tr.info.x));
     tr.info.y = pc.frame + 1u;
     temporal[i] = tr;
     if (span > 1.0) {

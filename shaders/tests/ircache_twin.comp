@@ -29,6 +29,7 @@ const uint MODE_WEIGHT = 1u;
 const uint MODE_EXTRAPOLATE = 2u;
 const uint MODE_RADIUS = 3u;
 const uint MODE_RECORD = 4u;
+const uint MODE_TEMPORAL = 5u;
 
 float flag(bool b) { return b ? 1.0 : 0.0; }
 uint bits(float x) { return floatBitsToUint(x); }
@@ -169,6 +170,17 @@ void record(Row i, inout Row o) {
     o.v[8] = vec4(flag(irradiance_is_valid(e)), luminance_rec709(e), 0.0, 0.0);
 }
 
+// in: 0 E(t_i); 1 E(t_i + 1); 2 (a_t, Δt_max, age, lifespan); 3 ∂E/∂t; 4 p; 5 n; 6 sphere.
+// out: 0 (temporal_lifespan, temporal_is_valid(age, lifespan), moving_cover, -);
+//      1 temporal_gradient; 2 temporal_extrapolate(E(t_i), ∂E/∂t, age).
+void temporal(Row i, inout Row o) {
+    o.v[0] = vec4(temporal_lifespan(i.v[0].xyz, i.v[1].xyz, i.v[2].x, i.v[2].y),
+                  flag(temporal_is_valid(i.v[2].z, i.v[2].w)),
+                  moving_cover(i.v[4].xyz, i.v[5].xyz, i.v[6]), 0.0);
+    o.v[1] = vec4(temporal_gradient(i.v[0].xyz, i.v[1].xyz), 0.0);
+    o.v[2] = vec4(temporal_extrapolate(i.v[0].xyz, i.v[3].xyz, i.v[2].z), 0.0);
+}
+
 void main() {
     uint id = gl_GlobalInvocationID.x;
     if (id >= pc.count) {
@@ -189,6 +201,8 @@ void main() {
         radius(i, o);
     } else if (pc.mode == MODE_RECORD) {
         record(i, o);
+    } else if (pc.mode == MODE_TEMPORAL) {
+        temporal(i, o);
     }
     outputs[id] = o;
 }

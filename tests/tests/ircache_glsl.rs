@@ -3,8 +3,7 @@
 //! grazing, perpendicular and opposite normals, misses at and beyond `IC_FAR`, zero irradiance,
 //! degenerate normals, an overflowing record). `shaders/tests/ircache_twin.comp` evaluates one
 //! row per invocation; each family below builds the rows and the expected outputs in the
-//! shader's output layout (see the shader for the slots). The temporal formulas (§11) are not
-//! used by any pass yet and are left to `crates/radcache-cache/tests`.
+//! shader's output layout (see the shader for the slots).
 //!
 //! Tolerance: `|gpu − cpu| <= 1e-5 · max(|cpu|, scale) + 1e-6`, where `scale` is the magnitude of
 //! the terms a result is summed from (cancellation: gradients, extrapolation, T&L weights, and
@@ -20,6 +19,7 @@ use radcache_cache::extrapolate::{clamp_extrapolation, extrapolate_irradiance};
 use radcache_cache::radius::*;
 use radcache_cache::record::*;
 use radcache_cache::sampling::*;
+use radcache_cache::temporal::*;
 use radcache_cache::weight::*;
 use radcache_cache::{luminance_rec709, IC_FAR};
 use radcache_tests::{context, finish, shaders, Rng};
@@ -464,6 +464,80 @@ fn records(rng: &mut Rng) -> (Vec<Case>, Vec<[f32; 4]>) {
     (cases, samples)
 }
 
+/// Mode 5: the temporal formulas (lifespan, validity, extrapolation) and the moving cover.
+fn temporal(rng: &mut Rng) -> Vec<Case> {
+    let mut cases = Vec::new();
+    for k in 0..160 {
+        let e0 = match k % 8 {
+            0 => Vec3::ZERO,
+            _ => vec(rng, 1.0) + Vec3::splat(1.2),
+        };
+        let e1 = match k % 8 {
+            1 => e0,
+            2 => Vec3::ZERO,
+            _ => e0 + vec(rng, 0.3),
+        };
+        let (a_t, max_age) = (rng.range(0.01, 0.2), rng.range(1.0, 60.0));
+        let (age, lifespan) = (rng.range(-2.0, 40.0), rng.range(0.0, 40.0));
+        let de = vec(rng, 0.2);
+        let (p, n) = (vec(rng, 2.0), unit(rng));
+        // Spheres around p: inside, above, across and below its horizon, of radius 0.
+        let dir = unit(rng);
+        let d = rng.range(0.05, 3.0);
+        let r = match k % 5 {
+            0 => d * rng.range(1.05, 2.0),
+            1 => 0.0,
+            _ => d * rng.range(0.01, 0.9),
+        };
+        let sphere = (p + dir * d).extend(r);
+        let mut row: Row = [[0.0; 4]; 16];
+        row[0] = v4(e0, 0.0);
+        row[1] = v4(e1, 0.0);
+        row[2] = [a_t, max_age, age, lifespan];
+        row[3] = v4(de, 0.0);
+        row[4] = v4(p, 0.0);
+        row[5] = v4(n, 0.0);
+        row[6] = sphere.to_array();
+        let mut e = Expect::new();
+        // The lifespan's cap is a step: a row within rounding of it is a tie.
+        let (y0, y1) = (luminance_rec709(e0).max(0.0), luminance_rec709(e1).max(0.0));
+        let cap_margin = a_t * y0 - max_age * (y1 - y0).abs();
+        e.f(0, 0, temporal_lifespan(e0, e1, a_t, max_age), max_age);
+        if cap_margin != 0.0 && cap_margin.abs() <= 1e-5 * (a_t * y0).max(1e-6) {
+            e.how[0][0] = How::Tie;
+        }
+        e.b(
+            0,
+            1,
+            temporal_is_valid(age, lifespan),
+            age - lifespan,
+            1e-6 * 40.0,
+        );
+        // The cover is continuous except where p is on the sphere (d = r).
+        let cover = moving_cover(p, n, sphere);
+        e.f(0, 2, cover, 1.0);
+        if r > 0.0 && (d - r).abs() <= 1e-5 * d {
+            e.how[0][2] = How::Tie;
+        }
+        e.v(
+            1,
+            temporal_gradient(e0, e1),
+            e0.max_element().max(e1.max_element()),
+        );
+        e.v(
+            2,
+            temporal_extrapolate(e0, de, age),
+            e0.max_element() + 40.0 * 0.2,
+        );
+        cases.push((row, e));
+    }
+    // The kinds of cover the rows hold.
+    let covers: Vec<f32> = cases.iter().map(|c| c.1.v[0][2]).collect();
+    assert!(covers.iter().any(|&c| c == 1.0) && covers.iter().any(|&c| c == 0.0));
+    assert!(covers.iter().filter(|&&c| c > 0.0 && c < 1.0).count() > 40);
+    cases
+}
+
 #[test]
 fn glsl_twin_matches_the_rust_formulas_on_the_gpu() {
     let ctx = context();
@@ -479,6 +553,7 @@ fn glsl_twin_matches_the_rust_formulas_on_the_gpu() {
     check(&ctx, &pipeline, 3, &radius(&mut rng), &[]);
     let (cases, samples) = records(&mut rng);
     check(&ctx, &pipeline, 4, &cases, &samples);
+    check(&ctx, &pipeline, 5, &temporal(&mut rng), &[]);
     drop(pipeline);
     finish(ctx);
 }

@@ -10,9 +10,14 @@
 //!   ratio is formed: `Y₀ = Y₁` (including both 0) gives `Δt_max`, `Y₀ = 0 < Y₁` gives 0;
 //! * value within the lifespan: `E(t) = max(0, E(t_i) + (t − t_i)·∂E/∂t)`, then the spatial
 //!   extrapolation of §5.6 ([`crate::extrapolate_irradiance`] with this value as `E_i`).
+//!
+//! [`moving_cover`] is this project's addition (not in the spec): the lifespan comes from one
+//! frame's change and misses what comes later (an object that approaches a record slowly at
+//! first), so a record also expires when the part of its hemisphere that moving objects' bounding
+//! spheres cover has changed by more than `a_t` since its last evaluation.
 
 use crate::luminance_rec709;
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 /// Temporal gradient per frame (§11.2 step 3): `E(t_i+1) − E(t_i)`.
 pub fn temporal_gradient(e_t0: Vec3, e_t1: Vec3) -> Vec3 {
@@ -44,4 +49,29 @@ pub fn temporal_is_valid(age: f32, lifespan: f32) -> bool {
 /// `age` clamped to `>= 0`.
 pub fn temporal_extrapolate(e_t0: Vec3, de_dt: Vec3, age: f32) -> Vec3 {
     (e_t0 + de_dt * age.max(0.0)).max(Vec3::ZERO)
+}
+
+/// The cosine-weighted fraction of the hemisphere over `(p, n)` (unit `n`) that the sphere
+/// `(centre, radius)` covers: with `k = r/d = sin α` and `c = cos θ` of the direction to the
+/// centre, exactly `k²·c` when the sphere is wholly above the horizon (`c ≥ k`: its projected
+/// solid angle is `π·sin²α·cos θ`); across the horizon (`|c| < k`) the quadratic `k·(c + k)²/4`,
+/// which meets `k²·c` with the same slope at `c = k` and falls to 0 at `c = −k`; 0 below; 1 with
+/// `p` inside the sphere (0 for a sphere of radius 0); at most 1.
+pub fn moving_cover(p: Vec3, n: Vec3, sphere: Vec4) -> f32 {
+    let v = sphere.truncate() - p;
+    let d = v.length();
+    let r = sphere.w.max(0.0);
+    if d <= r {
+        return if r > 0.0 { 1.0 } else { 0.0 };
+    }
+    let k = r / d;
+    let c = n.dot(v) / d;
+    let f = if c >= k {
+        k * k * c
+    } else if c > -k {
+        0.25 * k * (c + k) * (c + k)
+    } else {
+        0.0
+    };
+    f.min(1.0)
 }

@@ -3,7 +3,7 @@
 mod common;
 
 use common::{Rect, Scene};
-use glam::{DVec3, Quat, Vec3};
+use glam::{DVec3, Quat, Vec3, Vec4};
 use radcache_cache::extrapolate::*;
 use radcache_cache::temporal::*;
 use radcache_cache::EXTRAPOLATION_MAX_FACTOR;
@@ -156,4 +156,82 @@ fn temporal_gradient_lifespan_and_value() {
     let y = |v: Vec3| radcache_cache::luminance_rec709(v);
     let drift = (y(temporal_extrapolate(e0, g, life)) - y(e0)).abs() / y(e0);
     assert!((drift - at).abs() < 1e-4);
+}
+
+/// The cosine-weighted fraction of the hemisphere over (0, +Z) that a sphere covers, by
+/// stratified cosine-weighted directions (the exact answer to `moving_cover`'s question).
+fn covered_fraction(centre: DVec3, r: f64) -> f64 {
+    let side = 400;
+    let mut hit = 0u32;
+    for a in 0..side {
+        for b in 0..side {
+            let (u, v) = (
+                (a as f64 + 0.5) / side as f64,
+                (b as f64 + 0.5) / side as f64,
+            );
+            let (sin_t, phi) = (u.sqrt(), std::f64::consts::TAU * v);
+            let w = DVec3::new(sin_t * phi.cos(), sin_t * phi.sin(), (1.0 - u).sqrt());
+            let t = centre.dot(w);
+            if t > 0.0 && (centre - w * t).length_squared() <= r * r {
+                hit += 1;
+            }
+        }
+    }
+    f64::from(hit) / f64::from(side * side)
+}
+
+#[test]
+fn moving_cover_is_the_covered_share_of_the_cosine_weighted_hemisphere() {
+    let (p, n) = (Vec3::ZERO, Vec3::Z);
+    // Wholly above the horizon: exact (k²·cos θ), checked against the integral.
+    for (dir, d, r) in [
+        (Vec3::Z, 2.0f32, 0.3f32),
+        (Vec3::new(0.6, 0.0, 0.8), 1.0, 0.25),
+        (Vec3::new(0.0, -0.8, 0.6), 3.0, 0.9),
+    ] {
+        let c = dir.normalize() * d;
+        let got = moving_cover(p, n, c.extend(r));
+        let k = r / d;
+        assert!((got - k * k * dir.normalize().z).abs() < 1e-6);
+        let exact = covered_fraction(c.as_dvec3(), f64::from(r));
+        assert!(
+            (f64::from(got) - exact).abs() < 0.02 * exact + 1e-4,
+            "above: {got} against {exact}"
+        );
+    }
+    // Across the horizon: the quadratic is within a third of the integral and continuous.
+    for cos_t in [-0.2f32, 0.0, 0.15, 0.29] {
+        let dir = Vec3::new((1.0 - cos_t * cos_t).sqrt(), 0.0, cos_t);
+        let got = moving_cover(p, n, (dir * 1.0).extend(0.3));
+        let exact = covered_fraction(dir.as_dvec3(), 0.3);
+        assert!(
+            (f64::from(got) - exact).abs() < 0.35 * exact + 2e-3,
+            "across the horizon, cos θ = {cos_t}: {got} against {exact}"
+        );
+    }
+    let at = |c: f32| moving_cover(p, n, Vec3::new((1.0 - c * c).sqrt(), 0.0, c).extend(0.3));
+    assert!(
+        (at(0.3 + 1e-4) - at(0.3 - 1e-4)).abs() < 1e-4,
+        "continuous at c = k"
+    );
+    assert_eq!(at(-0.31), 0.0, "below the horizon");
+    assert_eq!(
+        moving_cover(p, n, Vec4::new(0.1, 0.0, 0.1, 0.5)),
+        1.0,
+        "inside"
+    );
+    assert_eq!(
+        moving_cover(p, n, Vec4::new(0.0, 0.0, 1.0, 0.0)),
+        0.0,
+        "no sphere"
+    );
+    assert_eq!(
+        moving_cover(p, n, Vec4::new(0.0, 0.0, 0.0, 0.0)),
+        0.0,
+        "a point at p"
+    );
+    // Approaching: the cover grows as 1/d².
+    let near = moving_cover(p, n, Vec4::new(0.0, 0.0, 1.0, 0.1));
+    let far = moving_cover(p, n, Vec4::new(0.0, 0.0, 2.0, 0.1));
+    assert!((near / far - 4.0).abs() < 1e-4);
 }

@@ -227,7 +227,8 @@ impl IcRenderer {
             }
             if temporal || view_changed {
                 let reclamp = view_changed.then_some(&self.params);
-                t.record_advance(&mut rec, gpu, &self.state, now, kept, temporal, reclamp)?;
+                let lifespans = temporal.then_some((scene, settings.time, &self.params));
+                t.record_advance(&mut rec, gpu, &self.state, now, kept, lifespans, reclamp)?;
             }
         }
         self.neighbours

@@ -11,7 +11,12 @@
 //! staggered by ±20 % per record so refreshes do not come in waves; the look-ahead value becomes
 //! E_k. A record shows E_k, carried at most one frame forward at its rate (an expired record
 //! shows it once more while its next value is computed). So a refresh costs one evaluation, and a
-//! record whose light changes quickly is evaluated every other frame. Linear extrapolation over
+//! record whose light changes quickly is evaluated every other frame. A lifespan measured from one
+//! frame's change misses a change still to come (an object approaching slowly at first), so a
+//! record also expires when the share of its cosine-weighted hemisphere that the other moving
+//! instances' bounding spheres cover (`radcache_cache::temporal::moving_cover`, summed; the
+//! spheres at the scene's time are written by the host before the advance and the finish) has
+//! changed by more than `a_t` since its last evaluation. Linear extrapolation over
 //! the whole lifespan (§11.2) measured worse: a difference of two evaluations carries the noise of
 //! the paths that diverge between the two scenes.
 //!
@@ -24,6 +29,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use radcache_cache::IcParams;
+use radcache_scene::Scene;
 use radcache_shared::gpu::{GpuInstance, GpuRecord, IcCounters};
 use radcache_vk::{
     vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, MemoryLocation, Pipeline,
@@ -50,6 +56,7 @@ struct Push {
     min_px: f32,
     max_px: f32,
     v_scale: f32,
+    moving_count: u32,
 }
 
 /// The shader's steps.
@@ -64,7 +71,7 @@ enum Mode {
 }
 
 /// The temporal pipeline, the list of records to evaluate this frame, the look-ahead copy of the
-/// records and the previous frame's instances.
+/// records, the previous frame's instances and the moving instances' bounding spheres.
 pub struct TemporalPass {
     pipeline: Pipeline,
     /// Record indices to evaluate this frame (`uint[capacity]`).
@@ -75,6 +82,10 @@ pub struct TemporalPass {
     /// The records evaluated at the next frame's time (same indices as the cache's).
     pub lookahead: Buffer,
     previous: Buffer,
+    /// Two vec4 per moving instance: bounding sphere (centre, radius) at the scene's current
+    /// time, then (instance index, 0, 0, 0) (`temporal.comp`'s motion-aware expiry).
+    moving: Buffer,
+    moving_count: u32,
     has_previous: bool,
     lifespans: bool,
     capacity: u32,
@@ -108,7 +119,7 @@ impl TemporalPass {
         lifespans: bool,
     ) -> Result<TemporalPass> {
         let spirv = shaders.compile("passes/temporal.comp", &scene.defines())?;
-        let pass: Vec<BindingLayout> = (0..7)
+        let pass: Vec<BindingLayout> = (0..8)
             .map(|k| BindingLayout::new(PASS_BASE + k, BindingKind::StorageBuffer))
             .collect();
         let pipeline = Pipeline::compute(
@@ -160,6 +171,13 @@ impl TemporalPass {
                 storage | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuOnly,
             )?,
+            moving: buffer(
+                "temporal.moving_spheres",
+                u64::from(instances.max(1)) * 32,
+                storage,
+                MemoryLocation::CpuToGpu,
+            )?,
+            moving_count: 0,
             has_previous: false,
             lifespans,
             capacity,
@@ -185,10 +203,12 @@ impl TemporalPass {
             (PASS_BASE + 4, Resource::Buffer(&self.list_counters)),
             (PASS_BASE + 5, Resource::Buffer(&self.lookahead)),
             (PASS_BASE + 6, Resource::Buffer(&self.previous)),
+            (PASS_BASE + 7, Resource::Buffer(&self.moving)),
         ]);
         let push = Push {
             mode: mode as u32,
             capacity: self.capacity,
+            moving_count: self.moving_count,
             ..push
         };
         rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
@@ -219,33 +239,63 @@ impl TemporalPass {
             min_px: 0.0,
             max_px: 0.0,
             v_scale: 1.0,
+            moving_count: 0,
         }
     }
 
+    /// Writes the bounding spheres of `scene`'s moving instances at time `t` for the next
+    /// advance or finish (no submission reading them may be in flight).
+    fn write_moving(&mut self, scene: &Scene, t: f32) -> Result<()> {
+        let transforms = scene.instance_transforms(t);
+        let mut spheres: Vec<[f32; 4]> = Vec::new();
+        for (i, (inst, m)) in scene.instances.iter().zip(&transforms).enumerate() {
+            let bounds = scene.meshes[inst.mesh].bounds;
+            if !inst.dynamic || bounds.is_empty() {
+                continue;
+            }
+            let world = bounds.transformed(m);
+            let (centre, radius) = (world.center(), 0.5 * world.size().length());
+            if centre.is_finite() && radius.is_finite() {
+                spheres.push(centre.extend(radius).to_array());
+                spheres.push([i as f32, 0.0, 0.0, 0.0]);
+            }
+        }
+        self.moving_count = (spheres.len() / 2) as u32;
+        if !spheres.is_empty() {
+            self.moving.write(0, &spheres)?;
+        }
+        Ok(())
+    }
+
     /// Records emptying the list, then, over the `records` kept from earlier frames: with
-    /// `lifespans`, moving every record with its instance and extrapolating it to `frame`, or
-    /// listing it when it expired; with `reclamp` (the camera moved), clamping every radius to
+    /// `lifespans` (the scene, the frame's time, the parameters), moving every record with its
+    /// instance and extrapolating it to `frame`, or listing it when it expired (its lifespan
+    /// ended, or the moving instances' cover of it changed by more than `a_t`); with `reclamp` (the camera moved), clamping every radius to
     /// `params`' [R⁻, R⁺] at the record's pixel footprint in the current view. The scene and view
     /// must be the frame's; the neighbour grid must be rebuilt afterwards.
     #[allow(clippy::too_many_arguments)]
     pub fn record_advance(
-        &self,
+        &mut self,
         rec: &mut Recorder,
         scene: &GpuScene,
         state: &IcState,
         frame: u32,
         records: u32,
-        lifespans: bool,
+        lifespans: Option<(&Scene, f32, &IcParams)>,
         reclamp: Option<&IcParams>,
     ) -> Result<()> {
         let push = Self::push(frame);
         self.dispatch(rec, scene, state, Mode::Begin, push, 1)?;
-        if records > 0 && (lifespans || reclamp.is_some()) {
+        if records > 0 && (lifespans.is_some() || reclamp.is_some()) {
             let mut push = Push {
                 has_previous: u32::from(self.has_previous),
-                has_lifespans: u32::from(lifespans),
+                has_lifespans: u32::from(lifespans.is_some()),
                 ..push
             };
+            if let Some((source, time, params)) = lifespans {
+                self.write_moving(source, time)?;
+                push.accuracy = params.temporal_accuracy;
+            }
             if let Some(p) = reclamp {
                 push.reclamp = 1;
                 push.min_px = p.min_spacing_px;
@@ -302,17 +352,20 @@ impl TemporalPass {
     }
 
     /// Records the rate and lifespan of every listed record from its known value and its
-    /// look-ahead value, which becomes its known value for frame `frame + 1`.
+    /// look-ahead value, which becomes its known value for frame `frame + 1`, and its cover by
+    /// the moving instances of `next` (the scene, at the next frame's time).
     #[allow(clippy::too_many_arguments)]
     pub fn record_finish(
-        &self,
+        &mut self,
         rec: &mut Recorder,
         scene: &GpuScene,
         state: &IcState,
         frame: u32,
         listed: u32,
         lifespans: Lifespans,
+        next: (&Scene, f32),
     ) -> Result<()> {
+        self.write_moving(next.0, next.1)?;
         let push = Push {
             accuracy: lifespans.accuracy,
             max_age: lifespans.max_age,

@@ -13,9 +13,7 @@ use crate::temporal::{Lifespans, TemporalPass};
 
 impl IcRenderer {
     fn temporal_pass(&self) -> Result<&TemporalPass> {
-        self.temporal.as_ref().ok_or_else(|| {
-            Error::Invalid("temporal caching needs a renderer created with a time step".into())
-        })
+        self.temporal.as_ref().ok_or_else(no_time_step)
     }
 
     /// The records the advance listed as expired (evaluated again by [`Self::look_ahead`]).
@@ -30,7 +28,7 @@ impl IcRenderer {
     /// and lifespans; the scene is back at the frame's time (and `view`) afterwards.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn look_ahead(
-        &self,
+        &mut self,
         ctx: &Context,
         scene: &Scene,
         gpu: &mut GpuScene,
@@ -40,7 +38,7 @@ impl IcRenderer {
         stats: &mut IcStats,
         clock: &mut FrameClock,
     ) -> Result<()> {
-        let t = self.temporal_pass()?;
+        let t = self.temporal.as_mut().ok_or_else(no_time_step)?;
         let count = self.state.read_counters()?.counts[0];
         let first = stats.records_kept as u32;
         let listed = expired
@@ -73,7 +71,8 @@ impl IcRenderer {
             accuracy: self.params.temporal_accuracy,
             max_age: self.params.max_age_frames,
         };
-        t.record_finish(&mut rec, gpu, &self.state, frame, listed, lifespans)?;
+        let next = (scene, settings.time + settings.time_step_s);
+        t.record_finish(&mut rec, gpu, &self.state, frame, listed, lifespans, next)?;
         clock.submit(ctx, rec)?;
         let rays = self.records.rays()?;
         stats.lookahead_rays += rays;
@@ -87,4 +86,8 @@ impl IcRenderer {
         clock.lap("lookahead");
         Ok(())
     }
+}
+
+fn no_time_step() -> Error {
+    Error::Invalid("temporal caching needs a renderer created with a time step".into())
 }
