@@ -533,7 +533,7 @@ fn temporal(rng: &mut Rng) -> Vec<Case> {
     }
     // The kinds of cover the rows hold.
     let covers: Vec<f32> = cases.iter().map(|c| c.1.v[0][2]).collect();
-    assert!(covers.iter().any(|&c| c == 1.0) && covers.iter().any(|&c| c == 0.0));
+    assert!(covers.contains(&1.0) && covers.contains(&0.0));
     assert!(covers.iter().filter(|&&c| c > 0.0 && c < 1.0).count() > 40);
     cases
 }
