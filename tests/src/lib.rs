@@ -9,6 +9,7 @@ pub mod ic_fixture;
 pub mod scenes;
 pub mod shader_check;
 pub mod stiff;
+pub mod twin;
 
 use std::path::PathBuf;
 use std::sync::Once;

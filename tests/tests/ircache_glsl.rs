@@ -13,7 +13,6 @@
 //! or a step (Ward's threshold, the lifespan's cap) whose CPU margin is within rounding of its
 //! threshold (a random row on a tie) is not compared; such ties are counted and must stay rare.
 
-use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use radcache_cache::extrapolate::{clamp_extrapolation, extrapolate_irradiance};
 use radcache_cache::radius::*;
@@ -22,147 +21,9 @@ use radcache_cache::sampling::*;
 use radcache_cache::temporal::*;
 use radcache_cache::weight::*;
 use radcache_cache::{luminance_rec709, IC_FAR};
+use radcache_tests::twin::{check, ub, unit, v4, vec, Case, Expect, How, Row};
 use radcache_tests::{context, finish, shaders, Rng};
-use radcache_vk::{vk, Access, BindingKind, BindingLayout, Context, Pipeline, Resource};
-
-type Row = [[f32; 4]; 16];
-/// A row of inputs and its expected outputs.
-type Case = (Row, Expect);
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct Push {
-    mode: u32,
-    count: u32,
-}
-
-/// How one output lane is compared.
-#[derive(Clone, Copy, Debug)]
-enum How {
-    Unused,
-    Tie,
-    Exact,
-    Near(f32),
-}
-
-/// Expected outputs of one row.
-#[derive(Clone, Copy)]
-struct Expect {
-    v: Row,
-    how: [[How; 4]; 16],
-}
-
-impl Expect {
-    fn new() -> Self {
-        Expect {
-            v: [[0.0; 4]; 16],
-            how: [[How::Unused; 4]; 16],
-        }
-    }
-
-    /// Lane `lane` of slot `slot`, within the tolerance for terms of size `scale`.
-    fn f(&mut self, slot: usize, lane: usize, x: f32, scale: f32) {
-        self.v[slot][lane] = x;
-        self.how[slot][lane] = How::Near(scale);
-    }
-
-    /// A whole slot of four values, like [`Expect::f`].
-    fn s(&mut self, slot: usize, x: [f32; 4], scale: f32) {
-        for (lane, x) in x.into_iter().enumerate() {
-            self.f(slot, lane, x, scale);
-        }
-    }
-
-    fn v(&mut self, slot: usize, x: Vec3, scale: f32) {
-        for c in 0..3 {
-            self.f(slot, c, x[c], scale);
-        }
-    }
-
-    fn exact(&mut self, slot: usize, lane: usize, x: f32) {
-        self.v[slot][lane] = x;
-        self.how[slot][lane] = How::Exact;
-    }
-
-    /// A boolean (0/1), or a tie when its CPU `margin` is non-zero but within `resolution`.
-    fn b(&mut self, slot: usize, lane: usize, x: bool, margin: f32, resolution: f32) {
-        self.exact(slot, lane, if x { 1.0 } else { 0.0 });
-        if margin != 0.0 && margin.abs() <= resolution {
-            self.how[slot][lane] = How::Tie;
-        }
-    }
-}
-
-fn v4(v: Vec3, w: f32) -> [f32; 4] {
-    [v.x, v.y, v.z, w]
-}
-
-fn ub(u: u32) -> f32 {
-    f32::from_bits(u)
-}
-
-fn unit(rng: &mut Rng) -> Vec3 {
-    loop {
-        let v = vec(rng, 1.0);
-        if v.length_squared() > 0.01 && v.length_squared() <= 1.0 {
-            return v.normalize();
-        }
-    }
-}
-
-fn vec(rng: &mut Rng, s: f32) -> Vec3 {
-    Vec3::new(rng.range(-s, s), rng.range(-s, s), rng.range(-s, s))
-}
-
-/// Runs one family through the twin shader in `mode` and compares every expected lane.
-fn check(ctx: &Context, pl: &Pipeline, mode: u32, cases: &[Case], samples: &[[f32; 4]]) {
-    let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-    let rows: Vec<Row> = cases.iter().map(|c| c.0).collect();
-    let inputs = ctx.create_buffer_init("twin.in", storage, &rows).unwrap();
-    let samples = [samples, &[[0.0; 4]]].concat();
-    let samples = ctx.create_buffer_init("twin.s", storage, &samples).unwrap();
-    let outputs = ctx.create_buffer_init("twin.out", storage, &rows).unwrap();
-    let count = rows.len() as u32;
-    let mut rec = ctx.begin("twin").unwrap();
-    rec.pass("ircache_twin", |rec| {
-        rec.bind_pipeline(pl);
-        rec.push_bindings(&[
-            (0, Resource::Buffer(&inputs)),
-            (1, Resource::Buffer(&outputs)),
-            (2, Resource::Buffer(&samples)),
-        ]);
-        rec.push_constants(&Push { mode, count });
-        rec.dispatch(count.div_ceil(64), 1, 1)
-    })
-    .unwrap();
-    rec.barrier(Access::COMPUTE_WRITE, Access::TRANSFER_READ);
-    ctx.submit(rec).unwrap().wait().unwrap();
-    let out: Vec<Row> = ctx.read_buffer(&outputs, rows.len()).unwrap();
-    let (mut failures, mut compared, mut ties) = (Vec::new(), 0usize, 0usize);
-    for (r, ((_, e), o)) in cases.iter().zip(&out).enumerate() {
-        for (slot, lane) in (0..16).flat_map(|s| (0..4).map(move |l| (s, l))) {
-            let (gpu, cpu) = (o[slot][lane], e.v[slot][lane]);
-            let ok = match e.how[slot][lane] {
-                How::Unused => continue,
-                How::Tie => {
-                    ties += 1;
-                    continue;
-                }
-                How::Exact => gpu.to_bits() == cpu.to_bits(),
-                How::Near(s) => gpu == cpu || (gpu - cpu).abs() <= 1e-5 * cpu.abs().max(s) + 1e-6,
-            };
-            compared += 1;
-            if !ok {
-                let (how, at) = (e.how[slot][lane], format!("row {r} out[{slot}][{lane}]"));
-                failures.push(format!("{at}: GPU {gpu:e}, CPU {cpu:e} ({how:?})"));
-            }
-        }
-    }
-    eprintln!("mode {mode}: {compared} values compared, {ties} ties skipped");
-    assert!(compared > 0 && ties * 50 <= compared, "{ties} ties");
-    let shown = failures[..failures.len().min(25)].join("\n");
-    assert!(failures.is_empty(), "mode {mode}:\n{shown}");
-}
+use radcache_vk::{BindingKind, BindingLayout, Pipeline};
 
 /// Mode 0: sampling, stratum coefficients and the frame.
 fn sampling(rng: &mut Rng) -> Vec<Case> {
