@@ -9,7 +9,7 @@
 // The rays form a Hammersley (0,6,2)-net, digitally shifted per pixel: every 8×8 stratum and
 // every 1/64-wide row and column of the pixel holds one ray, so an axis-aligned edge's coverage
 // is exact to 1/64 (a plain 8×8 grid quantises it to 1/8: the Cornell box's light edge was 32 %
-// too bright, 60 % of the default preset's error), and the shift decorrelates neighbouring
+// too bright, 28 % of the default preset's own error), and the shift decorrelates neighbouring
 // pixels along an edge.
 #version 460
 #extension GL_GOOGLE_include_directive : require
