@@ -197,10 +197,14 @@ void main() {
             // The newest known value E_k is exact at frame t_k (info.y) and `age` frames old.
             float age = float(pc.frame) - float(tr.info.y);
             if (age >= 1.0) {
-                float cover = cover_of_moving(records[gid].position_radius.xyz,
-                                              records[gid].normal_rorig.xyz, tr.info.x);
-                if (age > tr.object_position.w ||
-                    abs(cover - tr.birth_irradiance.w) > max(pc.accuracy, 0.0)) {
+                // Expired by age, else by a change of the moving instances' cover.
+                bool expired = age > tr.object_position.w;
+                if (!expired) {
+                    float cover = cover_of_moving(records[gid].position_radius.xyz,
+                                                  records[gid].normal_rorig.xyz, tr.info.x);
+                    expired = abs(cover - tr.birth_irradiance.w) > max(pc.accuracy, 0.0);
+                }
+                if (expired) {
                     append(gid);
                 }
             }

@@ -270,9 +270,10 @@ impl TemporalPass {
     /// Records emptying the list, then, over the `records` kept from earlier frames: with
     /// `lifespans` (the scene, the frame's time, the parameters), moving every record with its
     /// instance and extrapolating it to `frame`, or listing it when it expired (its lifespan
-    /// ended, or the moving instances' cover of it changed by more than `a_t`); with `reclamp` (the camera moved), clamping every radius to
-    /// `params`' [R⁻, R⁺] at the record's pixel footprint in the current view. The scene and view
-    /// must be the frame's; the neighbour grid must be rebuilt afterwards.
+    /// ended, or the moving instances' cover of it changed by more than `a_t`); with `reclamp`
+    /// (the camera moved), clamping every radius to `params`' [R⁻, R⁺] at the record's pixel
+    /// footprint in the current view. The scene and view must be the frame's; the neighbour grid
+    /// must be rebuilt afterwards.
     #[allow(clippy::too_many_arguments)]
     pub fn record_advance(
         &mut self,
