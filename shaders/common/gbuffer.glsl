@@ -1,5 +1,5 @@
-// The irradiance cache's G-buffer as compute and fragment passes read it: storage images at
-// B_PASS_BASE + 0..5 (see crates/radcache-render/src/gbuffer.rs, which owns the layout).
+// common/gbuffer.glsl: the G-buffer of crates/radcache-render/src/passes/gbuffer.rs as compute
+// and fragment passes read it: storage images at B_GBUFFER_* (crates/radcache-render/src/bindings.rs).
 //
 //   +0 position   xyz world position of the first hit; w = 1 on a surface, 0 on the background
 //   +1 normal     xyz unit shading normal, turned toward the camera; w = pixel footprint (world
@@ -10,24 +10,22 @@
 //   +4 emission   rgb radiance emitted toward the camera (front/back rule applied); w = 0
 //   +5 direct     rgb direct light reflected toward the camera (albedo/π × NEE, MIS); w = 0
 //
-// Pass-specific resources start at B_GBUFFER_END.
+// Pass-specific resources start at B_GBUFFER_END (generated with the rest).
 #ifndef RADCACHE_GBUFFER_GLSL
 #define RADCACHE_GBUFFER_GLSL
 
 #include "../shared/bindings.glsl"
 
-#define B_GBUFFER_END (B_PASS_BASE + 6)
-
 #ifndef GBUFFER_DIRECT_ACCESS
 #define GBUFFER_DIRECT_ACCESS readonly
 #endif
 
-layout(binding = B_PASS_BASE + 0, rgba32f) readonly uniform image2D g_position;
-layout(binding = B_PASS_BASE + 1, rgba32f) readonly uniform image2D g_normal;
-layout(binding = B_PASS_BASE + 2, rgba32f) readonly uniform image2D g_geometric;
-layout(binding = B_PASS_BASE + 3, rgba32f) readonly uniform image2D g_albedo;
-layout(binding = B_PASS_BASE + 4, rgba32f) readonly uniform image2D g_emission;
-layout(binding = B_PASS_BASE + 5, rgba32f) GBUFFER_DIRECT_ACCESS uniform image2D g_direct;
+layout(binding = B_GBUFFER_POSITION, rgba32f) readonly uniform image2D g_position;
+layout(binding = B_GBUFFER_NORMAL, rgba32f) readonly uniform image2D g_normal;
+layout(binding = B_GBUFFER_GEOMETRIC, rgba32f) readonly uniform image2D g_geometric;
+layout(binding = B_GBUFFER_ALBEDO, rgba32f) readonly uniform image2D g_albedo;
+layout(binding = B_GBUFFER_EMISSION, rgba32f) readonly uniform image2D g_emission;
+layout(binding = B_GBUFFER_DIRECT, rgba32f) GBUFFER_DIRECT_ACCESS uniform image2D g_direct;
 
 struct GSample {
     bool surface;

@@ -14,15 +14,10 @@
 #ifndef IRCACHE_MATH_GLSL
 #define IRCACHE_MATH_GLSL
 
-const float IC_FAR = 1.0e30;
-const float R_FLOOR = 1.0e-20;
-const float WARD_MIN_ERROR = 1.0e-3;
-const float TL_NORMAL_SCALE = 0.12325641;
-const float KAPPA_MIN = 1.0e-3;
-const float ELEVATION_MIN_SIN2 = 0.03015369;
-const float EXTRAPOLATION_MAX_FACTOR = 4.0;
-const uint WEIGHT_WARD = 0u;
-const uint WEIGHT_TL = 1u;
+// IC_FAR, R_FLOOR, WARD_MIN_ERROR, TL_NORMAL_SCALE, KAPPA_MIN, ELEVATION_MIN_SIN2,
+// EXTRAPOLATION_MAX_FACTOR, WEIGHT_WARD, WEIGHT_TL: declared once in Rust (radcache_shared::consts).
+#include "../shared/constants.glsl"
+
 const float IC_PI = 3.14159265358979;
 const float IC_TAU = 6.28318530717959;
 

@@ -9,9 +9,9 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = B_PASS_BASE, std430) writeonly buffer Albedo { vec4 albedo_out[]; };
-layout(binding = B_PASS_BASE + 1, std430) writeonly buffer Normal { vec4 normal_out[]; };
-layout(binding = B_PASS_BASE + 2, std430) writeonly buffer Depth { float depth_out[]; };
+layout(binding = B_AOV_ALBEDO, std430) writeonly buffer Albedo { vec4 albedo_out[]; };
+layout(binding = B_AOV_NORMAL, std430) writeonly buffer Normal { vec4 normal_out[]; };
+layout(binding = B_AOV_DEPTH, std430) writeonly buffer Depth { float depth_out[]; };
 
 const uint GRID = 4u;
 

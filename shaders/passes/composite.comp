@@ -9,22 +9,19 @@
 
 #include "../common/path.glsl"
 #include "../common/gbuffer.glsl"
+#include "../shared/push.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = B_GBUFFER_END, rgba32f) readonly uniform image2D splat_sum;
-layout(binding = B_GBUFFER_END + 1, std430) buffer Accum { vec4 accum[]; };
-layout(binding = B_GBUFFER_END + 2, std430) buffer Bad { uint nonfinite; };
-layout(binding = B_GBUFFER_END + 3, std430) buffer EmissionAccum { vec4 emission_accum[]; };
+layout(binding = B_COMPOSITE_SPLAT_SUM, rgba32f) readonly uniform image2D splat_sum;
+layout(binding = B_COMPOSITE_ACCUM, std430) buffer Accum { vec4 accum[]; };
+layout(binding = B_COMPOSITE_NONFINITE, std430) buffer Bad { uint nonfinite; };
+layout(binding = B_COMPOSITE_EMISSION_ACCUM, std430) buffer EmissionAccum { vec4 emission_accum[]; };
 // Debug AOVs, two vec4 per pixel: indirect radiance (rgb) and Σw (a); records per pixel (x).
-layout(binding = B_GBUFFER_END + 4, std430) buffer DebugAccum { vec4 debug_accum[]; };
-layout(binding = B_GBUFFER_END + 5, r32f) readonly uniform image2D splat_count;
+layout(binding = B_COMPOSITE_DEBUG_ACCUM, std430) buffer DebugAccum { vec4 debug_accum[]; };
+layout(binding = B_COMPOSITE_SPLAT_COUNT, r32f) readonly uniform image2D splat_count;
 
-layout(push_constant) uniform Push {
-    vec2 jitter;
-    uint debug;  // accumulate the debug AOVs
-    uint pad1;
-} pc;
+layout(push_constant) uniform Push { CompositePush pc; };
 
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);

@@ -16,17 +16,13 @@
 #define GBUFFER_DIRECT_ACCESS writeonly
 #include "../common/path.glsl"
 #include "../common/gbuffer.glsl"
+#include "../shared/push.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = B_GBUFFER_END, std430) buffer RayCount { uint ray_count; };
+layout(binding = B_DIRECT_RAY_COUNT, std430) buffer RayCount { uint ray_count; };
 
-layout(push_constant) uniform Push {
-    uint samples;
-    uint seed;
-    uint first_sample;
-    uint pad;
-} pc;
+layout(push_constant) uniform Push { DirectPush pc; };
 
 const float ONE_MINUS_EPS = 0.99999994;
 

@@ -19,9 +19,9 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = B_PASS_BASE, std430) buffer Accum { vec4 accum[]; };
-layout(binding = B_PASS_BASE + 1, std430) readonly buffer EmissionAccum { vec4 emission_accum[]; };
-layout(binding = B_PASS_BASE + 2, std430) buffer RayCount { uint ray_count; };
+layout(binding = B_EMISSION_ACCUM, std430) buffer Accum { vec4 accum[]; };
+layout(binding = B_EMISSION_EMISSION_ACCUM, std430) readonly buffer EmissionAccum { vec4 emission_accum[]; };
+layout(binding = B_EMISSION_RAY_COUNT, std430) buffer RayCount { uint ray_count; };
 
 const uint BITS = 6u;            // 64 rays per pixel
 const uint COUNT = 1u << BITS;

@@ -1,9 +1,7 @@
-// Push constants of the G-buffer rasterization.
+// passes/gbuffer_push.glsl: included by gbuffer.vert and gbuffer.frag (crates/radcache-render/src/passes/gbuffer.rs).
+// The push constants of the G-buffer rasterization (`GBufferPush`, generated from Rust).
 #ifndef RADCACHE_GBUFFER_PUSH_GLSL
 #define RADCACHE_GBUFFER_PUSH_GLSL
-layout(push_constant) uniform Push {
-    uint instance;  // custom index of the drawn instance
-    uint pad;
-    vec2 jitter;    // sub-pixel offset in pixels
-} pc;
+#include "../shared/push.glsl"
+layout(push_constant) uniform Push { GBufferPush pc; };
 #endif

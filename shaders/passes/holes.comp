@@ -8,19 +8,15 @@
 #include "../shared/layouts.glsl"
 #include "../common/gbuffer.glsl"
 #include "../common/hash.glsl"
+#include "../shared/push.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = B_GBUFFER_END, rgba32f) readonly uniform image2D splat_sum;
-layout(binding = B_GBUFFER_END + 1, std430) buffer Requests { uint requests[]; };
-layout(binding = B_GBUFFER_END + 2, std430) buffer Counters { IcCounters counters; };
+layout(binding = B_HOLES_SPLAT_SUM, rgba32f) readonly uniform image2D splat_sum;
+layout(binding = B_HOLES_REQUESTS, std430) buffer Requests { uint requests[]; };
+layout(binding = B_HOLES_COUNTERS, std430) buffer Counters { IcCounters counters; };
 
-layout(push_constant) uniform Push {
-    uint spacing;
-    float threshold;
-    uint seed;
-    uint count_only;
-} pc;
+layout(push_constant) uniform Push { HolesPush pc; };
 
 void main() {
     ivec2 size = imageSize(g_position);
@@ -50,14 +46,14 @@ void main() {
     if (holes == 0u) {
         return;
     }
-    atomicAdd(counters.counts.w, holes);
+    atomicAdd(counters.holes, holes);
     if (pc.count_only != 0u) {
         return;
     }
-    uint slot = atomicAdd(counters.counts.y, 1u);
-    if (slot < counters.limits.y) {
+    uint slot = atomicAdd(counters.requested, 1u);
+    if (slot < counters.request_capacity) {
         requests[slot] = best_pixel;
     } else {
-        atomicAdd(counters.limits.z, 1u);
+        atomicAdd(counters.dropped_requests, 1u);
     }
 }

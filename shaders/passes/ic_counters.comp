@@ -1,48 +1,51 @@
 // Bookkeeping of the irradiance cache's counters and indirect arguments (one invocation), so the
 // host never reads counts back to size the next dispatch or draw:
-//   mode 0  reset: no records, no requests (capacities from the push constants)
-//   mode 1  begin level: no requests, hole count 0
-//   mode 2  begin batch: record_base = record_count; dispatch = one workgroup per request that fits
-//   mode 3  end batch: record_count += dispatched; the splat draw covers every record, the batch
-//           draw the batch's records
+//   COUNTERS_RESET        no records, no requests (capacities from the push constants)
+//   COUNTERS_BEGIN_LEVEL  no requests, hole count 0
+//   COUNTERS_BEGIN_BATCH  batch_first = record_count; dispatch = one workgroup per request that fits
+//   COUNTERS_END_BATCH    record_count += dispatched; the splat draw covers every record, the batch
+//                         draw the batch's records
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
 #include "../shared/layouts.glsl"
 #include "../shared/bindings.glsl"
+#include "../shared/constants.glsl"
+#include "../shared/push.glsl"
 
 layout(local_size_x = 1) in;
 
-layout(binding = B_PASS_BASE, std430) buffer Counters { IcCounters counters; };
+layout(binding = B_IC_COUNTERS_COUNTERS, std430) buffer Counters { IcCounters counters; };
 
-layout(push_constant) uniform Push {
-    uint mode;
-    uint record_capacity;
-    uint request_capacity;
-    uint pad;
-} pc;
+layout(push_constant) uniform Push { IcCountersPush pc; };
 
 void main() {
-    if (pc.mode == 0u) {
-        counters.counts = uvec4(0u);
-        counters.dispatch = uvec4(0u, 1u, 1u, 0u);
-        counters.draw = uvec4(6u, 0u, 0u, 0u);
-        counters.limits = uvec4(pc.record_capacity, pc.request_capacity, 0u, 0u);
-        counters.batch_draw = uvec4(6u, 0u, 0u, 0u);
-    } else if (pc.mode == 1u) {
-        counters.counts.y = 0u;
-        counters.counts.w = 0u;
-    } else if (pc.mode == 2u) {
-        uint room = counters.limits.x - min(counters.counts.x, counters.limits.x);
-        uint requested = min(counters.counts.y, counters.limits.y);
+    if (pc.step == COUNTERS_RESET) {
+        counters.record_count = 0u;
+        counters.requested = 0u;
+        counters.batch_first = 0u;
+        counters.holes = 0u;
+        counters.dispatch = DispatchArgs(0u, 1u, 1u, 0u);
+        counters.draw = DrawArgs(QUAD_VERTICES, 0u, 0u, 0u);
+        counters.record_capacity = pc.record_capacity;
+        counters.request_capacity = pc.request_capacity;
+        counters.dropped_requests = 0u;
+        counters.rejected_records = 0u;
+        counters.batch_draw = DrawArgs(QUAD_VERTICES, 0u, 0u, 0u);
+    } else if (pc.step == COUNTERS_BEGIN_LEVEL) {
+        counters.requested = 0u;
+        counters.holes = 0u;
+    } else if (pc.step == COUNTERS_BEGIN_BATCH) {
+        uint room = counters.record_capacity - min(counters.record_count, counters.record_capacity);
+        uint requested = min(counters.requested, counters.request_capacity);
         uint n = min(requested, room);
-        counters.limits.z += requested - n;
-        counters.counts.z = counters.counts.x;
-        counters.dispatch = uvec4(n, 1u, 1u, 0u);
-        counters.batch_draw = uvec4(6u, 0u, 0u, 0u);
-    } else {
-        counters.counts.x += counters.dispatch.x;
-        counters.draw = uvec4(6u, counters.counts.x, 0u, 0u);
-        counters.batch_draw = uvec4(6u, counters.dispatch.x, 0u, counters.counts.z);
+        counters.dropped_requests += requested - n;
+        counters.batch_first = counters.record_count;
+        counters.dispatch = DispatchArgs(n, 1u, 1u, 0u);
+        counters.batch_draw = DrawArgs(QUAD_VERTICES, 0u, 0u, 0u);
+    } else if (pc.step == COUNTERS_END_BATCH) {
+        counters.record_count += counters.dispatch.x;
+        counters.draw = DrawArgs(QUAD_VERTICES, counters.record_count, 0u, 0u);
+        counters.batch_draw = DrawArgs(QUAD_VERTICES, counters.dispatch.x, 0u, counters.batch_first);
     }
 }

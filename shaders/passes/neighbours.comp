@@ -28,30 +28,24 @@
 #include "../shared/layouts.glsl"
 #include "../shared/bindings.glsl"
 #include "../common/ircache_math.glsl"
+#include "../shared/push.glsl"
 
 layout(local_size_x = 64) in;
 
-layout(binding = B_PASS_BASE, std430) readonly buffer Counters { IcCounters counters; };
-layout(binding = B_PASS_BASE + 1, std430) buffer Records { GpuRecord records[]; };
+layout(binding = B_NEIGHBOURS_COUNTERS, std430) readonly buffer Counters { IcCounters counters; };
+layout(binding = B_NEIGHBOURS_RECORDS, std430) buffer Records { GpuRecord records[]; };
 // The same buffer as 32-bit words, for the atomic minimum on R_orig (word 7 of 44 per record).
-layout(binding = B_PASS_BASE + 2, std430) buffer RecordWords { uint record_words[]; };
+layout(binding = B_NEIGHBOURS_RECORD_WORDS, std430) buffer RecordWords { uint record_words[]; };
 // Bucket heads: 1 + entry of the list's first entry, 0 = empty. Length a power of two.
-layout(binding = B_PASS_BASE + 3, std430) buffer Heads { uint heads[]; };
+layout(binding = B_NEIGHBOURS_HEADS, std430) buffer Heads { uint heads[]; };
 // Per entry: 1 + the next entry, 0 = end of the list.
-layout(binding = B_PASS_BASE + 4, std430) buffer Next { uint next_entry[]; };
+layout(binding = B_NEIGHBOURS_NEXT, std430) buffer Next { uint next_entry[]; };
 
-layout(push_constant) uniform Push {
-    uint mode;
-    int level_max;
-    uint pad0;
-    uint pad1;
-} pc;
+layout(push_constant) uniform Push { NeighboursPush pc; };
 
-const uint RECORD_WORDS = 44u;
-const uint R_ORIG_WORD = 7u;
-const int LEVELS = 12;           // neighbours.rs GRID_LEVELS
-const uint SLOTS = 13u;          // 1 + LEVELS entries per record
-const uint MAX_LIST = 4096u;     // guard against a corrupted list; never reached in practice
+// GPU_RECORD_WORDS, GPU_RECORD_R_ORIG_WORD, GRID_LEVELS, GRID_SLOTS (1 + GRID_LEVELS entries per
+// record) and GRID_MAX_LIST (a guard against a corrupted list) come from constants.glsl.
+const int LEVELS = int(GRID_LEVELS);
 
 int level_base() { return pc.level_max - LEVELS + 1; }
 
@@ -75,7 +69,7 @@ uint bucket(uint table, int level, ivec3 cell) {
 }
 
 void insert(uint j, uint slot, uint table, int level) {
-    uint e = j * SLOTS + slot;
+    uint e = j * GRID_SLOTS + slot;
     uint b = bucket(table, level, cell_of(records[j].position_radius.xyz, level));
     next_entry[e] = atomicExchange(heads[b], e + 1u);
 }
@@ -97,13 +91,13 @@ shared float group_min[64];
 
 void main() {
     uint lid = gl_LocalInvocationID.x;
-    uint count = counters.counts.x;
-    uint base = counters.counts.z;
+    uint count = counters.record_count;
+    uint base = counters.batch_first;
     uint batch_end = min(base + counters.dispatch.x, count);
-    if (pc.mode == 0u) {
+    if (pc.step == NEIGHBOURS_INSERT_OLD) {
         uint j = gl_GlobalInvocationID.x;
         if (j < count && (j < base || j >= batch_end)) {
-            for (uint s = 0u; s < SLOTS; ++s) {
+            for (uint s = 0u; s < GRID_SLOTS; ++s) {
                 insert_slot(j, s);
             }
         }
@@ -113,19 +107,19 @@ void main() {
     if (i >= batch_end) {
         return;
     }
-    if (pc.mode == 1u) {
+    if (pc.step == NEIGHBOURS_INSERT_BATCH) {
         if (lid == 0u) {
             float hi = sanitize_radius(records[i].bounds.y);
-            atomicMin(record_words[i * RECORD_WORDS + R_ORIG_WORD], floatBitsToUint(hi));
+            atomicMin(record_words[i * GPU_RECORD_WORDS + GPU_RECORD_R_ORIG_WORD], floatBitsToUint(hi));
         }
-        if (lid < SLOTS) {
+        if (lid < GRID_SLOTS) {
             insert_slot(i, lid);
         }
         return;
     }
 
     vec3 p_i = records[i].position_radius.xyz;
-    float r_i = sanitize_radius(uintBitsToFloat(record_words[i * RECORD_WORDS + R_ORIG_WORD]));
+    float r_i = sanitize_radius(uintBitsToFloat(record_words[i * GPU_RECORD_WORDS + GPU_RECORD_R_ORIG_WORD]));
     int own = record_level(i);
     uint items = uint(pc.level_max - own + 1) * 27u;
     float local_min = IC_FAR;
@@ -136,11 +130,11 @@ void main() {
         uint table = level == own ? 1u : 0u;
         uint want_slot = table == 1u ? uint(1 + level - level_base()) : 0u;
         uint e1 = heads[bucket(table, level, cell)];
-        for (uint steps = 0u; e1 != 0u && steps < MAX_LIST; ++steps) {
+        for (uint steps = 0u; e1 != 0u && steps < GRID_MAX_LIST; ++steps) {
             uint e = e1 - 1u;
             e1 = next_entry[e];
-            uint j = e / SLOTS;
-            if (e % SLOTS != want_slot || j == i || j >= count) {
+            uint j = e / GRID_SLOTS;
+            if (e % GRID_SLOTS != want_slot || j == i || j >= count) {
                 continue;
             }
             if (table == 0u && record_level(j) != level) {
@@ -148,11 +142,11 @@ void main() {
             }
             float d = distance(p_i, records[j].position_radius.xyz);
             float r_j =
-                sanitize_radius(uintBitsToFloat(record_words[j * RECORD_WORDS + R_ORIG_WORD]));
+                sanitize_radius(uintBitsToFloat(record_words[j * GPU_RECORD_WORDS + GPU_RECORD_R_ORIG_WORD]));
             local_min = min(local_min, neighbour_clamp(IC_FAR, r_j, d));
             float shrunk = neighbour_clamp(r_j, r_i, d);
             if (shrunk < r_j) {
-                atomicMin(record_words[j * RECORD_WORDS + R_ORIG_WORD], floatBitsToUint(shrunk));
+                atomicMin(record_words[j * GPU_RECORD_WORDS + GPU_RECORD_R_ORIG_WORD], floatBitsToUint(shrunk));
             }
         }
     }
@@ -165,6 +159,6 @@ void main() {
         barrier();
     }
     if (lid == 0u && group_min[0] < r_i) {
-        atomicMin(record_words[i * RECORD_WORDS + R_ORIG_WORD], floatBitsToUint(group_min[0]));
+        atomicMin(record_words[i * GPU_RECORD_WORDS + GPU_RECORD_R_ORIG_WORD], floatBitsToUint(group_min[0]));
     }
 }

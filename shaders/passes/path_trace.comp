@@ -9,26 +9,22 @@
 #extension GL_GOOGLE_include_directive : require
 
 #include "../common/path.glsl"
+#include "../shared/push.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = B_PASS_BASE, std430) buffer Accum {
+layout(binding = B_PATH_TRACE_ACCUM, std430) buffer Accum {
     vec4 accum[];  // per pixel: Kahan sum (rgb), sample count (a)
 };
-layout(binding = B_PASS_BASE + 1, std430) buffer Compensation {
+layout(binding = B_PATH_TRACE_COMPENSATION, std430) buffer Compensation {
     vec4 compensation[];  // per pixel: Kahan compensation (rgb)
 };
 
-layout(binding = B_PASS_BASE + 2, std430) buffer RayCount {
+layout(binding = B_PATH_TRACE_RAY_COUNT, std430) buffer RayCount {
     uint ray_count;  // ray queries issued by this dispatch (cleared by the host per submission)
 };
 
-layout(push_constant) uniform Push {
-    uint sample_start;
-    uint sample_count;
-    uint pad0;
-    uint pad1;
-} pc;
+layout(push_constant) uniform Push { PathTracePush pc; };
 
 void main() {
     uvec2 pixel = gl_GlobalInvocationID.xy;

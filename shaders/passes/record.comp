@@ -1,8 +1,8 @@
 // Irradiance records (IC reference §3, §4, §6, §7, §16): one workgroup per requested pixel,
 // dispatched indirectly from IcCounters.dispatch (crates/radcache-render/src/records.rs).
 //
-// Request i (gl_WorkGroupID.x) exists when i < min(counts.y, limits.y); it creates record
-// counts.z + i, or, past the record capacity limits.x, is dropped and counted in limits.z.
+// Request i (gl_WorkGroupID.x) exists when i < min(requested, request_capacity); it creates
+// record batch_first + i, or, past record_capacity, is dropped and counted in dropped_requests.
 //
 // Gather (§3.1, §3.3): the M×N stratified cosine-weighted directions (stratum_direction_local with
 // the deterministic jitter stratum_jitter(record_seed, j·N + k), record_seed = ircache_hash(pixel ^
@@ -29,7 +29,7 @@
 // Guards (§16): irradiance that is not storable (irradiance_is_valid) or a requested pixel without
 // a surface gives a REJECTED record: E = 0, no gradients, zero normal (every weight's normal test
 // fails), R_orig = IC_FAR (it clamps no neighbour) and R⁻ = R⁺ = R_FLOOR (its splat is empty);
-// it is flagged and counted in limits.w. No field is ever NaN or Inf.
+// it is flagged and counted in rejected_records. No field is ever NaN or Inf.
 //
 // Optional sample dump (tests): when the buffer bound at B_GBUFFER_END + 4 holds at least
 // (i + 1)·M·N vec4, request i writes (L_jk, r_jk) of its strata at i·M·N + j·N + k.
@@ -39,41 +39,21 @@
 #include "../common/path.glsl"
 #include "../common/gbuffer.glsl"
 #include "../common/ircache_math.glsl"
+#include "../shared/push.glsl"
 
-#define MAX_STRATA 1728u
-#define GROUP 64u
+// info.w: flags (RECORD_FLAGS_MASK, the RECORD_FLAG_* of constants.glsl) and 1 + the record's
+// mesh instance (from bit RECORD_INSTANCE_SHIFT up; 0 for a rejected record). MAX_STRATA and
+// RECORD_GROUP (invocations per record) come from constants.glsl too.
 
-// info.w: flags (low 8 bits, records.rs RECORD_FLAG_*) and 1 + the record's mesh instance
-// (bits 8 and up, RECORD_INSTANCE_SHIFT; 0 for a rejected record).
-const uint INSTANCE_SHIFT = 8u;
-const uint FLAG_INVALID_IRRADIANCE = 1u;
-const uint FLAG_NO_SURFACE = 2u;
-const uint FLAG_CLAMPED_UP = 4u;
-const uint FLAG_CLAMPED_DOWN = 8u;
-const uint FLAG_FOLDED = 16u;
+layout(local_size_x = RECORD_GROUP) in;
 
-layout(local_size_x = 64) in;
+layout(binding = B_RECORD_REQUESTS, std430) readonly buffer Requests { uint requests[]; };
+layout(binding = B_RECORD_COUNTERS, std430) buffer Counters { IcCounters counters; };
+layout(binding = B_RECORD_RECORDS, std430) buffer Records { GpuRecord records[]; };
+layout(binding = B_RECORD_RAY_COUNT, std430) buffer RayCount { uint ray_count; };
+layout(binding = B_RECORD_SAMPLES, std430) writeonly buffer Samples { vec4 samples[]; };
 
-layout(binding = B_GBUFFER_END, std430) readonly buffer Requests { uint requests[]; };
-layout(binding = B_GBUFFER_END + 1, std430) buffer Counters { IcCounters counters; };
-layout(binding = B_GBUFFER_END + 2, std430) buffer Records { GpuRecord records[]; };
-layout(binding = B_GBUFFER_END + 3, std430) buffer RayCount { uint ray_count; };
-layout(binding = B_GBUFFER_END + 4, std430) writeonly buffer Samples { vec4 samples[]; };
-
-layout(push_constant) uniform Push {
-    uint m;
-    uint n;
-    uint seed;
-    uint level_subframe;   // level (low 16 bits), sub-frame (high 16 bits)
-    float min_px;          // R⁻ as a validity radius in pixel footprints
-    float max_px;          // R⁺ likewise
-    float v_scale;         // validity radius / R (IcParams::validity_scale)
-    float r_eps_rel;       // r_eps = r_eps_rel × scene scale (frame.camera_position.w)
-    uint source;           // 0: pixel requests (G-buffer); 1: record indices, refreshed in place
-    uint pad0;
-    uint pad1;
-    uint pad2;
-} pc;
+layout(push_constant) uniform Push { RecordPush pc; };
 
 // Level and sub-frame of the record being written (a refreshed record keeps its own).
 uint g_level_subframe;
@@ -102,7 +82,7 @@ uvec4 record_info_instance(uint pixel_index, uint flags) {
     return record_info(pixel_index, flags | g_instance_bits);
 }
 
-// A record that can never weigh anything (see the header), counted in limits.w.
+// A record that can never weigh anything (see the header), counted in rejected_records.
 void write_rejected(uint index, vec3 position, float footprint, uint pixel_index, uint flags) {
     GpuRecord rec;
     rec.position_radius = vec4(position, R_FLOOR);
@@ -117,7 +97,7 @@ void write_rejected(uint index, vec3 position, float footprint, uint pixel_index
     rec.grad_t_blue = vec4(0.0);
     rec.info = record_info(pixel_index, flags);
     records[index] = rec;
-    atomicAdd(counters.limits.w, 1u);
+    atomicAdd(counters.rejected_records, 1u);
 }
 
 // Stratum i's gather path: its direction (folded above the geometric surface when the shading
@@ -146,7 +126,7 @@ void main() {
     uint lid = gl_LocalInvocationID.x;
     uint request = gl_WorkGroupID.x;
     // Everything up to the barrier is uniform over the workgroup.
-    if (request >= min(counters.counts.y, counters.limits.y)) {
+    if (request >= min(counters.requested, counters.request_capacity)) {
         return;
     }
     uint index;
@@ -154,32 +134,32 @@ void main() {
     uint pass_seed = pc.seed;
     GSample g;
     g_level_subframe = pc.level_subframe;
-    if (pc.source == 1u) {
+    if (pc.source == RECORD_SOURCE_RECORDS) {
         // Refresh in place: the surface point, normal and footprint are the record's own, and
-        // so are its pixel, level and sub-frame, hence its seeds (records.rs creation_seed): under
+        // so are its pixel, level and sub-frame, hence its seeds (creation_seed, passes/record.rs): under
         // unchanged lighting the refreshed record reproduces its value.
         index = requests[request];
-        if (index >= counters.counts.x) {
+        if (index >= counters.record_count) {
             return;
         }
         GpuRecord old = records[index];
         if (dot(old.normal_rorig.xyz, old.normal_rorig.xyz) == 0.0) {
             return;  // a rejected record stays rejected
         }
-        g_instance_bits = old.info.w & ~((1u << INSTANCE_SHIFT) - 1u);
+        g_instance_bits = old.info.w & ~RECORD_FLAGS_MASK;
         pixel_index = old.info.x;
         g_level_subframe = old.info.y | (old.info.z << 16u);
-        pass_seed = (pc.seed * 0x9e3779b9u) ^ old.info.z;
+        pass_seed = (pc.seed * SEED_SUB_FRAME_MUL) ^ old.info.z;
         g.surface = true;
         g.position = old.position_radius.xyz;
         g.normal = old.normal_rorig.xyz;
         g.geometric = vec3(old.grad_r_red.w, old.grad_r_green.w, old.grad_r_blue.w);
         g.footprint = old.bounds.z;
     } else {
-        index = counters.counts.z + request;
-        if (index >= counters.limits.x) {
+        index = counters.batch_first + request;
+        if (index >= counters.record_capacity) {
             if (lid == 0u) {
-                atomicAdd(counters.limits.z, 1u);
+                atomicAdd(counters.dropped_requests, 1u);
             }
             return;
         }
@@ -189,15 +169,15 @@ void main() {
         uint row = pixel_index / width;
         if (row >= uint(max(size.y, 0))) {
             if (lid == 0u) {
-                write_rejected(index, vec3(0.0), 0.0, pixel_index, FLAG_NO_SURFACE);
+                write_rejected(index, vec3(0.0), 0.0, pixel_index, RECORD_FLAG_NO_SURFACE);
             }
             return;
         }
         g = gbuffer_load(ivec2(pixel_index % width, row));
-        g_instance_bits = (g.instance + 1u) << INSTANCE_SHIFT;
+        g_instance_bits = (g.instance + 1u) << RECORD_INSTANCE_SHIFT;
         if (!g.surface) {
             if (lid == 0u) {
-                write_rejected(index, g.position, g.footprint, pixel_index, FLAG_NO_SURFACE);
+                write_rejected(index, g.position, g.footprint, pixel_index, RECORD_FLAG_NO_SURFACE);
             }
             return;
         }
@@ -300,9 +280,9 @@ void main() {
         }
     }
     vec3 e = sum_l * stratum_projected_solid_angle(m, n);
-    uint flags = s_folded != 0u ? FLAG_FOLDED : 0u;
+    uint flags = s_folded != 0u ? RECORD_FLAG_FOLDED : 0u;
     if (!irradiance_is_valid(e)) {
-        write_rejected(index, g.position, g.footprint, pixel_index, flags | FLAG_INVALID_IRRADIANCE);
+        write_rejected(index, g.position, g.footprint, pixel_index, flags | RECORD_FLAG_INVALID_IRRADIANCE);
         return;
     }
 
@@ -313,8 +293,8 @@ void main() {
     radius_bounds(g.footprint, pc.min_px, pc.max_px, pc.v_scale, r_lo, r_hi);
     float r_orig, r_used, lo, hi, att;
     finalize_radius(r_raw, e, gt[0], gt[1], gt[2], IC_FAR, r_lo, r_hi, r_orig, r_used, lo, hi, att);
-    flags |= r_orig < lo ? FLAG_CLAMPED_UP : 0u;
-    flags |= r_orig > hi ? FLAG_CLAMPED_DOWN : 0u;
+    flags |= r_orig < lo ? RECORD_FLAG_CLAMPED_UP : 0u;
+    flags |= r_orig > hi ? RECORD_FLAG_CLAMPED_DOWN : 0u;
 
     GpuRecord rec;
     rec.position_radius = vec4(g.position, r_used);

@@ -2,21 +2,14 @@
 #ifndef RADCACHE_SPLAT_COMMON_GLSL
 #define RADCACHE_SPLAT_COMMON_GLSL
 
-layout(binding = B_FRAME) uniform Frame { FrameConstants frame; };
-layout(binding = B_GBUFFER_END, std430) readonly buffer Records { GpuRecord records[]; };
-// Per record: the last frame in which it weighed on a pixel (eviction, ic_state.rs).
-layout(binding = B_GBUFFER_END + 1, std430) buffer LastUsed { uint last_used[]; };
+#include "../shared/push.glsl"
 
-layout(push_constant) uniform Push {
-    uint kind;           // WEIGHT_WARD or WEIGHT_TL
-    float param;         // a (Ward) or κ (T&L)
-    float w_min;         // weights at or below this are rejected
-    float front_tol_px;  // in-front tolerance, in pixel footprints
-    uint mark_frame;     // written to last_used of every record that weighs (0: none)
-    uint pad0;
-    uint pad1;
-    uint pad2;
-} pc;
+layout(binding = B_FRAME) uniform Frame { FrameConstants frame; };
+layout(binding = B_SPLAT_RECORDS, std430) readonly buffer Records { GpuRecord records[]; };
+// Per record: the last frame in which it weighed on a pixel (eviction, crates/radcache-render/src/state.rs).
+layout(binding = B_SPLAT_LAST_USED, std430) buffer LastUsed { uint last_used[]; };
+
+layout(push_constant) uniform Push { SplatWeights pc; };
 
 // The radius the weight uses: R_orig (shrunk by neighbour clamping after creation) clamped to
 // the record's own [R⁻, R⁺].

@@ -3,13 +3,13 @@
 // lifespan, and are evaluated again (at their own points, one frame ahead) when they expire.
 //
 // Buffers: the cache's counters (read) and records, the records' temporal state (same index), the
-// list of records to evaluate this frame with its own IcCounters (counts.x = records, counts.y =
+// list of records to evaluate this frame with its own IcCounters (record_count = records, requested =
 // listed, dispatch = one workgroup per listed record, as the record pass's refresh reads it),
 // the record copy evaluated at the next frame's time, the instances of the previous frame, and the
 // bounding spheres of the scene's moving instances at the scene's current time (two vec4 each:
 // centre and radius, then the instance index).
 //
-// Modes (push constant `mode`):
+// Steps (push constant `step`, TEMPORAL_* of constants.glsl):
 //   0 begin     (1 invocation)   empty list
 //   1 advance   (per record)     move adopted records with their instance (point, normals; the
 //                                gradients rotate with the instance's change since the previous
@@ -50,36 +50,21 @@
 
 #include "../common/scene.glsl"
 #include "../common/ircache_math.glsl"
+#include "../shared/push.glsl"
 
 layout(local_size_x = 64) in;
 
-layout(binding = B_PASS_BASE, std430) readonly buffer Counters { IcCounters counters; };
-layout(binding = B_PASS_BASE + 1, std430) buffer Records { GpuRecord records[]; };
-layout(binding = B_PASS_BASE + 2, std430) buffer Temporal { GpuRecordTemporal temporal[]; };
-layout(binding = B_PASS_BASE + 3, std430) buffer List { uint list[]; };
-layout(binding = B_PASS_BASE + 4, std430) buffer ListCounters { IcCounters list_counters; };
-layout(binding = B_PASS_BASE + 5, std430) buffer Lookahead { GpuRecord lookahead[]; };
-layout(binding = B_PASS_BASE + 6, std430) readonly buffer Previous { GpuInstance previous[]; };
-layout(binding = B_PASS_BASE + 7, std430) readonly buffer Moving { vec4 moving[]; };
+layout(binding = B_TEMPORAL_COUNTERS, std430) readonly buffer Counters { IcCounters counters; };
+layout(binding = B_TEMPORAL_RECORDS, std430) buffer Records { GpuRecord records[]; };
+layout(binding = B_TEMPORAL_TEMPORAL, std430) buffer Temporal { GpuRecordTemporal temporal[]; };
+layout(binding = B_TEMPORAL_LIST, std430) buffer List { uint list[]; };
+layout(binding = B_TEMPORAL_LIST_COUNTERS, std430) buffer ListCounters { IcCounters list_counters; };
+layout(binding = B_TEMPORAL_LOOKAHEAD, std430) buffer Lookahead { GpuRecord lookahead[]; };
+layout(binding = B_TEMPORAL_PREVIOUS, std430) readonly buffer Previous { GpuInstance previous[]; };
+layout(binding = B_TEMPORAL_MOVING, std430) readonly buffer Moving { vec4 moving[]; };
 
-layout(push_constant) uniform Push {
-    uint mode;
-    uint frame;          // this frame's number (birth frames count in it)
-    uint first;          // append: first new record
-    uint has_previous;   // advance: `previous` holds the instances of the frame before
-    uint has_lifespans;  // advance: records carry temporal state (a time step was given)
-    float accuracy;      // a_t
-    float max_age;       // Δt_max in frames
-    uint capacity;       // list capacity
-    uint reclamp;        // advance: clamp radii to this view's footprints
-    float min_px;        // R⁻ in pixel footprints (IcParams)
-    float max_px;        // R⁺
-    float v_scale;       // validity radius / R
-    uint moving_count;   // advance, finish: moving instances in `moving`
-} pc;
+layout(push_constant) uniform Push { TemporalPush pc; };
 
-const uint ADOPTED = 1u;
-const uint INSTANCE_SHIFT = 8u;  // records.rs RECORD_INSTANCE_SHIFT
 
 vec3 to_world_point(GpuInstance inst, vec3 p) { return (inst.world_from_object * vec4(p, 1.0)).xyz; }
 
@@ -108,7 +93,7 @@ vec3 finite_or(vec3 v, vec3 fallback) {
 }
 
 void append(uint index) {
-    uint slot = atomicAdd(list_counters.counts.y, 1u);
+    uint slot = atomicAdd(list_counters.requested, 1u);
     if (slot < pc.capacity) {
         list[slot] = index;
         atomicAdd(list_counters.dispatch.x, 1u);
@@ -179,20 +164,26 @@ void reclamp_record(uint i) {
 
 void main() {
     uint gid = gl_GlobalInvocationID.x;
-    if (pc.mode == 0u) {
+    if (pc.step == TEMPORAL_BEGIN) {
         if (gid == 0u) {
-            list_counters.counts = uvec4(counters.counts.x, 0u, 0u, 0u);
-            list_counters.dispatch = uvec4(0u, 1u, 1u, 0u);
-            list_counters.limits = uvec4(pc.capacity, pc.capacity, 0u, 0u);
+            list_counters.record_count = counters.record_count;
+            list_counters.requested = 0u;
+            list_counters.batch_first = 0u;
+            list_counters.holes = 0u;
+            list_counters.dispatch = DispatchArgs(0u, 1u, 1u, 0u);
+            list_counters.record_capacity = pc.capacity;
+            list_counters.request_capacity = pc.capacity;
+            list_counters.dropped_requests = 0u;
+            list_counters.rejected_records = 0u;
         }
         return;
     }
-    if (pc.mode == 1u) {
-        if (gid >= counters.counts.x) {
+    if (pc.step == TEMPORAL_ADVANCE) {
+        if (gid >= counters.record_count) {
             return;
         }
         GpuRecordTemporal tr = temporal[gid];
-        if (pc.has_lifespans != 0u && (tr.info.z & ADOPTED) != 0u) {
+        if (pc.has_lifespans != 0u && (tr.info.z & TEMPORAL_FLAG_ADOPTED) != 0u) {
             move_record(gid, tr);
             // The newest known value E_k is exact at frame t_k (info.y) and `age` frames old.
             float age = float(pc.frame) - float(tr.info.y);
@@ -219,27 +210,27 @@ void main() {
         }
         return;
     }
-    if (pc.mode == 2u) {
+    if (pc.step == TEMPORAL_APPEND) {
         uint i = pc.first + gid;
-        if (i >= counters.counts.x) {
+        if (i >= counters.record_count) {
             return;
         }
         if (gid == 0u) {
-            list_counters.counts.x = counters.counts.x;
+            list_counters.record_count = counters.record_count;
         }
         temporal[i].info = uvec4(0u);
         append(i);
         return;
     }
-    if (gid >= min(list_counters.counts.y, pc.capacity)) {
+    if (gid >= min(list_counters.requested, pc.capacity)) {
         return;
     }
     uint i = list[gid];
-    if (pc.mode == 3u) {
+    if (pc.step == TEMPORAL_ADOPT) {
         GpuRecord r = records[i];
         GpuRecordTemporal tr = temporal[i];
-        uint bits = r.info.w >> INSTANCE_SHIFT;
-        if ((tr.info.z & ADOPTED) == 0u) {
+        uint bits = r.info.w >> RECORD_INSTANCE_SHIFT;
+        if ((tr.info.z & TEMPORAL_FLAG_ADOPTED) == 0u) {
             if (bits == 0u || dot(r.normal_rorig.xyz, r.normal_rorig.xyz) == 0.0) {
                 temporal[i].info = uvec4(0u);  // rejected: never weighs, never refreshed
                 return;
@@ -255,16 +246,16 @@ void main() {
             tr.birth_irradiance = vec4(r.irradiance.rgb, 0.0);
             tr.gradient = vec4(0.0);
             tr.info.y = pc.frame;
-            tr.info.z = ADOPTED;
+            tr.info.z = TEMPORAL_FLAG_ADOPTED;
             temporal[i] = tr;
         }
         return;  // an expired record keeps its known value until the look-ahead replaces it
     }
     GpuRecordTemporal tr = temporal[i];
-    if ((tr.info.z & ADOPTED) == 0u) {
+    if ((tr.info.z & TEMPORAL_FLAG_ADOPTED) == 0u) {
         return;
     }
-    if (pc.mode == 4u) {
+    if (pc.step == TEMPORAL_SHIFT) {
         GpuInstance inst = instances[tr.info.x];
         vec3 ng = to_world_normal(inst, tr.object_geometric.xyz);
         lookahead[i].position_radius.xyz = to_world_point(inst, tr.object_position.xyz);
@@ -274,7 +265,7 @@ void main() {
         lookahead[i].grad_r_blue.w = ng.z;
         return;
     }
-    // mode 5: the look-ahead value E(t + 1) against the known value E_k of frame t_k.
+    // TEMPORAL_FINISH: the look-ahead value E(t + 1) against the known value E_k of frame t_k.
     vec3 e0 = tr.birth_irradiance.rgb;
     vec3 e1 = finite_or(lookahead[i].irradiance.rgb, e0);
     float span = max(float(pc.frame + 1u) - float(tr.info.y), 1.0);

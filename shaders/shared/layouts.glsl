@@ -75,12 +75,32 @@ struct GpuRecord {
     uvec4 info;
 };  // 176 bytes
 
+struct DispatchArgs {
+    uint x;
+    uint y;
+    uint z;
+    uint pad;
+};  // 16 bytes
+
+struct DrawArgs {
+    uint vertex_count;
+    uint instance_count;
+    uint first_vertex;
+    uint first_instance;
+};  // 16 bytes
+
 struct IcCounters {
-    uvec4 counts;
-    uvec4 dispatch;
-    uvec4 draw;
-    uvec4 limits;
-    uvec4 batch_draw;
+    uint record_count;
+    uint requested;
+    uint batch_first;
+    uint holes;
+    DispatchArgs dispatch;
+    DrawArgs draw;
+    uint record_capacity;
+    uint request_capacity;
+    uint dropped_requests;
+    uint rejected_records;
+    DrawArgs batch_draw;
 };  // 80 bytes
 
 struct GpuRecordTemporal {

@@ -24,12 +24,7 @@ layout(push_constant) uniform Push {
     uint count;
 } pc;
 
-const uint MODE_SAMPLING = 0u;
-const uint MODE_WEIGHT = 1u;
-const uint MODE_EXTRAPOLATE = 2u;
-const uint MODE_RADIUS = 3u;
-const uint MODE_RECORD = 4u;
-const uint MODE_TEMPORAL = 5u;
+// The modes are radcache_shared::consts::TwinMode (TWIN_* in constants.glsl).
 
 float flag(bool b) { return b ? 1.0 : 0.0; }
 uint bits(float x) { return floatBitsToUint(x); }
@@ -191,17 +186,17 @@ void main() {
     for (int c = 0; c < 16; ++c) {
         o.v[c] = vec4(0.0);
     }
-    if (pc.mode == MODE_SAMPLING) {
+    if (pc.mode == TWIN_SAMPLING) {
         sampling(i, o);
-    } else if (pc.mode == MODE_WEIGHT) {
+    } else if (pc.mode == TWIN_WEIGHT) {
         weight(i, o);
-    } else if (pc.mode == MODE_EXTRAPOLATE) {
+    } else if (pc.mode == TWIN_EXTRAPOLATE) {
         extrapolate(i, o);
-    } else if (pc.mode == MODE_RADIUS) {
+    } else if (pc.mode == TWIN_RADIUS) {
         radius(i, o);
-    } else if (pc.mode == MODE_RECORD) {
+    } else if (pc.mode == TWIN_RECORD) {
         record(i, o);
-    } else if (pc.mode == MODE_TEMPORAL) {
+    } else if (pc.mode == TWIN_TEMPORAL) {
         temporal(i, o);
     }
     outputs[id] = o;

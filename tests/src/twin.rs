@@ -6,6 +6,7 @@ use glam::Vec3;
 use radcache_vk::{vk, Access, Context, Pipeline, Resource};
 
 use crate::Rng;
+pub use radcache_shared::consts::TwinMode;
 
 /// 16 vec4 of inputs or outputs (uints as float bits, booleans as 0/1).
 pub type Row = [[f32; 4]; 16];
@@ -117,7 +118,8 @@ pub fn vec(rng: &mut Rng, s: f32) -> Vec3 {
 }
 
 /// Runs one family through the twin shader in `mode` and compares every expected lane.
-pub fn check(ctx: &Context, pl: &Pipeline, mode: u32, cases: &[Case], samples: &[[f32; 4]]) {
+pub fn check(ctx: &Context, pl: &Pipeline, mode: TwinMode, cases: &[Case], samples: &[[f32; 4]]) {
+    let mode = mode as u32;
     let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
     let rows: Vec<Row> = cases.iter().map(|c| c.0).collect();
     let inputs = ctx.create_buffer_init("twin.in", storage, &rows).unwrap();

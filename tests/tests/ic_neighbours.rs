@@ -5,7 +5,7 @@
 use glam::Vec3;
 use radcache_cache::radius::neighbour_clamp;
 use radcache_render::{IcState, NeighbourPass};
-use radcache_shared::gpu::{GpuRecord, IcCounters};
+use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::{context, finish, shaders, Rng};
 use radcache_vk::{Access, Recorder};
 
@@ -106,11 +106,17 @@ fn the_hash_grid_gives_the_all_pairs_clamp() {
     let state = IcState::new(&ctx, &shaders, 4096, 1024).unwrap();
     let pass = NeighbourPass::new(&ctx, &shaders).unwrap();
     let counters = IcCounters {
-        counts: [n as u32, 0, base as u32, 0],
-        dispatch: [(n - base) as u32, 1, 1, 0],
-        draw: [6, n as u32, 0, 0],
-        limits: [4096, 1024, 0, 0],
-        batch_draw: [6, (n - base) as u32, 0, base as u32],
+        record_count: n as u32,
+        requested: 0,
+        batch_first: base as u32,
+        holes: 0,
+        dispatch: DispatchArgs::groups((n - base) as u32),
+        draw: DrawArgs::quads(n as u32, 0),
+        record_capacity: 4096,
+        request_capacity: 1024,
+        dropped_requests: 0,
+        rejected_records: 0,
+        batch_draw: DrawArgs::quads((n - base) as u32, base as u32),
     };
     let mut rec = ctx.begin("test.grid").unwrap();
     upload(&mut rec, &state, &records, counters);

@@ -19,7 +19,7 @@ use radcache_render::{record_seed, GBuffer, GpuScene, IcState, RecordPass, R_EPS
 use radcache_render::{RECORD_FLAGS_MASK, RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE};
 use radcache_render::{RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED};
 use radcache_scene::Scene;
-use radcache_shared::gpu::{GpuRecord, IcCounters};
+use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::geometry::intersect;
 use radcache_tests::scenes::{load, temp_dir};
 use radcache_tests::{context, finish, shaders};
@@ -173,11 +173,17 @@ fn run(
 
 fn counters(base: u32, requests: u32, groups: u32, capacity: u32) -> IcCounters {
     IcCounters {
-        counts: [base, requests, base, 0],
-        dispatch: [groups, 1, 1, 0],
-        draw: [6, base, 0, 0],
-        limits: [capacity, 64, 0, 0],
-        batch_draw: [6, 0, 0, 0],
+        record_count: base,
+        requested: requests,
+        batch_first: base,
+        holes: 0,
+        dispatch: DispatchArgs::groups(groups),
+        draw: DrawArgs::quads(base, 0),
+        record_capacity: capacity,
+        request_capacity: 64,
+        dropped_requests: 0,
+        rejected_records: 0,
+        batch_draw: DrawArgs::quads(0, 0),
     }
 }
 
@@ -382,8 +388,17 @@ fn furnace_records_match_the_analytic_irradiance() {
     for slot in (0..base as usize).chain(base as usize + 5..SLOTS) {
         assert_eq!(out.records[slot], sentinel(), "slot {slot} was written");
     }
-    assert_eq!(out.counters.limits, [64, 64, 0, 0]);
-    assert_eq!(out.counters.counts, c.counts, "the counts are left alone");
+    let limits = |c: &IcCounters| {
+        let l = [c.record_capacity, c.request_capacity];
+        [l[0], l[1], c.dropped_requests, c.rejected_records]
+    };
+    let counts = |c: &IcCounters| [c.record_count, c.requested, c.batch_first, c.holes];
+    assert_eq!(limits(&out.counters), [64, 64, 0, 0]);
+    assert_eq!(
+        counts(&out.counters),
+        counts(&c),
+        "the counts are left alone"
+    );
     assert!(out.rays > 5 * u64::from(m * n), "{} rays", out.rays);
     drop(pass);
     end(f);
@@ -419,7 +434,17 @@ fn invalid_irradiance_background_and_overflow_are_guarded() {
         assert_eq!(all[16..40], [0.0; 24], "gradients of record {i}");
     }
     assert_eq!(out.records[5], sentinel(), "dropped, yet written");
-    assert_eq!(out.counters.limits, [5, 64, 1, 3], "dropped 1, rejected 3");
+    let c = &out.counters;
+    assert_eq!(
+        [
+            c.record_capacity,
+            c.request_capacity,
+            c.dropped_requests,
+            c.rejected_records
+        ],
+        [5, 64, 1, 3],
+        "dropped 1, rejected 3"
+    );
     drop(pass);
     end(f);
 }
@@ -493,7 +518,10 @@ fn cornell_records_agree_with_an_independent_estimate() {
     // A ray through a crack between two triangles may legitimately differ.
     assert!(bad * 200 <= points.len() * ca, "{bad} distances differ");
     assert!(a.rays > u64::from(k) * ca as u64 && b.rays > u64::from(k) * cb as u64);
-    assert_eq!((a.counters.limits[2], a.counters.limits[3]), (0, 0));
+    assert_eq!(
+        (a.counters.dropped_requests, a.counters.rejected_records),
+        (0, 0)
+    );
     drop((pass_a, pass_b));
     end(f);
 }

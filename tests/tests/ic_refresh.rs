@@ -5,7 +5,7 @@
 
 use radcache_cache::IcParams;
 use radcache_render::{GBuffer, GpuScene, IcRenderer, IcSettings, RecordPass};
-use radcache_shared::gpu::{GpuRecord, IcCounters};
+use radcache_shared::gpu::{DispatchArgs, GpuRecord, IcCounters};
 use radcache_tests::scenes::load;
 use radcache_tests::{context, finish, shaders};
 use radcache_vk::{Access, Context};
@@ -24,9 +24,9 @@ fn refresh(
 ) -> Vec<GpuRecord> {
     let state = r.state();
     let mut c: IcCounters = state.read_counters().unwrap();
-    let count = c.counts[0] as usize;
-    c.counts[1] = which.len() as u32;
-    c.dispatch = [which.len() as u32, 1, 1, 0];
+    let count = c.record_count as usize;
+    c.requested = which.len() as u32;
+    c.dispatch = DispatchArgs::groups(which.len() as u32);
     let mut rec = ctx.begin("test.refresh").unwrap();
     rec.update_buffer(&state.requests, 0, which);
     rec.update_buffer(&state.counters, 0, std::slice::from_ref(&c));

@@ -5,10 +5,11 @@
 use glam::Vec3;
 use radcache_cache::{extrapolate_irradiance, record_weight, IcParams, WeightKind};
 use radcache_render::{
-    GBuffer, GpuScene, HolePass, IcState, NeighbourPass, SplatPass, SplatScope, SplatWeights,
+    GBuffer, GpuScene, HolePass, HoleSelection, IcState, NeighbourPass, SplatPass, SplatScope,
+    SplatWeights,
 };
 use radcache_scene::{LoadOptions, Scene};
-use radcache_shared::gpu::{GpuRecord, IcCounters};
+use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::{context, finish, shaders};
 use radcache_vk::{Context, ImageUse, Recorder};
 
@@ -78,11 +79,17 @@ fn set_state(rec: &mut Recorder, state: &IcState, records: &[GpuRecord], counter
 
 fn counters(records: u32, batch_base: u32) -> IcCounters {
     IcCounters {
-        counts: [records, 0, batch_base, 0],
-        dispatch: [records - batch_base, 1, 1, 0],
-        draw: [6, records, 0, 0],
-        limits: [64, 1024, 0, 0],
-        batch_draw: [6, records - batch_base, 0, batch_base],
+        record_count: records,
+        requested: 0,
+        batch_first: batch_base,
+        holes: 0,
+        dispatch: DispatchArgs::groups(records - batch_base),
+        draw: DrawArgs::quads(records, 0),
+        record_capacity: 64,
+        request_capacity: 1024,
+        dropped_requests: 0,
+        rejected_records: 0,
+        batch_draw: DrawArgs::quads(records - batch_base, batch_base),
     }
 }
 
@@ -235,16 +242,24 @@ fn holes_request_one_record_per_block_and_vanish_when_covered() {
         .unwrap();
     holes
         .record(
-            &mut rec, &f.gbuffer, &f.splat, &f.state, spacing, 0.5, 7, false,
+            &mut rec,
+            &f.gbuffer,
+            &f.splat,
+            &f.state,
+            HoleSelection::Request {
+                spacing,
+                threshold: 0.5,
+                seed: 7,
+            },
         )
         .unwrap();
     f.state.record_begin_batch(&mut rec).unwrap();
     f.ctx.submit(rec).unwrap().wait().unwrap();
     let c = f.state.read_counters().unwrap();
-    assert_eq!(c.counts[3], W * H, "hole pixels");
+    assert_eq!(c.holes, W * H, "hole pixels");
     let blocks = W.div_ceil(spacing) * H.div_ceil(spacing);
-    assert_eq!(c.counts[1], blocks, "one request per block");
-    assert_eq!(c.dispatch[0], blocks, "record pass dispatch");
+    assert_eq!(c.requested, blocks, "one request per block");
+    assert_eq!(c.dispatch.x, blocks, "record pass dispatch");
     let requests: Vec<u32> = f
         .ctx
         .read_buffer(&f.state.requests, blocks as usize)
@@ -277,12 +292,20 @@ fn holes_request_one_record_per_block_and_vanish_when_covered() {
         .unwrap();
     holes
         .record(
-            &mut rec, &f.gbuffer, &f.splat, &f.state, spacing, 0.5, 7, false,
+            &mut rec,
+            &f.gbuffer,
+            &f.splat,
+            &f.state,
+            HoleSelection::Request {
+                spacing,
+                threshold: 0.5,
+                seed: 7,
+            },
         )
         .unwrap();
     f.ctx.submit(rec).unwrap().wait().unwrap();
     let c = f.state.read_counters().unwrap();
-    assert_eq!((c.counts[1], c.counts[3]), (0, 0), "{c:?}");
+    assert_eq!((c.requested, c.holes), (0, 0), "{c:?}");
     drop(holes);
     end(f);
 }
@@ -294,24 +317,25 @@ fn counters_turn_requests_into_dispatches_within_capacity() {
     f.state.record_reset(&mut rec).unwrap();
     f.ctx.submit(rec).unwrap().wait().unwrap();
     let c = f.state.read_counters().unwrap();
-    assert_eq!(c.counts, [0; 4]);
-    assert_eq!(c.limits[..2], [64, 1024]);
+    let counts = [c.record_count, c.requested, c.batch_first, c.holes];
+    assert_eq!(counts, [0; 4]);
+    assert_eq!([c.record_capacity, c.request_capacity], [64, 1024]);
 
     // 60 records exist, 10 are requested, room for 4.
     let mut rec = f.ctx.begin("test.batch").unwrap();
     let mut start = counters(60, 60);
-    start.counts[1] = 10;
+    start.requested = 10;
     set_state(&mut rec, &f.state, &[], start);
     f.state.record_begin_batch(&mut rec).unwrap();
     f.state.record_end_batch(&mut rec).unwrap();
     f.ctx.submit(rec).unwrap().wait().unwrap();
     let c = f.state.read_counters().unwrap();
-    assert_eq!(c.dispatch[0], 4);
-    assert_eq!(c.counts[2], 60, "batch base");
-    assert_eq!(c.counts[0], 64, "record count");
-    assert_eq!(c.draw, [6, 64, 0, 0]);
-    assert_eq!(c.batch_draw, [6, 4, 0, 60], "the batch's own draw");
-    assert_eq!(c.limits[2], 6, "dropped requests");
+    assert_eq!(c.dispatch.x, 4);
+    assert_eq!(c.batch_first, 60, "batch base");
+    assert_eq!(c.record_count, 64, "record count");
+    assert_eq!(c.draw, DrawArgs::quads(64, 0));
+    assert_eq!(c.batch_draw, DrawArgs::quads(4, 60), "the batch's own draw");
+    assert_eq!(c.dropped_requests, 6, "dropped requests");
     end(f);
 }
 
@@ -335,7 +359,7 @@ fn neighbour_clamping_shrinks_radii_to_neighbour_plus_distance() {
         record(Vec3::new(0.0, 1.0, 0.0), N, Vec3::ONE, 5.0, [Vec3::ZERO; 3]),
     ];
     let mut c = counters(4, 1);
-    c.dispatch[0] = 2; // records 1 and 2 are the new batch
+    c.dispatch.x = 2; // records 1 and 2 are the new batch
     let mut rec = f.ctx.begin("test.neighbours").unwrap();
     set_state(&mut rec, &f.state, &recs, c);
     pass.record_rebuild(&mut rec, &f.state, 200.0).unwrap();

@@ -21,7 +21,7 @@ use radcache_cache::sampling::*;
 use radcache_cache::temporal::*;
 use radcache_cache::weight::*;
 use radcache_cache::{luminance_rec709, IC_FAR};
-use radcache_tests::twin::{check, ub, unit, v4, vec, Case, Expect, How, Row};
+use radcache_tests::twin::{check, ub, unit, v4, vec, Case, Expect, How, Row, TwinMode};
 use radcache_tests::{context, finish, shaders, Rng};
 use radcache_vk::{BindingKind, BindingLayout, Pipeline};
 
@@ -408,13 +408,31 @@ fn glsl_twin_matches_the_rust_formulas_on_the_gpu() {
         .collect();
     let pipeline = Pipeline::compute(&ctx, "ircache_twin", &spirv, &layout, 8).unwrap();
     let mut rng = Rng::new(0x1c_2024);
-    check(&ctx, &pipeline, 0, &sampling(&mut rng), &[]);
-    check(&ctx, &pipeline, 1, &weights(&mut rng), &[]);
-    check(&ctx, &pipeline, 2, &extrapolation(&mut rng), &[]);
-    check(&ctx, &pipeline, 3, &radius(&mut rng), &[]);
+    check(
+        &ctx,
+        &pipeline,
+        TwinMode::Sampling,
+        &sampling(&mut rng),
+        &[],
+    );
+    check(&ctx, &pipeline, TwinMode::Weight, &weights(&mut rng), &[]);
+    check(
+        &ctx,
+        &pipeline,
+        TwinMode::Extrapolate,
+        &extrapolation(&mut rng),
+        &[],
+    );
+    check(&ctx, &pipeline, TwinMode::Radius, &radius(&mut rng), &[]);
     let (cases, samples) = records(&mut rng);
-    check(&ctx, &pipeline, 4, &cases, &samples);
-    check(&ctx, &pipeline, 5, &temporal(&mut rng), &[]);
+    check(&ctx, &pipeline, TwinMode::Record, &cases, &samples);
+    check(
+        &ctx,
+        &pipeline,
+        TwinMode::Temporal,
+        &temporal(&mut rng),
+        &[],
+    );
     drop(pipeline);
     finish(ctx);
 }

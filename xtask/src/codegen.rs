@@ -1,6 +1,7 @@
 //! `cargo xtask codegen [--check]`: writes the generated GLSL from the Rust sources of truth
-//! (`shaders/shared/layouts.glsl` from `radcache-shared`, `shaders/shared/bindings.glsl` from
-//! `radcache-render::bindings`), or with `--check` fails if a file on disk is stale.
+//! (`shaders/shared/layouts.glsl` and `constants.glsl` from `radcache-shared`,
+//! `shaders/shared/bindings.glsl` from `radcache-render::bindings`, `shaders/shared/push.glsl`
+//! from the passes' push-constant structs), or with `--check` fails if a file on disk is stale.
 
 use anyhow::{bail, Result};
 
@@ -12,7 +13,9 @@ pub fn run(args: &[&str]) -> Result<()> {
     };
     let files = [
         ("layouts.glsl", radcache_shared::gpu::generated_glsl()),
+        ("constants.glsl", radcache_shared::consts::generated_glsl()),
         ("bindings.glsl", radcache_render::bindings::generated_glsl()),
+        ("push.glsl", radcache_render::passes::push_constants_glsl()),
     ];
     let dir = crate::root().join("shaders/shared");
     let mut stale = Vec::new();

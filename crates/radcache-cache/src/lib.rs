@@ -51,28 +51,11 @@ pub use weight::{record_weight, splat_radius, WeightKind};
 
 use glam::Vec3;
 
-/// Distances at or above this value are misses ("no geometry"); radii are capped to it.
-/// Chosen well below 2^126 so that `x / r` stays inside Vulkan's guaranteed division range.
-pub const IC_FAR: f32 = 1.0e30;
-
-/// Smallest radius any weight or clamp divides by (§16.1, `R = 0` guard).
-pub const R_FLOOR: f32 = 1.0e-20;
-
-/// Ward error floor: `w = 1 / max(ε, WARD_MIN_ERROR)` caps the weight at 1000 (RADIANCE's cap, §16.1).
-pub const WARD_MIN_ERROR: f32 = 1.0e-3;
-
-/// `sqrt(1 − cos 10°)`: the Tabellion–Lamorlette normal-error scale (§5.3).
-pub const TL_NORMAL_SCALE: f32 = 0.123_256_41;
-
-/// Smallest T&L κ accepted (κ = 0 would give an unbounded zone of influence).
-pub const KAPPA_MIN: f32 = 1.0e-3;
-
-/// `sin²(10°)`: rows lying entirely above 10° elevation (`cos²θ_j⁺ >= sin²10°`) take part in the
-/// restricted minimum distance (§7.1, Mitsuba's grazing-ray guard).
-pub const ELEVATION_MIN_SIN2: f32 = 0.030_153_69;
-
-/// Per-channel upper bound of the extrapolated irradiance relative to the record's value (§16.2).
-pub const EXTRAPOLATION_MAX_FACTOR: f32 = 4.0;
+// The constants shared with GLSL are declared once, in `radcache_shared::consts`.
+pub use radcache_shared::consts::{
+    ELEVATION_MIN_SIN2, EXTRAPOLATION_MAX_FACTOR, IC_FAR, KAPPA_MIN, R_FLOOR, TL_NORMAL_SCALE,
+    WARD_MIN_ERROR,
+};
 
 /// `min(max(x, lo), hi)` in GLSL's order. Unlike `f32::clamp` it never panics (`lo > hi` gives `hi`)
 /// and maps a NaN `x` to `lo`.

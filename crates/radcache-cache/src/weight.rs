@@ -31,10 +31,8 @@
 use crate::{clamp_lo_hi, IC_FAR, KAPPA_MIN, R_FLOOR, TL_NORMAL_SCALE, WARD_MIN_ERROR};
 use glam::Vec3;
 
-/// GLSL value of [`WeightKind::Ward`].
-pub const WEIGHT_WARD: u32 = 0;
-/// GLSL value of [`WeightKind::TabellionLamorlette`].
-pub const WEIGHT_TL: u32 = 1;
+/// GLSL values of [`WeightKind`] (declared once in `radcache_shared::consts`).
+pub use radcache_shared::consts::{WEIGHT_TL, WEIGHT_WARD};
 
 /// Which weighting function interpolates the cache (`as u32` gives the GLSL constant).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

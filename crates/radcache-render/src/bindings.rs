@@ -1,6 +1,10 @@
-//! The one owner of binding numbers. Bindings 0–15 are the scene's (every pass that reads the scene
-//! pushes the same table); each pass's own bindings start at [`PASS_BASE`]. `cargo xtask codegen`
-//! writes these constants to `shaders/shared/bindings.glsl`.
+//! The one owner of binding numbers and kinds. Bindings 0–15 are the scene's (every pass that
+//! reads the scene pushes the same table); the G-buffer's six images follow at [`PASS_BASE`]
+//! in the passes that read it; each pass's own bindings come next, declared once here by
+//! [`pass_bindings!`] as a named table. `cargo xtask codegen` writes every number to
+//! `shaders/shared/bindings.glsl` as `B_<PASS>_<NAME>` (a test fails when it is stale), so no
+//! shader writes a binding number; `radcache-vk` checks at record time that each binding pushed
+//! has the declared kind and that none was left out.
 
 use radcache_vk::{BindingKind, BindingLayout};
 
@@ -53,9 +57,260 @@ pub const SCENE: [BindingLayout; 14] = [
     BindingLayout::new(ENV_ALIAS, BindingKind::StorageBuffer),
 ];
 
-/// The scene table followed by a pass's own bindings.
-pub fn with_scene(pass: &[BindingLayout]) -> Vec<BindingLayout> {
-    SCENE.iter().chain(pass).copied().collect()
+/// One named binding of a table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Binding {
+    /// Name (upper snake case, as in GLSL without the `B_<PASS>_` prefix).
+    pub name: &'static str,
+    /// Binding number.
+    pub binding: u32,
+    /// Descriptor kind.
+    pub kind: BindingKind,
+}
+
+impl Binding {
+    /// The layout entry of this binding.
+    pub const fn layout(&self) -> BindingLayout {
+        BindingLayout::new(self.binding, self.kind)
+    }
+}
+
+/// Declares a pass's binding table: a module with one `pub const` per binding (numbered in
+/// order from `base`), the named table, the full layout (the prefix tables, then its own), and
+/// the GLSL `#define`s.
+macro_rules! pass_bindings {
+    (
+        $(#[$meta:meta])*
+        pub mod $pass:ident ($glsl:literal, base = $base:expr, prefix = [$($prefix:expr),*]) {
+            $( $(#[$bmeta:meta])* $name:ident : $kind:ident ),* $(,)?
+        }
+    ) => {
+        $(#[$meta])*
+        pub mod $pass {
+            #[allow(unused_imports)]
+            use super::*;
+
+            #[allow(non_camel_case_types, clippy::upper_case_acronyms, dead_code)]
+            #[repr(u32)]
+            enum Slot { $($name),* }
+
+            $( $(#[$bmeta])* pub const $name: u32 = $base + Slot::$name as u32; )*
+
+            /// The pass's own bindings, by name.
+            pub const OWN: &[$crate::bindings::Binding] = &[$(
+                $crate::bindings::Binding {
+                    name: stringify!($name),
+                    binding: $name,
+                    kind: radcache_vk::BindingKind::$kind,
+                }
+            ),*];
+
+            /// The pass's whole table: the prefix tables, then its own bindings.
+            pub fn layout() -> Vec<radcache_vk::BindingLayout> {
+                let prefix: &[&[radcache_vk::BindingLayout]] = &[$(&$prefix),*];
+                prefix
+                    .iter()
+                    .flat_map(|t| t.iter().copied())
+                    .chain(OWN.iter().map(|b| b.layout()))
+                    .collect()
+            }
+
+            /// The GLSL `#define`s of the own bindings.
+            pub fn glsl() -> String {
+                $crate::bindings::glsl_defines($glsl, OWN)
+            }
+        }
+    };
+}
+
+/// `#define B_<PASS>_<NAME> n` for each binding of `table`.
+pub fn glsl_defines(pass: &str, table: &[Binding]) -> String {
+    let mut s = format!("// {pass}\n");
+    for b in table {
+        s.push_str(&format!("#define B_{pass}_{} {}\n", b.name, b.binding));
+    }
+    s
+}
+
+pass_bindings! {
+    /// The G-buffer images (`shaders/common/gbuffer.glsl`), storage images read by the cache's
+    /// passes; the G-buffer pass writes them as attachments.
+    pub mod gbuffer("GBUFFER", base = PASS_BASE, prefix = []) {
+        /// World position (xyz), 1 on surfaces (w).
+        POSITION: StorageImage,
+        /// Shading normal (xyz), pixel footprint (w).
+        NORMAL: StorageImage,
+        /// Geometric normal (xyz), material index (w).
+        GEOMETRIC: StorageImage,
+        /// Diffuse albedo (rgb), mesh instance (w).
+        ALBEDO: StorageImage,
+        /// Emitted radiance toward the camera (rgb).
+        EMISSION: StorageImage,
+        /// Direct light toward the camera (rgb), written by the direct pass.
+        DIRECT: StorageImage,
+    }
+}
+
+/// The G-buffer's bindings as a layout prefix.
+pub const GBUFFER: [BindingLayout; 6] = [
+    gbuffer::OWN[0].layout(),
+    gbuffer::OWN[1].layout(),
+    gbuffer::OWN[2].layout(),
+    gbuffer::OWN[3].layout(),
+    gbuffer::OWN[4].layout(),
+    gbuffer::OWN[5].layout(),
+];
+
+/// First binding after the G-buffer's.
+pub const GBUFFER_END: u32 = PASS_BASE + GBUFFER.len() as u32;
+
+/// The frame constants alone (the splat's only scene binding).
+pub const FRAME_ONLY: [BindingLayout; 1] = [SCENE[0]];
+
+pass_bindings! {
+    /// `passes/aov.comp`: first-hit albedo, normal and depth.
+    pub mod aov("AOV", base = PASS_BASE, prefix = [SCENE]) {
+        /// Albedo per pixel (`vec4[]`).
+        ALBEDO: StorageBuffer,
+        /// Normal per pixel (`vec4[]`).
+        NORMAL: StorageBuffer,
+        /// Depth per pixel (`float[]`).
+        DEPTH: StorageBuffer,
+    }
+}
+
+pass_bindings! {
+    /// `passes/composite.comp`: a sub-frame into the frame accumulator.
+    pub mod composite("COMPOSITE", base = GBUFFER_END, prefix = [SCENE, GBUFFER]) {
+        /// Σw·Ẽ (rgb), Σw (a): the splat target.
+        SPLAT_SUM: StorageImage,
+        /// The frame accumulator (`vec4[]`: Σ radiance, sub-frames).
+        ACCUM: StorageBuffer,
+        /// Non-finite values dropped (`uint`).
+        NONFINITE: StorageBuffer,
+        /// The emission accumulator (`vec4[]`).
+        EMISSION_ACCUM: StorageBuffer,
+        /// Debug AOVs (`vec4[2 per pixel]`).
+        DEBUG_ACCUM: StorageBuffer,
+        /// Records reaching each pixel (the splat's count target).
+        SPLAT_COUNT: StorageImage,
+    }
+}
+
+pass_bindings! {
+    /// `passes/direct.comp`: direct light at the G-buffer's points.
+    pub mod direct("DIRECT", base = GBUFFER_END, prefix = [SCENE, GBUFFER]) {
+        /// Ray queries traced (`uint`).
+        RAY_COUNT: StorageBuffer,
+    }
+}
+
+pass_bindings! {
+    /// `passes/emission.comp`: box-filtered emission into the frame accumulator.
+    pub mod emission("EMISSION", base = PASS_BASE, prefix = [SCENE]) {
+        /// The frame accumulator (`vec4[]`).
+        ACCUM: StorageBuffer,
+        /// The composite's emission accumulator (`vec4[]`).
+        EMISSION_ACCUM: StorageBuffer,
+        /// Ray queries traced (`uint`).
+        RAY_COUNT: StorageBuffer,
+    }
+}
+
+pass_bindings! {
+    /// `passes/holes.comp`: one request per S×S block with an uncovered pixel.
+    pub mod holes("HOLES", base = GBUFFER_END, prefix = [GBUFFER]) {
+        /// Σw·Ẽ (rgb), Σw (a): the coverage splat.
+        SPLAT_SUM: StorageImage,
+        /// Requested pixels (`uint[]`).
+        REQUESTS: StorageBuffer,
+        /// `IcCounters`.
+        COUNTERS: StorageBuffer,
+    }
+}
+
+pass_bindings! {
+    /// `passes/ic_counters.comp`: the counters' bookkeeping.
+    pub mod ic_counters("IC_COUNTERS", base = PASS_BASE, prefix = []) {
+        /// `IcCounters`.
+        COUNTERS: StorageBuffer,
+    }
+}
+
+pass_bindings! {
+    /// `passes/neighbours.comp`: neighbour clamping over a hash grid.
+    pub mod neighbours("NEIGHBOURS", base = PASS_BASE, prefix = []) {
+        /// `IcCounters`.
+        COUNTERS: StorageBuffer,
+        /// `GpuRecord[]`.
+        RECORDS: StorageBuffer,
+        /// The same records as words (atomic radius updates).
+        RECORD_WORDS: StorageBuffer,
+        /// Bucket list heads (`uint[]`).
+        HEADS: StorageBuffer,
+        /// List links (`uint[]`).
+        NEXT: StorageBuffer,
+    }
+}
+
+pass_bindings! {
+    /// `passes/path_trace.comp`: the reference path tracer.
+    pub mod path_trace("PATH_TRACE", base = PASS_BASE, prefix = [SCENE]) {
+        /// Σ radiance per pixel (`vec4[]`).
+        ACCUM: StorageBuffer,
+        /// Kahan compensation of the sums (`vec4[]`).
+        COMPENSATION: StorageBuffer,
+        /// Ray queries traced (`uint`).
+        RAY_COUNT: StorageBuffer,
+    }
+}
+
+pass_bindings! {
+    /// `passes/record.comp`: the records' gathers.
+    pub mod record("RECORD", base = GBUFFER_END, prefix = [SCENE, GBUFFER]) {
+        /// Requested pixels or record indices (`uint[]`).
+        REQUESTS: StorageBuffer,
+        /// `IcCounters` of the requests.
+        COUNTERS: StorageBuffer,
+        /// `GpuRecord[]` written.
+        RECORDS: StorageBuffer,
+        /// Ray queries traced (`uint`).
+        RAY_COUNT: StorageBuffer,
+        /// Stratum samples, for the twin tests (`vec4[]`).
+        SAMPLES: StorageBuffer,
+    }
+}
+
+pass_bindings! {
+    /// `passes/splat.vert` + `splat.frag`: the records' zones into the splat targets.
+    pub mod splat("SPLAT", base = GBUFFER_END, prefix = [FRAME_ONLY, GBUFFER]) {
+        /// `GpuRecord[]`.
+        RECORDS: StorageBuffer,
+        /// Last frame each record weighed on a pixel (`uint[]`).
+        LAST_USED: StorageBuffer,
+    }
+}
+
+pass_bindings! {
+    /// `passes/temporal.comp`: the records' temporal lifecycle.
+    pub mod temporal("TEMPORAL", base = PASS_BASE, prefix = [SCENE]) {
+        /// `IcCounters` of the cache.
+        COUNTERS: StorageBuffer,
+        /// `GpuRecord[]`.
+        RECORDS: StorageBuffer,
+        /// `GpuRecordTemporal[]`.
+        TEMPORAL: StorageBuffer,
+        /// Record indices to evaluate (`uint[]`).
+        LIST: StorageBuffer,
+        /// The list's `IcCounters`.
+        LIST_COUNTERS: StorageBuffer,
+        /// The look-ahead copy of the listed records (`GpuRecord[]`).
+        LOOKAHEAD: StorageBuffer,
+        /// The previous frame's instances (`GpuInstance[]`).
+        PREVIOUS: StorageBuffer,
+        /// Bounding spheres of the moving instances (`vec4[]`).
+        MOVING: StorageBuffer,
+    }
 }
 
 /// `shaders/shared/bindings.glsl`.
@@ -76,14 +331,80 @@ pub fn generated_glsl() -> String {
         ("ENV_TEXELS", ENV_TEXELS),
         ("ENV_ALIAS", ENV_ALIAS),
         ("PASS_BASE", PASS_BASE),
+        ("GBUFFER_END", GBUFFER_END),
     ];
     let mut s = String::from(
         "// Generated by `cargo xtask codegen` from crates/radcache-render/src/bindings.rs. Do not edit.\n\
-         #ifndef RADCACHE_SHARED_BINDINGS_GLSL\n#define RADCACHE_SHARED_BINDINGS_GLSL\n\n",
+         #ifndef RADCACHE_SHARED_BINDINGS_GLSL\n#define RADCACHE_SHARED_BINDINGS_GLSL\n\n// scene\n",
     );
     for (name, value) in names {
         s.push_str(&format!("#define B_{name} {value}\n"));
     }
+    for table in [
+        gbuffer::glsl(),
+        aov::glsl(),
+        composite::glsl(),
+        direct::glsl(),
+        emission::glsl(),
+        holes::glsl(),
+        ic_counters::glsl(),
+        neighbours::glsl(),
+        path_trace::glsl(),
+        record::glsl(),
+        splat::glsl(),
+        temporal::glsl(),
+    ] {
+        s.push('\n');
+        s.push_str(&table);
+    }
     s.push_str("\n#endif\n");
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn generated_glsl_is_up_to_date() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../shaders/shared/bindings.glsl"
+        );
+        let on_disk = std::fs::read_to_string(path).unwrap_or_default();
+        assert!(
+            on_disk == generated_glsl(),
+            "shaders/shared/bindings.glsl is stale: run `cargo xtask codegen`"
+        );
+    }
+
+    #[test]
+    fn tables_number_their_bindings_once() {
+        for table in [
+            composite::layout(),
+            direct::layout(),
+            holes::layout(),
+            record::layout(),
+            splat::layout(),
+            temporal::layout(),
+            aov::layout(),
+            emission::layout(),
+            path_trace::layout(),
+            neighbours::layout(),
+            ic_counters::layout(),
+        ] {
+            let mut numbers: Vec<u32> = table.iter().map(|b| b.binding).collect();
+            numbers.sort_unstable();
+            let n = numbers.len();
+            numbers.dedup();
+            assert_eq!(
+                numbers.len(),
+                n,
+                "a binding number is used twice: {table:?}"
+            );
+        }
+        assert_eq!(composite::SPLAT_SUM, GBUFFER_END);
+        assert_eq!(composite::SPLAT_COUNT, GBUFFER_END + 5);
+        assert_eq!(temporal::MOVING, PASS_BASE + 7);
+    }
 }

@@ -154,22 +154,87 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// Counters and indirect arguments of the irradiance cache, written by the GPU.
+    /// `VkDispatchIndirectCommand` (x, y, z) padded to 16 bytes.
+    pub struct DispatchArgs {
+        /// Workgroups along x.
+        pub x: u32 => "uint",
+        /// Workgroups along y.
+        pub y: u32 => "uint",
+        /// Workgroups along z.
+        pub z: u32 => "uint",
+        /// Unused (keeps the next field 16-byte aligned).
+        pub pad: u32 => "uint",
+    }
+}
+
+gpu_struct! {
+    /// `VkDrawIndirectCommand`.
+    pub struct DrawArgs {
+        /// Vertices per instance.
+        pub vertex_count: u32 => "uint",
+        /// Instances.
+        pub instance_count: u32 => "uint",
+        /// First vertex.
+        pub first_vertex: u32 => "uint",
+        /// First instance (`gl_InstanceIndex` starts here).
+        pub first_instance: u32 => "uint",
+    }
+}
+
+impl DispatchArgs {
+    /// `n` workgroups along x.
+    pub const fn groups(n: u32) -> DispatchArgs {
+        DispatchArgs {
+            x: n,
+            y: 1,
+            z: 1,
+            pad: 0,
+        }
+    }
+}
+
+impl DrawArgs {
+    /// Vertices of one splat quad (two triangles).
+    pub const QUAD_VERTICES: u32 = crate::consts::QUAD_VERTICES;
+
+    /// `count` quads (one instance each) from instance `first`.
+    pub const fn quads(count: u32, first: u32) -> DrawArgs {
+        DrawArgs {
+            vertex_count: Self::QUAD_VERTICES,
+            instance_count: count,
+            first_vertex: 0,
+            first_instance: first,
+        }
+    }
+}
+
+gpu_struct! {
+    /// Counters and indirect arguments of the irradiance cache, written by the GPU
+    /// (`shaders/passes/ic_counters.comp` moves them from step to step).
     pub struct IcCounters {
-        /// Records in the record buffer (x), pending requests (y), first record of the pending
-        /// batch (z), hole pixels found by the last selection (w).
-        pub counts: [u32; 4] => "uvec4",
-        /// `VkDispatchIndirectCommand` of the record pass: one workgroup per request (xyz), unused (w).
-        pub dispatch: [u32; 4] => "uvec4",
-        /// `VkDrawIndirectCommand` of the splat pass: 6 vertices, one instance per record.
-        pub draw: [u32; 4] => "uvec4",
-        /// Record capacity (x), request capacity (y), requests dropped for lack of space (z),
-        /// records rejected as invalid (w).
-        pub limits: [u32; 4] => "uvec4",
-        /// `VkDrawIndirectCommand` of the splat of the last batch only: 6 vertices, one instance
-        /// per record of the batch, first instance its first record (no instance before a batch
-        /// ends, none after a level that created nothing).
-        pub batch_draw: [u32; 4] => "uvec4",
+        /// Records in the record buffer.
+        pub record_count: u32 => "uint",
+        /// Requests appended by the hole selection since the level began.
+        pub requested: u32 => "uint",
+        /// First record of the pending batch.
+        pub batch_first: u32 => "uint",
+        /// Hole pixels found by the last selection.
+        pub holes: u32 => "uint",
+        /// The record pass's indirect dispatch: one workgroup per request that fits.
+        pub dispatch: DispatchArgs => struct,
+        /// The splat of every record: one quad per record.
+        pub draw: DrawArgs => struct,
+        /// Record capacity.
+        pub record_capacity: u32 => "uint",
+        /// Request capacity of one batch.
+        pub request_capacity: u32 => "uint",
+        /// Requests dropped for lack of room (record or request capacity).
+        pub dropped_requests: u32 => "uint",
+        /// Records rejected as invalid (stored as black).
+        pub rejected_records: u32 => "uint",
+        /// The splat of the last batch only: one quad per record of the batch from its first
+        /// record (no instance before a batch ends, none after a level that created nothing).
+        pub batch_draw: DrawArgs => struct,
     }
 }
 
@@ -211,6 +276,8 @@ pub fn generated_glsl() -> String {
         glsl_struct::<GpuLight>(),
         glsl_struct::<FrameConstants>(),
         glsl_struct::<GpuRecord>(),
+        glsl_struct::<DispatchArgs>(),
+        glsl_struct::<DrawArgs>(),
         glsl_struct::<IcCounters>(),
         glsl_struct::<GpuRecordTemporal>(),
     ] {
@@ -239,10 +306,13 @@ mod tests {
         errors.extend(std430_violations::<GpuLight>());
         errors.extend(std430_violations::<FrameConstants>());
         errors.extend(std430_violations::<GpuRecord>());
+        errors.extend(std430_violations::<DispatchArgs>());
+        errors.extend(std430_violations::<DrawArgs>());
         errors.extend(std430_violations::<IcCounters>());
         errors.extend(std430_violations::<GpuRecordTemporal>());
         assert_eq!(std::mem::size_of::<GpuRecord>(), 176);
         assert_eq!(std::mem::size_of::<GpuRecordTemporal>(), 96);
+        assert_eq!(std::mem::size_of::<IcCounters>(), 80);
         assert!(errors.is_empty(), "{}", errors.join("\n"));
     }
 

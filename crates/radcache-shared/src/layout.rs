@@ -17,6 +17,8 @@ pub struct Field {
     pub offset: usize,
     /// Byte size in the Rust struct.
     pub size: usize,
+    /// std430 (size, alignment) of the GLSL type, `None` for a type radcache does not support.
+    pub std430: Option<(usize, usize)>,
 }
 
 /// A struct shared with GLSL.
@@ -25,6 +27,18 @@ pub trait GpuStruct: bytemuck::Pod {
     const NAME: &'static str;
     /// The fields in declaration order.
     fn fields() -> Vec<Field>;
+
+    /// std430 (size, alignment) of the struct as a member of another one.
+    fn std430() -> (usize, usize) {
+        let mut offset = 0usize;
+        let mut max_align = 4usize;
+        for f in Self::fields() {
+            let (size, align) = f.std430.unwrap_or((f.size, 4));
+            max_align = max_align.max(align);
+            offset = offset.div_ceil(align) * align + size;
+        }
+        (offset.div_ceil(max_align) * max_align, max_align)
+    }
 }
 
 /// std430 (size, alignment) of a GLSL type radcache uses.
@@ -44,7 +58,7 @@ pub fn std430_violations<T: GpuStruct>() -> Vec<String> {
     let mut offset = 0usize;
     let mut max_align = 4usize;
     for f in T::fields() {
-        let Some((size, align)) = std430_size_align(f.glsl) else {
+        let Some((size, align)) = f.std430 else {
             errors.push(format!(
                 "{}.{}: unsupported GLSL type {}",
                 T::NAME,
@@ -87,13 +101,30 @@ pub fn glsl_struct<T: GpuStruct>() -> String {
     s
 }
 
+/// The GLSL type name and std430 (size, alignment) of a field declared `=> "glsl"` or
+/// `=> struct` (a nested [`GpuStruct`]).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __gpu_field_type {
+    ($ty:ty, struct) => {
+        (
+            <$ty as $crate::layout::GpuStruct>::NAME,
+            Some(<$ty as $crate::layout::GpuStruct>::std430()),
+        )
+    };
+    ($ty:ty, $glsl:literal) => {
+        ($glsl, $crate::layout::std430_size_align($glsl))
+    };
+}
+
 /// Defines a `#[repr(C)]` plain-data struct shared with GLSL and its [`GpuStruct`] description.
+/// Each field names its GLSL type (`=> "vec4"`), or `=> struct` for a nested shared struct.
 #[macro_export]
 macro_rules! gpu_struct {
     (
         $(#[$meta:meta])*
         pub struct $name:ident {
-            $( $(#[$fmeta:meta])* pub $field:ident : $ty:ty => $glsl:literal ),* $(,)?
+            $( $(#[$fmeta:meta])* pub $field:ident : $ty:ty => $glsl:tt ),* $(,)?
         }
     ) => {
         $(#[$meta])*
@@ -106,11 +137,15 @@ macro_rules! gpu_struct {
         impl $crate::layout::GpuStruct for $name {
             const NAME: &'static str = stringify!($name);
             fn fields() -> Vec<$crate::layout::Field> {
-                vec![$($crate::layout::Field {
-                    name: stringify!($field),
-                    glsl: $glsl,
-                    offset: std::mem::offset_of!($name, $field),
-                    size: std::mem::size_of::<$ty>(),
+                vec![$({
+                    let (glsl, std430) = $crate::__gpu_field_type!($ty, $glsl);
+                    $crate::layout::Field {
+                        name: stringify!($field),
+                        glsl,
+                        offset: std::mem::offset_of!($name, $field),
+                        size: std::mem::size_of::<$ty>(),
+                        std430,
+                    }
                 }),*]
             }
         }

@@ -1,5 +1,5 @@
-//! One frame rendered with the irradiance cache (`--method ic`): its settings and figures, and
-//! [`render_ic`]; the frame's passes and phases are in [`IcRenderer`] (`ic_renderer.rs`).
+//! The settings and figures of a frame rendered with the irradiance cache (`--method ic`); the
+//! frame itself is [`crate::IcRenderer`] (`frame/ic.rs`).
 //!
 //! Anti-aliasing: `sub_frames` jittered sub-frames (the centre, then the R2 sequence) are
 //! composited and averaged, which box-filters edges like the reference. Records persist across
@@ -7,16 +7,8 @@
 //! and only fill the holes their jitter uncovers.
 
 use std::collections::BTreeMap;
-use std::time::Instant;
 
 use radcache_cache::IcParams;
-use radcache_scene::Scene;
-use radcache_vk::{Context, ShaderCompiler};
-
-use crate::error::Result;
-use crate::gpu_scene::GpuScene;
-use crate::ic_renderer::IcRenderer;
-use crate::render::{FrameOutput, Progress};
 
 /// Settings of one frame rendered with the cache.
 #[derive(Debug, Clone, PartialEq)]
@@ -109,7 +101,7 @@ pub struct IcStats {
     /// Ray queries of the look-ahead evaluations of the frame's new and expired records at the
     /// next frame's time (part of `record_rays`).
     pub lookahead_rays: u64,
-    /// Wall time of each phase of the frame, s: `pipelines` (creating the passes, [`render_ic`]
+    /// Wall time of each phase of the frame, s: `pipelines` (creating the passes, [`crate::render_ic`]
     /// only), `setup`, `cache_gbuffer`, `hole_selection`, `record_creation`, `shade`
     /// (G-buffer, direct, splat, composite), `emission`, `readback` (summed over sub-frames).
     /// Host-measured, so it holds on drivers whose timestamps miss asynchronous compute work.
@@ -147,25 +139,6 @@ pub fn sub_frame_jitter(k: u32) -> [f32; 2] {
         (0.5 - (0.5 + a1 * n).fract()) as f32,
         (0.5 - (0.5 + a2 * n).fract()) as f32,
     ]
-}
-
-/// Renders `scene` at `settings.time` with the irradiance cache, from an empty cache (a
-/// sequence keeps an [`IcRenderer`] instead, to create the pipelines once and keep records).
-pub fn render_ic(
-    ctx: &Context,
-    shaders: &ShaderCompiler,
-    scene: &Scene,
-    gpu: &mut GpuScene,
-    settings: &IcSettings,
-    progress: &mut dyn FnMut(Progress),
-) -> Result<(FrameOutput, IcStats)> {
-    let start = Instant::now();
-    let mut renderer = IcRenderer::new(ctx, shaders, gpu, settings)?;
-    let pipelines_s = start.elapsed().as_secs_f64();
-    let (mut out, mut stats) = renderer.render(ctx, scene, gpu, settings, progress)?;
-    out.time_s += pipelines_s;
-    stats.phases_s.insert("pipelines".into(), pipelines_s);
-    Ok((out, stats))
 }
 
 #[cfg(test)]

@@ -1,35 +1,17 @@
-//! The irradiance cache's GPU state: the record buffer, the request list and the counters with the
-//! indirect arguments (`IcCounters`), plus the bookkeeping pass `shaders/passes/ic_counters.comp`
-//! that keeps the counters consistent on the GPU, so the host never reads a count to size a
-//! dispatch or a draw.
+//! The irradiance cache's GPU state: the record buffer, the request list, the neighbour grid, the
+//! records' temporal state and the counters with the indirect arguments (`IcCounters`), which the
+//! bookkeeping pass ([`crate::passes::ic_counters`]) keeps consistent on the GPU, so the host never
+//! reads a count to size a dispatch or a draw.
 
-use bytemuck::{Pod, Zeroable};
-use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal, IcCounters};
+use radcache_shared::gpu::{DrawArgs, GpuRecord, GpuRecordTemporal, IcCounters};
 use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, MemoryLocation, Pipeline,
-    Recorder, Resource, ShaderCompiler,
+    vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Recorder, ShaderCompiler,
 };
 
-use crate::bindings::PASS_BASE;
 use crate::error::Result;
+use crate::passes::ic_counters::{CounterStep, IcCountersPass};
 
-/// The bookkeeping shader, relative to `shaders/`.
-pub const SHADER: &str = "passes/ic_counters.comp";
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct Push {
-    mode: u32,
-    record_capacity: u32,
-    request_capacity: u32,
-    pad: u32,
-}
-
-/// Levels of the neighbour grid (`LEVELS` in `shaders/passes/neighbours.comp`): cell sizes from
-/// 2^level_max down to 2^(level_max − 11); smaller radii use the finest level.
-pub const GRID_LEVELS: u32 = 12;
-/// Grid entries per record: one in table A, one per level in table B.
-pub const GRID_SLOTS: u32 = GRID_LEVELS + 1;
+pub use radcache_shared::consts::{GRID_LEVELS, GRID_SLOTS};
 
 /// Buckets of the neighbour grid for `record_capacity` records: the power of two at or above
 /// four per record (lists stay short), at least 1024.
@@ -41,18 +23,9 @@ pub fn grid_buckets(record_capacity: u32) -> u32 {
         .max(1024)
 }
 
-/// Bookkeeping steps (see the shader).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Mode {
-    Reset = 0,
-    BeginLevel = 1,
-    BeginBatch = 2,
-    EndBatch = 3,
-}
-
 /// Records, requests and counters of one cache.
 pub struct IcState {
-    pipeline: Pipeline,
+    bookkeeping: IcCountersPass,
     /// `GpuRecord[record_capacity]`.
     pub records: Buffer,
     /// Pixel indices of requested records, `uint[request_capacity]`.
@@ -91,15 +64,7 @@ impl IcState {
         record_capacity: u32,
         request_capacity: u32,
     ) -> Result<IcState> {
-        let spirv = shaders.compile(SHADER, &[])?;
-        let bindings = [BindingLayout::new(PASS_BASE, BindingKind::StorageBuffer)];
-        let pipeline = Pipeline::compute(
-            ctx,
-            "ic_counters",
-            &spirv,
-            &bindings,
-            std::mem::size_of::<Push>() as u32,
-        )?;
+        let bookkeeping = IcCountersPass::new(ctx, shaders)?;
         let buffer = |name, size: u64, usage, location| {
             Buffer::new(
                 ctx,
@@ -114,7 +79,7 @@ impl IcState {
         };
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         Ok(IcState {
-            pipeline,
+            bookkeeping,
             records: buffer(
                 "ic.records",
                 u64::from(record_capacity) * std::mem::size_of::<GpuRecord>() as u64,
@@ -167,45 +132,32 @@ impl IcState {
         self.record_capacity
     }
 
-    fn step(&self, rec: &mut Recorder, mode: Mode) -> Result<()> {
-        let push = Push {
-            mode: mode as u32,
-            record_capacity: self.record_capacity,
-            request_capacity: self.request_capacity,
-            pad: 0,
-        };
-        rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
-        rec.bind_pipeline(&self.pipeline);
-        rec.push_bindings(&[(PASS_BASE, Resource::Buffer(&self.counters))]);
-        rec.push_constants(&push);
-        rec.dispatch(1, 1, 1)?;
-        rec.barrier(
-            Access::COMPUTE_WRITE,
-            Access::ALL.union(Access::INDIRECT).union(Access::HOST_READ),
-        );
-        Ok(())
+    fn step(&self, rec: &mut Recorder, step: CounterStep) -> Result<()> {
+        let capacities = (self.record_capacity, self.request_capacity);
+        self.bookkeeping
+            .record(rec, &self.counters, step, capacities)
     }
 
     /// Records forgetting every record (the start of a frame without reuse).
     pub fn record_reset(&self, rec: &mut Recorder) -> Result<()> {
         rec.barrier(Access::ALL, Access::TRANSFER_WRITE);
         rec.fill_buffer(&self.last_used, 0, vk::WHOLE_SIZE, 0);
-        self.step(rec, Mode::Reset)
+        self.step(rec, CounterStep::Reset)
     }
 
     /// Records the start of a creation level (no requests, hole count 0).
     pub fn record_begin_level(&self, rec: &mut Recorder) -> Result<()> {
-        self.step(rec, Mode::BeginLevel)
+        self.step(rec, CounterStep::BeginLevel)
     }
 
     /// Records turning the requests into the record pass's indirect dispatch.
     pub fn record_begin_batch(&self, rec: &mut Recorder) -> Result<()> {
-        self.step(rec, Mode::BeginBatch)
+        self.step(rec, CounterStep::BeginBatch)
     }
 
     /// Records adding the batch to the record count and the splat draw.
     pub fn record_end_batch(&self, rec: &mut Recorder) -> Result<()> {
-        self.step(rec, Mode::EndBatch)
+        self.step(rec, CounterStep::EndBatch)
     }
 
     /// Keeps the records `keep` selects (by index and last use) and drops the others, moving the
@@ -213,7 +165,7 @@ impl IcState {
     /// rebuild the neighbour grid afterwards. Rare (eviction), so it goes through the host.
     pub fn compact(&self, ctx: &Context, keep: impl Fn(usize, u32) -> bool) -> Result<u32> {
         let counters = self.read_counters()?;
-        let count = counters.counts[0].min(self.record_capacity) as usize;
+        let count = counters.record_count.min(self.record_capacity) as usize;
         if count == 0 {
             return Ok(0);
         }
@@ -252,11 +204,11 @@ impl IcState {
             0,
         );
         let mut c = counters;
-        c.counts[0] = n;
-        c.counts[2] = n;
-        c.dispatch[0] = 0;
-        c.draw[1] = n;
-        c.batch_draw = [6, 0, 0, 0];
+        c.record_count = n;
+        c.batch_first = n;
+        c.dispatch.x = 0;
+        c.draw = DrawArgs::quads(n, 0);
+        c.batch_draw = DrawArgs::quads(0, 0);
         rec.update_buffer(&self.counters, 0, std::slice::from_ref(&c));
         rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
         ctx.submit(rec)?.wait()?;

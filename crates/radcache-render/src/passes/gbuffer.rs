@@ -10,7 +10,6 @@
 //! sample, so the sample sees the floor behind the wall) replaces it, so the G-buffer never holds
 //! a point the camera cannot see (the stiff suite's `two_rooms`).
 
-use bytemuck::{Pod, Zeroable};
 use radcache_vk::{
     vk, ColorTarget, Context, DepthState, DepthTarget, GraphicsDesc, ImageUse, Pipeline, Recorder,
     ShaderCompiler,
@@ -18,15 +17,22 @@ use radcache_vk::{
 
 use crate::bindings::SCENE;
 use crate::error::Result;
-use crate::gbuffer::{GBuffer, DEPTH_FORMAT, GBUFFER_FORMAT};
-use crate::gpu_scene::GpuScene;
+use crate::scene::GpuScene;
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct Push {
-    instance: u32,
-    pad: u32,
-    jitter: [f32; 2],
+mod images;
+
+pub use images::{GBuffer, DEPTH_FORMAT, GBUFFER_BINDINGS, GBUFFER_FORMAT};
+
+radcache_shared::gpu_struct! {
+    /// The push constants of the pass (`GBufferPush` in GLSL).
+    pub struct GBufferPush {
+        /// Instance.
+        pub instance: u32 => "uint",
+        /// Padding.
+        pub pad: u32 => "uint",
+        /// Jitter.
+        pub jitter: [f32; 2] => "vec2",
+    }
 }
 
 /// The G-buffer pipeline.
@@ -52,7 +58,7 @@ impl GBufferPass {
                 vertex: &vertex,
                 fragment: &fragment,
                 bindings: &SCENE,
-                push_constant_size: std::mem::size_of::<Push>() as u32,
+                push_constant_size: std::mem::size_of::<GBufferPush>() as u32,
                 color_formats: &[GBUFFER_FORMAT; 5],
                 depth: Some(DepthState {
                     format: DEPTH_FORMAT,
@@ -105,7 +111,7 @@ impl GBufferPass {
             rec.bind_pipeline(&self.pipeline);
             rec.push_bindings(&bindings);
             for &(instance, triangles) in &draws {
-                rec.push_constants(&Push {
+                rec.push_constants(&GBufferPush {
                     instance,
                     pad: 0,
                     jitter,

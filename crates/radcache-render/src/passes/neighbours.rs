@@ -5,30 +5,25 @@
 //! record). The result equals the all-pairs clamp (see the shader), at a cost that grows with the
 //! number of nearby records instead of with all records.
 
-use bytemuck::{Pod, Zeroable};
-use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, Context, Pipeline, Recorder, Resource, ShaderCompiler,
-};
+use radcache_vk::{vk, Access, Context, Pipeline, Recorder, Resource, ShaderCompiler};
 
-use crate::bindings::PASS_BASE;
+use crate::bindings::neighbours as b;
 use crate::error::Result;
-use crate::ic_state::IcState;
+use crate::state::IcState;
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct Push {
-    mode: u32,
-    level_max: i32,
-    pad: [u32; 2],
+radcache_shared::gpu_struct! {
+    /// The push constants of the pass (`NeighboursPush` in GLSL).
+    pub struct NeighboursPush {
+        /// Step.
+        pub step: u32 => "uint",
+        /// Level max.
+        pub level_max: i32 => "int",
+        /// Padding.
+        pub pad: [u32; 2] => "uvec2",
+    }
 }
 
-/// The shader's steps.
-#[derive(Clone, Copy)]
-enum Mode {
-    InsertOld = 0,
-    InsertBatch = 1,
-    Clamp = 2,
-}
+use radcache_shared::consts::NeighbourStep as Mode;
 
 /// The neighbour-clamping pipeline.
 pub struct NeighbourPass {
@@ -57,15 +52,13 @@ impl NeighbourPass {
     /// Compiles the pass.
     pub fn new(ctx: &Context, shaders: &ShaderCompiler) -> Result<NeighbourPass> {
         let spirv = shaders.compile("passes/neighbours.comp", &[])?;
-        let bindings: Vec<BindingLayout> = (0..5)
-            .map(|k| BindingLayout::new(PASS_BASE + k, BindingKind::StorageBuffer))
-            .collect();
+        let bindings = b::layout();
         let pipeline = Pipeline::compute(
             ctx,
             "neighbours",
             &spirv,
             &bindings,
-            std::mem::size_of::<Push>() as u32,
+            std::mem::size_of::<NeighboursPush>() as u32,
         )?;
         Ok(NeighbourPass { pipeline })
     }
@@ -73,14 +66,14 @@ impl NeighbourPass {
     fn bind(&self, rec: &mut Recorder, state: &IcState, mode: Mode, scene_scale: f32) {
         rec.bind_pipeline(&self.pipeline);
         rec.push_bindings(&[
-            (PASS_BASE, Resource::Buffer(&state.counters)),
-            (PASS_BASE + 1, Resource::Buffer(&state.records)),
-            (PASS_BASE + 2, Resource::Buffer(&state.records)),
-            (PASS_BASE + 3, Resource::Buffer(&state.grid_heads)),
-            (PASS_BASE + 4, Resource::Buffer(&state.grid_next)),
+            (b::COUNTERS, Resource::Buffer(&state.counters)),
+            (b::RECORDS, Resource::Buffer(&state.records)),
+            (b::RECORD_WORDS, Resource::Buffer(&state.records)),
+            (b::HEADS, Resource::Buffer(&state.grid_heads)),
+            (b::NEXT, Resource::Buffer(&state.grid_next)),
         ]);
-        rec.push_constants(&Push {
-            mode: mode as u32,
+        rec.push_constants(&NeighboursPush {
+            step: mode as u32,
             level_max: grid_level_max(scene_scale),
             pad: [0; 2],
         });

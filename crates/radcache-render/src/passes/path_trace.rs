@@ -6,25 +6,28 @@
 //! `sample_count` samples per pixel, and [`PathTracer::chunk_size`] adapts that count so one
 //! submission stays short (drivers, lavapipe included, kill long dispatches).
 
-use bytemuck::{Pod, Zeroable};
 use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, MemoryLocation, Pipeline,
-    Recorder, Resource, ShaderCompiler,
+    vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
+    ShaderCompiler,
 };
 
-use crate::bindings::{with_scene, PASS_BASE};
+use crate::bindings::path_trace as b;
 use crate::error::Result;
-use crate::gpu_scene::GpuScene;
+use crate::scene::GpuScene;
 
 /// The shader, relative to `shaders/`.
 pub const SHADER: &str = "passes/path_trace.comp";
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct Push {
-    sample_start: u32,
-    sample_count: u32,
-    pad: [u32; 2],
+radcache_shared::gpu_struct! {
+    /// The push constants of the pass (`PathTracePush` in GLSL).
+    pub struct PathTracePush {
+        /// Sample start.
+        pub sample_start: u32 => "uint",
+        /// Sample count.
+        pub sample_count: u32 => "uint",
+        /// Padding.
+        pub pad: [u32; 2] => "uvec2",
+    }
 }
 
 /// Accumulation state and pipeline of the path tracer for one image size.
@@ -58,17 +61,13 @@ impl PathTracer {
         height: u32,
     ) -> Result<PathTracer> {
         let spirv = shaders.compile(SHADER, &scene.defines())?;
-        let bindings = with_scene(&[
-            BindingLayout::new(PASS_BASE, BindingKind::StorageBuffer),
-            BindingLayout::new(PASS_BASE + 1, BindingKind::StorageBuffer),
-            BindingLayout::new(PASS_BASE + 2, BindingKind::StorageBuffer),
-        ]);
+        let bindings = b::layout();
         let pipeline = Pipeline::compute(
             ctx,
             "path_trace",
             &spirv,
             &bindings,
-            std::mem::size_of::<Push>() as u32,
+            std::mem::size_of::<PathTracePush>() as u32,
         )?;
         let pixels = u64::from(width) * u64::from(height);
         let accum_desc = |name| BufferDesc {
@@ -123,16 +122,18 @@ impl PathTracer {
     ) -> Result<()> {
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
         rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
-        let push = Push {
+        let push = PathTracePush {
             sample_start: self.samples,
             sample_count: count,
             pad: [0; 2],
         };
         let (w, h) = (self.width, self.height);
         let mut bindings = scene.bindings();
-        bindings.push((PASS_BASE, Resource::Buffer(&self.accum)));
-        bindings.push((PASS_BASE + 1, Resource::Buffer(&self.compensation)));
-        bindings.push((PASS_BASE + 2, Resource::Buffer(&self.rays)));
+        bindings.extend([
+            (b::ACCUM, Resource::Buffer(&self.accum)),
+            (b::COMPENSATION, Resource::Buffer(&self.compensation)),
+            (b::RAY_COUNT, Resource::Buffer(&self.rays)),
+        ]);
         let pipeline = &self.pipeline;
         rec.pass("path_trace", |rec| {
             rec.bind_pipeline(pipeline);

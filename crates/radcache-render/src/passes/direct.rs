@@ -1,26 +1,28 @@
 //! Direct lighting of the cache's frame (`shaders/passes/direct.comp`): next-event estimation with
 //! MIS per surface pixel, compiled with the plan's defines (only the scene's light sources).
 
-use bytemuck::{Pod, Zeroable};
 use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, MemoryLocation, Pipeline,
-    Recorder, Resource, ShaderCompiler,
+    vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
+    ShaderCompiler,
 };
 
-use crate::bindings::with_scene;
+use crate::bindings::direct as b;
 use crate::error::Result;
-use crate::gbuffer::{GBuffer, GBUFFER_BINDINGS};
-use crate::gpu_scene::GpuScene;
+use crate::passes::gbuffer::GBuffer;
+use crate::scene::GpuScene;
 
-const RAYS: u32 = crate::bindings::PASS_BASE + GBUFFER_BINDINGS;
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct Push {
-    samples: u32,
-    seed: u32,
-    first_sample: u32,
-    pad: u32,
+radcache_shared::gpu_struct! {
+    /// The push constants of the pass (`DirectPush` in GLSL).
+    pub struct DirectPush {
+        /// Samples.
+        pub samples: u32 => "uint",
+        /// Seed.
+        pub seed: u32 => "uint",
+        /// First sample.
+        pub first_sample: u32 => "uint",
+        /// Padding.
+        pub pad: u32 => "uint",
+    }
 }
 
 /// The direct-lighting pipeline and its ray counter.
@@ -39,14 +41,12 @@ impl DirectPass {
     /// Compiles the pass for `scene`'s plan.
     pub fn new(ctx: &Context, shaders: &ShaderCompiler, scene: &GpuScene) -> Result<DirectPass> {
         let spirv = shaders.compile("passes/direct.comp", &scene.defines())?;
-        let mut pass = GBuffer::layout().to_vec();
-        pass.push(BindingLayout::new(RAYS, BindingKind::StorageBuffer));
         let pipeline = Pipeline::compute(
             ctx,
             "direct",
             &spirv,
-            &with_scene(&pass),
-            std::mem::size_of::<Push>() as u32,
+            &b::layout(),
+            std::mem::size_of::<DirectPush>() as u32,
         )?;
         let rays = Buffer::new(
             ctx,
@@ -77,8 +77,8 @@ impl DirectPass {
         rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
         let mut bindings = scene.bindings();
         bindings.extend(gbuffer.bindings());
-        bindings.push((RAYS, Resource::Buffer(&self.rays)));
-        let push = Push {
+        bindings.push((b::RAY_COUNT, Resource::Buffer(&self.rays)));
+        let push = DirectPush {
             samples: samples.max(1),
             seed,
             first_sample,

@@ -3,86 +3,87 @@
 //! the request count), M×N stratified gather rays each, the record formed as
 //! `radcache_cache::compute_record` + `finalize_radius` do (the shader's header has the details).
 //!
-//! Bindings, after the scene's and the G-buffer's (`PASS_BASE + 0..5`), from
-//! [`RECORD_BINDINGS_BASE`] (`B_GBUFFER_END` in GLSL):
+//! Bindings (`bindings::record`), after the scene's and the G-buffer's:
 //!
-//! - `+0` requests: `uint[]` pixel indices `y·width + x`;
-//! - `+1` `IcCounters`: request `i < min(counts.y, limits.y)` creates record `counts.z + i`; the
-//!   indirect dispatch is read at [`DISPATCH_OFFSET`]; `limits.z`/`limits.w` count dropped
-//!   requests and rejected records;
-//! - `+2` `GpuRecord[]`;
-//! - `+3` the ray count (`uint`, host-readable, [`RecordPass::rays`]);
-//! - `+4` the optional sample dump, `vec4[]` of `(L_jk, r_jk)`
+//! - `REQUESTS`: `uint[]` pixel indices `y·width + x` (or record indices);
+//! - `COUNTERS`: `IcCounters`: request `i < min(requested, request_capacity)` creates record
+//!   `batch_first + i`; the indirect dispatch is read at [`DISPATCH_OFFSET`];
+//!   `dropped_requests`/`rejected_records` count dropped requests and rejected records;
+//! - `RECORDS`: `GpuRecord[]`;
+//! - `RAY_COUNT`: the ray count (`uint`, host-readable, [`RecordPass::rays`]);
+//! - `SAMPLES`: the optional sample dump, `vec4[]` of `(L_jk, r_jk)`
 //!   ([`RecordPass::record_with_samples`]).
 //!
-//! Push constants (48 bytes): `M`, `N`, seed, level | sub-frame << 16 (u32), then `min_px`,
-//! `max_px` (R⁻/R⁺ as validity radii in pixel footprints), the validity scale
-//! (`IcParams::validity_scale`) and `r_eps` relative to the scene scale (f32), then the source
-//! (0: pixel requests; 1: record indices to refresh in place, [`RecordPass::record_refresh`]).
+//! Push constants ([`RecordPush`], 48 bytes): `M`, `N`, seed, level | sub-frame << 16, then
+//! `min_px`, `max_px` (R⁻/R⁺ as validity radii in pixel footprints), the validity scale
+//! (`IcParams::validity_scale`) and `r_eps` relative to the scene scale, then the source
+//! ([`RecordSource`]: pixel requests, or record indices evaluated again,
+//! [`RecordPass::record_refresh`]).
 
-use bytemuck::{Pod, Zeroable};
 use radcache_cache::sampling::ircache_hash;
 use radcache_cache::IcParams;
 use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, ImageUse, MemoryLocation,
-    Pipeline, Recorder, Resource, ShaderCompiler,
+    vk, Access, Buffer, BufferDesc, Context, ImageUse, MemoryLocation, Pipeline, Recorder,
+    Resource, ShaderCompiler,
 };
 
-use crate::bindings::{with_scene, PASS_BASE};
+use crate::bindings::record as b;
 use crate::error::{Error, Result};
-use crate::gbuffer::{GBuffer, GBUFFER_BINDINGS};
-use crate::gpu_scene::GpuScene;
+use crate::passes::gbuffer::GBuffer;
+use crate::scene::GpuScene;
+use radcache_shared::consts::{RecordSource, SEED_SUB_FRAME_MUL};
+use radcache_shared::gpu::IcCounters;
 
 /// The shader, relative to `shaders/`.
 pub const SHADER: &str = "passes/record.comp";
-/// First binding of the pass's own resources (`B_GBUFFER_END` in GLSL).
-pub const RECORD_BINDINGS_BASE: u32 = PASS_BASE + GBUFFER_BINDINGS;
-/// Most strata a record may have (the shader's shared-memory arrays).
-pub const MAX_STRATA: u32 = 1728;
+/// First binding of the pass's own resources (`B_RECORD_REQUESTS` in GLSL).
+pub const RECORD_BINDINGS_BASE: u32 = b::REQUESTS;
 /// Distances at or below this fraction of the scene's size are invalid samples (self-hits).
 pub const R_EPS_REL: f32 = 1.0e-5;
-/// Byte offset of the `VkDispatchIndirectCommand` in `IcCounters`.
-pub const DISPATCH_OFFSET: u64 = 16;
+/// Byte offset of the record pass's `VkDispatchIndirectCommand` in `IcCounters`.
+pub const DISPATCH_OFFSET: u64 = std::mem::offset_of!(IcCounters, dispatch) as u64;
 
-/// `info.w`: the irradiance was not storable (`irradiance_is_valid`); the record is rejected.
-pub const RECORD_FLAG_INVALID_IRRADIANCE: u32 = 1;
-/// `info.w`: the requested pixel has no surface; the record is rejected.
-pub const RECORD_FLAG_NO_SURFACE: u32 = 2;
-/// `info.w`: `R_orig < R⁻` (the radius was raised; the gradient is attenuated).
-pub const RECORD_FLAG_CLAMPED_UP: u32 = 4;
-/// `info.w`: `R_orig > R⁺` (the radius was lowered).
-pub const RECORD_FLAG_CLAMPED_DOWN: u32 = 8;
-/// `info.w`: some gather directions fell below the geometric surface and were mirrored into it.
-pub const RECORD_FLAG_FOLDED: u32 = 16;
-/// `info.w`'s flag bits; the bits above hold 1 + the record's mesh instance
-/// ([`RECORD_INSTANCE_SHIFT`]; 0 for a rejected record).
-pub const RECORD_FLAGS_MASK: u32 = 0xff;
-/// Shift of `1 + instance` in `info.w`.
-pub const RECORD_INSTANCE_SHIFT: u32 = 8;
+pub use radcache_shared::consts::{
+    MAX_STRATA, RECORD_FLAGS_MASK, RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP,
+    RECORD_FLAG_FOLDED, RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE,
+    RECORD_INSTANCE_SHIFT,
+};
 
-/// Push constants of `record.comp` (48 bytes).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct Push {
-    m: u32,
-    n: u32,
-    seed: u32,
-    /// Level in the low 16 bits, sub-frame in the high 16 bits.
-    level_subframe: u32,
-    min_px: f32,
-    max_px: f32,
-    v_scale: f32,
-    r_eps_rel: f32,
-    /// 0: requests are pixels (new records); 1: requests are record indices (refresh in place).
-    source: u32,
-    pad: [u32; 3],
+radcache_shared::gpu_struct! {
+    /// The push constants of the pass (`RecordPush` in GLSL).
+    pub struct RecordPush {
+        /// M.
+        pub m: u32 => "uint",
+        /// N.
+        pub n: u32 => "uint",
+        /// Seed.
+        pub seed: u32 => "uint",
+        /// Level in the low 16 bits, sub-frame in the high 16 bits.
+        pub level_subframe: u32 => "uint",
+        /// Min px.
+        pub min_px: f32 => "float",
+        /// Max px.
+        pub max_px: f32 => "float",
+        /// V scale.
+        pub v_scale: f32 => "float",
+        /// R eps rel.
+        pub r_eps_rel: f32 => "float",
+        /// 0: requests are pixels (new records); 1: requests are record indices (refresh in place).
+        pub source: u32 => "uint",
+        /// Padding.
+        pub pad0: u32 => "uint",
+        /// Padding.
+        pub pad1: u32 => "uint",
+        /// Padding.
+        pub pad2: u32 => "uint",
+    }
 }
 
 /// The pass seed of the records created for sub-frame `sub_frame` of a frame rendered with
 /// `seed` (`IcRenderer`); `record.comp` recomputes it from a record's stored sub-frame when it
 /// refreshes the record, so a refresh draws the record's own directions and paths again.
 pub fn creation_seed(seed: u32, sub_frame: u32) -> u32 {
-    seed.wrapping_mul(0x9e37_79b9) ^ sub_frame
+    seed.wrapping_mul(SEED_SUB_FRAME_MUL) ^ sub_frame
 }
 
 /// Seed of the jitter of the record created at `pixel_index` with the pass seed `seed`: stratum
@@ -132,19 +133,12 @@ impl RecordPass {
             )));
         }
         let spirv = shaders.compile(SHADER, &scene.defines())?;
-        let mut pass = GBuffer::layout().to_vec();
-        for i in 0..5 {
-            pass.push(BindingLayout::new(
-                RECORD_BINDINGS_BASE + i,
-                BindingKind::StorageBuffer,
-            ));
-        }
         let pipeline = Pipeline::compute(
             ctx,
             "records",
             &spirv,
-            &with_scene(&pass),
-            std::mem::size_of::<Push>() as u32,
+            &b::layout(),
+            std::mem::size_of::<RecordPush>() as u32,
         )?;
         let buffer = |name, location| {
             Buffer::new(
@@ -173,7 +167,8 @@ impl RecordPass {
     }
 
     /// Records computing the pending batch in a pass named `records`: request `i` of `requests`
-    /// (`i < min(counts.y, limits.y)` of `counters`) becomes record `counts.z + i` of `records`;
+    /// (`i < min(requested, request_capacity)` of `counters`) becomes record `batch_first + i` of
+    /// `records`;
     /// one workgroup per request, dispatched from `counters`' indirect arguments (which must be
     /// visible to indirect reads). `level` and `sub_frame` are stored in the record's `info`;
     /// `seed` selects the jitter ([`record_seed`]).
@@ -205,7 +200,7 @@ impl RecordPass {
     }
 
     /// Records refreshing records in place (temporal caching, IC reference §11.2 step 6): request
-    /// `i` of `requests` (`i < min(counts.y, limits.y)`, dispatched from `counters`) is a record
+    /// `i` of `requests` (`i < min(requested, request_capacity)`, dispatched from `counters`) is a record
     /// index; that record is computed again at its own point, normal and footprint, with its own
     /// pixel, level and sub-frame, and the pass seed [`creation_seed`]`(frame_seed, sub-frame)`,
     /// so under unchanged lighting its irradiance and gradients come out bit for bit as they were
@@ -228,7 +223,16 @@ impl RecordPass {
             records,
             samples: &self.no_samples,
         };
-        self.record_io(rec, scene, gbuffer, &io, 0, 0, frame_seed, 1)
+        self.record_io(
+            rec,
+            scene,
+            gbuffer,
+            &io,
+            0,
+            0,
+            frame_seed,
+            RecordSource::Records,
+        )
     }
 
     /// As [`RecordPass::record`], and request `i` also writes the samples of its strata,
@@ -254,7 +258,16 @@ impl RecordPass {
             records,
             samples,
         };
-        self.record_io(rec, scene, gbuffer, &io, level, sub_frame, seed, 0)
+        self.record_io(
+            rec,
+            scene,
+            gbuffer,
+            &io,
+            level,
+            sub_frame,
+            seed,
+            RecordSource::Pixels,
+        )
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -267,7 +280,7 @@ impl RecordPass {
         level: u32,
         sub_frame: u32,
         seed: u32,
-        source: u32,
+        source: RecordSource,
     ) -> Result<()> {
         if level > 0xffff || sub_frame > 0xffff {
             return Err(Error::Invalid(format!(
@@ -275,7 +288,7 @@ impl RecordPass {
             )));
         }
         let p = &self.params;
-        let push = Push {
+        let push = RecordPush {
             m: p.strata_m,
             n: p.strata_n,
             seed,
@@ -284,22 +297,25 @@ impl RecordPass {
             max_px: p.max_spacing_px,
             v_scale: p.validity_scale(),
             r_eps_rel: R_EPS_REL,
-            source,
-            pad: [0; 3],
+            source: source as u32,
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         };
         for image in gbuffer.images() {
             rec.use_image(image, ImageUse::ComputeStorage);
         }
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
         rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
-        let base = RECORD_BINDINGS_BASE;
         let mut bindings = scene.bindings();
         bindings.extend(gbuffer.bindings());
-        bindings.push((base, Resource::Buffer(io.requests)));
-        bindings.push((base + 1, Resource::Buffer(io.counters)));
-        bindings.push((base + 2, Resource::Buffer(io.records)));
-        bindings.push((base + 3, Resource::Buffer(&self.rays)));
-        bindings.push((base + 4, Resource::Buffer(io.samples)));
+        bindings.extend([
+            (b::REQUESTS, Resource::Buffer(io.requests)),
+            (b::COUNTERS, Resource::Buffer(io.counters)),
+            (b::RECORDS, Resource::Buffer(io.records)),
+            (b::RAY_COUNT, Resource::Buffer(&self.rays)),
+            (b::SAMPLES, Resource::Buffer(io.samples)),
+        ]);
         rec.pass("records", |rec| {
             rec.bind_pipeline(&self.pipeline);
             rec.push_bindings(&bindings);

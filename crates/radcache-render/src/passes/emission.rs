@@ -3,14 +3,14 @@
 //! like the reference's instead of being quantised by the few sub-frame jitters.
 
 use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, MemoryLocation, Pipeline,
-    Recorder, Resource, ShaderCompiler,
+    vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
+    ShaderCompiler,
 };
 
-use crate::bindings::{with_scene, PASS_BASE};
-use crate::composite::CompositePass;
+use crate::bindings::emission as b;
 use crate::error::Result;
-use crate::gpu_scene::GpuScene;
+use crate::passes::composite::CompositePass;
+use crate::scene::GpuScene;
 
 /// The emission pipeline and its ray counter.
 pub struct EmissionPass {
@@ -28,12 +28,7 @@ impl EmissionPass {
     /// Compiles the pass.
     pub fn new(ctx: &Context, shaders: &ShaderCompiler, scene: &GpuScene) -> Result<EmissionPass> {
         let spirv = shaders.compile("passes/emission.comp", &scene.defines())?;
-        let pass = [
-            BindingLayout::new(PASS_BASE, BindingKind::StorageBuffer),
-            BindingLayout::new(PASS_BASE + 1, BindingKind::StorageBuffer),
-            BindingLayout::new(PASS_BASE + 2, BindingKind::StorageBuffer),
-        ];
-        let pipeline = Pipeline::compute(ctx, "emission", &spirv, &with_scene(&pass), 0)?;
+        let pipeline = Pipeline::compute(ctx, "emission", &spirv, &b::layout(), 0)?;
         let rays = Buffer::new(
             ctx,
             &BufferDesc {
@@ -58,9 +53,14 @@ impl EmissionPass {
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
         rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
         let mut bindings = scene.bindings();
-        bindings.push((PASS_BASE, Resource::Buffer(&composite.accum)));
-        bindings.push((PASS_BASE + 1, Resource::Buffer(&composite.emission_accum)));
-        bindings.push((PASS_BASE + 2, Resource::Buffer(&self.rays)));
+        bindings.extend([
+            (b::ACCUM, Resource::Buffer(&composite.accum)),
+            (
+                b::EMISSION_ACCUM,
+                Resource::Buffer(&composite.emission_accum),
+            ),
+            (b::RAY_COUNT, Resource::Buffer(&self.rays)),
+        ]);
         let (w, h) = composite.size();
         rec.pass("emission", |rec| {
             rec.bind_pipeline(&self.pipeline);

@@ -6,11 +6,11 @@ use std::time::Instant;
 use radcache_scene::Scene;
 use radcache_vk::{Context, ShaderCompiler};
 
-use crate::aov::{AovPass, Aovs};
-use crate::clock::{FrameClock, Span};
 use crate::error::{Error, Result};
-use crate::gpu_scene::GpuScene;
-use crate::path_trace::PathTracer;
+use crate::frame::clock::{FrameClock, Span};
+use crate::passes::aov::{AovPass, Aovs};
+use crate::passes::path_trace::PathTracer;
+use crate::scene::GpuScene;
 
 /// When to stop sampling.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -18,12 +18,16 @@ use radcache_vk::{
     TlasUpdate,
 };
 
-use crate::env_map::{gpu_alias, EnvMap};
 use crate::error::Result;
-use crate::scene_lights::{gpu_emitters, gpu_lights};
-use crate::scene_pack::{pack_geometry, pack_materials, PackedGeometry};
-use crate::upload::{cols, host_buffer, rows3x4, storage};
+use crate::scene::env_map::{gpu_alias, EnvMap};
+use crate::scene::lights::{gpu_emitters, gpu_lights};
+use crate::scene::pack::{pack_geometry, pack_materials, PackedGeometry};
+use crate::scene::upload::{cols, host_buffer, rows3x4, storage};
 
+pub(crate) mod env_map;
+pub(crate) mod lights;
+pub(crate) mod pack;
+pub(crate) mod upload;
 mod view;
 
 /// A full TLAS rebuild after this many refits.

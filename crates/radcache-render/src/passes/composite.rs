@@ -9,26 +9,27 @@
 //! [`crate::EmissionPass`], which adds the box-filtered emission), the debug accumulator and the
 //! splat record count. A non-finite value is replaced by 0 and counted.
 
-use bytemuck::{Pod, Zeroable};
 use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, ImageUse, MemoryLocation,
-    Pipeline, Recorder, Resource, ShaderCompiler,
+    vk, Access, Buffer, BufferDesc, Context, ImageUse, MemoryLocation, Pipeline, Recorder,
+    Resource, ShaderCompiler,
 };
 
-use crate::bindings::{with_scene, PASS_BASE};
+use crate::bindings::composite as b;
 use crate::error::Result;
-use crate::gbuffer::{GBuffer, GBUFFER_BINDINGS};
-use crate::gpu_scene::GpuScene;
-use crate::splat::SplatPass;
+use crate::passes::gbuffer::GBuffer;
+use crate::passes::splat::SplatPass;
+use crate::scene::GpuScene;
 
-const BASE: u32 = PASS_BASE + GBUFFER_BINDINGS;
-
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct Push {
-    jitter: [f32; 2],
-    debug: u32,
-    pad: u32,
+radcache_shared::gpu_struct! {
+    /// The push constants of the pass (`CompositePush` in GLSL).
+    pub struct CompositePush {
+        /// Jitter.
+        pub jitter: [f32; 2] => "vec2",
+        /// Debug.
+        pub debug: u32 => "uint",
+        /// Padding.
+        pub pad: u32 => "uint",
+    }
 }
 
 /// The composite pipeline and the frame accumulator.
@@ -61,19 +62,12 @@ impl CompositePass {
         height: u32,
     ) -> Result<CompositePass> {
         let spirv = shaders.compile("passes/composite.comp", &scene.defines())?;
-        let mut pass = GBuffer::layout().to_vec();
-        pass.push(BindingLayout::new(BASE, BindingKind::StorageImage));
-        pass.push(BindingLayout::new(BASE + 1, BindingKind::StorageBuffer));
-        pass.push(BindingLayout::new(BASE + 2, BindingKind::StorageBuffer));
-        pass.push(BindingLayout::new(BASE + 3, BindingKind::StorageBuffer));
-        pass.push(BindingLayout::new(BASE + 4, BindingKind::StorageBuffer));
-        pass.push(BindingLayout::new(BASE + 5, BindingKind::StorageImage));
         let pipeline = Pipeline::compute(
             ctx,
             "composite",
             &spirv,
-            &with_scene(&pass),
-            std::mem::size_of::<Push>() as u32,
+            &b::layout(),
+            std::mem::size_of::<CompositePush>() as u32,
         )?;
         let buffer = |name, size, location| {
             Buffer::new(
@@ -125,13 +119,15 @@ impl CompositePass {
         rec.use_image(&splat.count, ImageUse::ComputeStorage);
         let mut bindings = scene.bindings();
         bindings.extend(gbuffer.bindings());
-        bindings.push((BASE, Resource::StorageImage(&splat.sum)));
-        bindings.push((BASE + 1, Resource::Buffer(&self.accum)));
-        bindings.push((BASE + 2, Resource::Buffer(&self.nonfinite)));
-        bindings.push((BASE + 3, Resource::Buffer(&self.emission_accum)));
-        bindings.push((BASE + 4, Resource::Buffer(&self.debug_accum)));
-        bindings.push((BASE + 5, Resource::StorageImage(&splat.count)));
-        let push = Push {
+        bindings.extend([
+            (b::SPLAT_SUM, Resource::StorageImage(&splat.sum)),
+            (b::ACCUM, Resource::Buffer(&self.accum)),
+            (b::NONFINITE, Resource::Buffer(&self.nonfinite)),
+            (b::EMISSION_ACCUM, Resource::Buffer(&self.emission_accum)),
+            (b::DEBUG_ACCUM, Resource::Buffer(&self.debug_accum)),
+            (b::SPLAT_COUNT, Resource::StorageImage(&splat.count)),
+        ]);
+        let push = CompositePush {
             jitter,
             debug: u32::from(debug),
             pad: 0,

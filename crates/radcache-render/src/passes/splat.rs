@@ -3,18 +3,17 @@
 //! an RGBA32F target with (ONE, ONE) blending. No depth test: the G-buffer already resolved
 //! visibility, and the fragment rejects points outside the record's zone.
 
-use bytemuck::{Pod, Zeroable};
-use radcache_cache::{IcParams, WeightKind};
+use radcache_cache::IcParams;
 use radcache_vk::{
-    vk, BindingKind, BindingLayout, Blend, ColorTarget, Context, GraphicsDesc, Image, ImageDesc,
-    ImageUse, Pipeline, Recorder, Resource, ShaderCompiler,
+    vk, Blend, ColorTarget, Context, GraphicsDesc, Image, ImageDesc, ImageUse, Pipeline, Recorder,
+    Resource, ShaderCompiler,
 };
 
-use crate::bindings::{FRAME, PASS_BASE};
+use crate::bindings::{splat as b, FRAME};
 use crate::error::Result;
-use crate::gbuffer::{GBuffer, GBUFFER_BINDINGS};
-use crate::gpu_scene::GpuScene;
-use crate::ic_state::IcState;
+use crate::passes::gbuffer::GBuffer;
+use crate::scene::GpuScene;
+use crate::state::IcState;
 
 /// Which records a splat draws.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,26 +28,28 @@ pub enum SplatScope {
 /// Format of the record-count target.
 const COUNT_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
 
-/// Binding of the record buffer (just after the G-buffer).
-pub const RECORDS: u32 = PASS_BASE + GBUFFER_BINDINGS;
-
-/// Weighting of one splat pass: the kind, its parameter, and the in-front tolerance.
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-#[repr(C)]
-pub struct SplatWeights {
-    /// `WEIGHT_WARD` or `WEIGHT_TL`.
-    pub kind: u32,
-    /// `a` (Ward) or `κ` (T&L).
-    pub param: f32,
-    /// Weights at or below this are rejected (0: the whole zone).
-    pub w_min: f32,
-    /// In-front tolerance in pixel footprints.
-    pub front_tol_px: f32,
-    /// Frame number written to the last-use slot of every record that weighs on a pixel (0: none;
-    /// the final splat marks, the coverage splats do not).
-    pub mark_frame: u32,
-    /// Padding to 16-byte rows.
-    pub pad: [u32; 3],
+radcache_shared::gpu_struct! {
+    /// Weighting of one splat pass (its push constants, `SplatWeights` in GLSL): the kind, its
+    /// parameter, and the in-front tolerance.
+    pub struct SplatWeights {
+        /// `WEIGHT_WARD` or `WEIGHT_TL`.
+        pub kind: u32 => "uint",
+        /// `a` (Ward) or `κ` (T&L).
+        pub param: f32 => "float",
+        /// Weights at or below this are rejected (0: the whole zone).
+        pub w_min: f32 => "float",
+        /// In-front tolerance in pixel footprints.
+        pub front_tol_px: f32 => "float",
+        /// Frame number written to the last-use slot of every record that weighs on a pixel (0:
+        /// none; the final splat marks, the coverage splats do not).
+        pub mark_frame: u32 => "uint",
+        /// Padding.
+        pub pad0: u32 => "uint",
+        /// Padding.
+        pub pad1: u32 => "uint",
+        /// Padding.
+        pub pad2: u32 => "uint",
+    }
 }
 
 impl SplatWeights {
@@ -57,13 +58,14 @@ impl SplatWeights {
         SplatWeights {
             kind: params.weight_kind as u32,
             param: params.weight_param(),
-            w_min: match params.weight_kind {
-                WeightKind::Ward => 0.0,
-                WeightKind::TabellionLamorlette => 0.0,
-            },
+            // Every weight above zero counts, for both kinds: the whole zone is drawn (a positive
+            // floor would cut the zone where its weights are small but still normalise).
+            w_min: 0.0,
             front_tol_px: params.front_tolerance_px,
             mark_frame: 0,
-            pad: [0; 3],
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         }
     }
 }
@@ -88,10 +90,7 @@ impl SplatPass {
     pub fn new(ctx: &Context, shaders: &ShaderCompiler, width: u32, height: u32) -> Result<Self> {
         let vertex = shaders.compile("passes/splat.vert", &[])?;
         let fragment = shaders.compile("passes/splat.frag", &[])?;
-        let mut bindings = vec![BindingLayout::new(FRAME, BindingKind::UniformBuffer)];
-        bindings.extend(GBuffer::layout());
-        bindings.push(BindingLayout::new(RECORDS, BindingKind::StorageBuffer));
-        bindings.push(BindingLayout::new(RECORDS + 1, BindingKind::StorageBuffer));
+        let bindings = b::layout();
         let format = vk::Format::R32G32B32A32_SFLOAT;
         let pipeline = Pipeline::graphics(
             ctx,
@@ -160,8 +159,8 @@ impl SplatPass {
         let scene_bindings = scene.bindings();
         let mut bindings = vec![scene_bindings[FRAME as usize]];
         bindings.extend(gbuffer.bindings());
-        bindings.push((RECORDS, Resource::Buffer(&state.records)));
-        bindings.push((RECORDS + 1, Resource::Buffer(&state.last_used)));
+        bindings.push((b::RECORDS, Resource::Buffer(&state.records)));
+        bindings.push((b::LAST_USED, Resource::Buffer(&state.last_used)));
         rec.pass(name, |rec| {
             rec.begin_rendering(
                 &[

@@ -8,7 +8,7 @@ use radcache_vk::Resource;
 use super::GpuScene;
 use crate::bindings as b;
 use crate::error::Result;
-use crate::upload::{cols, vulkan_clip_from_view};
+use crate::scene::upload::{cols, vulkan_clip_from_view};
 
 impl GpuScene {
     /// Writes the frame constants for `view` at `width × height`.

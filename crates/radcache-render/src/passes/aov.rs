@@ -2,13 +2,12 @@
 //! depth per pixel, box-filtered over 4×4 sub-pixel positions.
 
 use radcache_vk::{
-    vk, BindingKind, BindingLayout, Buffer, BufferDesc, Context, MemoryLocation, Pipeline,
-    Recorder, Resource, ShaderCompiler,
+    vk, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource, ShaderCompiler,
 };
 
-use crate::bindings::{with_scene, PASS_BASE};
+use crate::bindings::aov as b;
 use crate::error::Result;
-use crate::gpu_scene::GpuScene;
+use crate::scene::GpuScene;
 
 /// The shader, relative to `shaders/`.
 pub const SHADER: &str = "passes/aov.comp";
@@ -52,11 +51,7 @@ impl AovPass {
         height: u32,
     ) -> Result<AovPass> {
         let spirv = shaders.compile(SHADER, &[])?;
-        let bindings = with_scene(&[
-            BindingLayout::new(PASS_BASE, BindingKind::StorageBuffer),
-            BindingLayout::new(PASS_BASE + 1, BindingKind::StorageBuffer),
-            BindingLayout::new(PASS_BASE + 2, BindingKind::StorageBuffer),
-        ]);
+        let bindings = b::layout();
         let pipeline = Pipeline::compute(ctx, "aov", &spirv, &bindings, 0)?;
         let pixels = u64::from(width) * u64::from(height);
         let buffer = |name, texel: u64| {
@@ -84,9 +79,9 @@ impl AovPass {
     /// Records the pass (the scene's view must be set for this image size).
     pub fn record(&self, rec: &mut Recorder, scene: &GpuScene) -> Result<()> {
         let mut bindings = scene.bindings();
-        bindings.push((PASS_BASE, Resource::Buffer(&self.albedo)));
-        bindings.push((PASS_BASE + 1, Resource::Buffer(&self.normal)));
-        bindings.push((PASS_BASE + 2, Resource::Buffer(&self.depth)));
+        bindings.push((b::ALBEDO, Resource::Buffer(&self.albedo)));
+        bindings.push((b::NORMAL, Resource::Buffer(&self.normal)));
+        bindings.push((b::DEPTH, Resource::Buffer(&self.depth)));
         let (w, h) = (self.width, self.height);
         rec.pass("aov", |rec| {
             rec.bind_pipeline(&self.pipeline);

@@ -27,48 +27,52 @@
 //! [`TemporalPass::record_finish`]) with the scene at the next frame's time, and
 //! [`TemporalPass::record_keep_instances`] at the end.
 
-use bytemuck::{Pod, Zeroable};
 use radcache_cache::IcParams;
 use radcache_scene::Scene;
 use radcache_shared::gpu::{GpuInstance, GpuRecord, IcCounters};
 use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, Buffer, BufferDesc, Context, MemoryLocation, Pipeline,
-    Recorder, Resource, ShaderCompiler,
+    vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
+    ShaderCompiler,
 };
 
-use crate::bindings::{with_scene, PASS_BASE};
+use crate::bindings::temporal as b;
 use crate::error::Result;
-use crate::gpu_scene::GpuScene;
-use crate::ic_state::IcState;
+use crate::scene::GpuScene;
+use crate::state::IcState;
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct Push {
-    mode: u32,
-    frame: u32,
-    first: u32,
-    has_previous: u32,
-    has_lifespans: u32,
-    accuracy: f32,
-    max_age: f32,
-    capacity: u32,
-    reclamp: u32,
-    min_px: f32,
-    max_px: f32,
-    v_scale: f32,
-    moving_count: u32,
+radcache_shared::gpu_struct! {
+    /// The push constants of the pass (`TemporalPush` in GLSL).
+    pub struct TemporalPush {
+        /// Step.
+        pub step: u32 => "uint",
+        /// Frame.
+        pub frame: u32 => "uint",
+        /// First.
+        pub first: u32 => "uint",
+        /// Has previous.
+        pub has_previous: u32 => "uint",
+        /// Has lifespans.
+        pub has_lifespans: u32 => "uint",
+        /// Accuracy.
+        pub accuracy: f32 => "float",
+        /// Max age.
+        pub max_age: f32 => "float",
+        /// Capacity.
+        pub capacity: u32 => "uint",
+        /// Reclamp.
+        pub reclamp: u32 => "uint",
+        /// Min px.
+        pub min_px: f32 => "float",
+        /// Max px.
+        pub max_px: f32 => "float",
+        /// V scale.
+        pub v_scale: f32 => "float",
+        /// Moving count.
+        pub moving_count: u32 => "uint",
+    }
 }
 
-/// The shader's steps.
-#[derive(Clone, Copy)]
-enum Mode {
-    Begin = 0,
-    Advance = 1,
-    Append = 2,
-    Adopt = 3,
-    Shift = 4,
-    Finish = 5,
-}
+use radcache_shared::consts::TemporalStep as Mode;
 
 /// The temporal pipeline, the list of records to evaluate this frame, the look-ahead copy of the
 /// records, the previous frame's instances and the moving instances' bounding spheres.
@@ -119,15 +123,12 @@ impl TemporalPass {
         lifespans: bool,
     ) -> Result<TemporalPass> {
         let spirv = shaders.compile("passes/temporal.comp", &scene.defines())?;
-        let pass: Vec<BindingLayout> = (0..8)
-            .map(|k| BindingLayout::new(PASS_BASE + k, BindingKind::StorageBuffer))
-            .collect();
         let pipeline = Pipeline::compute(
             ctx,
             "temporal",
             &spirv,
-            &with_scene(&pass),
-            std::mem::size_of::<Push>() as u32,
+            &b::layout(),
+            std::mem::size_of::<TemporalPush>() as u32,
         )?;
         let buffer = |name, size: u64, usage, location| {
             Buffer::new(
@@ -191,22 +192,22 @@ impl TemporalPass {
         scene: &GpuScene,
         state: &IcState,
         mode: Mode,
-        push: Push,
+        push: TemporalPush,
         invocations: u32,
     ) -> Result<()> {
         let mut bindings = scene.bindings();
         bindings.extend([
-            (PASS_BASE, Resource::Buffer(&state.counters)),
-            (PASS_BASE + 1, Resource::Buffer(&state.records)),
-            (PASS_BASE + 2, Resource::Buffer(&state.temporal)),
-            (PASS_BASE + 3, Resource::Buffer(&self.list)),
-            (PASS_BASE + 4, Resource::Buffer(&self.list_counters)),
-            (PASS_BASE + 5, Resource::Buffer(&self.lookahead)),
-            (PASS_BASE + 6, Resource::Buffer(&self.previous)),
-            (PASS_BASE + 7, Resource::Buffer(&self.moving)),
+            (b::COUNTERS, Resource::Buffer(&state.counters)),
+            (b::RECORDS, Resource::Buffer(&state.records)),
+            (b::TEMPORAL, Resource::Buffer(&state.temporal)),
+            (b::LIST, Resource::Buffer(&self.list)),
+            (b::LIST_COUNTERS, Resource::Buffer(&self.list_counters)),
+            (b::LOOKAHEAD, Resource::Buffer(&self.lookahead)),
+            (b::PREVIOUS, Resource::Buffer(&self.previous)),
+            (b::MOVING, Resource::Buffer(&self.moving)),
         ]);
-        let push = Push {
-            mode: mode as u32,
+        let push = TemporalPush {
+            step: mode as u32,
             capacity: self.capacity,
             moving_count: self.moving_count,
             ..push
@@ -225,9 +226,9 @@ impl TemporalPass {
         Ok(())
     }
 
-    fn push(frame: u32) -> Push {
-        Push {
-            mode: 0,
+    fn push(frame: u32) -> TemporalPush {
+        TemporalPush {
+            step: 0,
             frame,
             first: 0,
             has_previous: 0,
@@ -288,7 +289,7 @@ impl TemporalPass {
         let push = Self::push(frame);
         self.dispatch(rec, scene, state, Mode::Begin, push, 1)?;
         if records > 0 && (lifespans.is_some() || reclamp.is_some()) {
-            let mut push = Push {
+            let mut push = TemporalPush {
                 has_previous: u32::from(self.has_previous),
                 has_lifespans: u32::from(lifespans.is_some()),
                 ..push
@@ -323,7 +324,7 @@ impl TemporalPass {
         records: u32,
         listed: u32,
     ) -> Result<()> {
-        let push = Push {
+        let push = TemporalPush {
             first,
             ..Self::push(frame)
         };
@@ -367,7 +368,7 @@ impl TemporalPass {
         next: (&Scene, f32),
     ) -> Result<()> {
         self.write_moving(next.0, next.1)?;
-        let push = Push {
+        let push = TemporalPush {
             accuracy: lifespans.accuracy,
             max_age: lifespans.max_age,
             ..Self::push(frame)
@@ -401,6 +402,6 @@ impl TemporalPass {
     /// Listed records after the last submission (expired, then new).
     pub fn listed(&self) -> Result<u32> {
         let c = self.list_counters.read::<IcCounters>(1)?[0];
-        Ok(c.counts[1].min(self.capacity))
+        Ok(c.requested.min(self.capacity))
     }
 }

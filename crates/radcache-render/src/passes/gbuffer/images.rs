@@ -1,9 +1,9 @@
 //! The irradiance cache's G-buffer: the images every IC pass reads (layout in
 //! `shaders/common/gbuffer.glsl`), bound at `PASS_BASE + 0..5`.
 
-use radcache_vk::{vk, BindingKind, BindingLayout, Context, Image, ImageDesc, Resource};
+use radcache_vk::{vk, BindingLayout, Context, Image, ImageDesc, Resource};
 
-use crate::bindings::PASS_BASE;
+use crate::bindings::{gbuffer as b, GBUFFER};
 use crate::error::Result;
 
 /// Format of every G-buffer colour image.
@@ -11,7 +11,7 @@ pub const GBUFFER_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 /// Format of the depth attachment (reversed Z: 1 at the near plane, cleared to 0).
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 /// Number of bindings the G-buffer occupies from `PASS_BASE` (the last is the direct light).
-pub const GBUFFER_BINDINGS: u32 = 6;
+pub const GBUFFER_BINDINGS: u32 = GBUFFER.len() as u32;
 
 /// The G-buffer images of one image size.
 pub struct GBuffer {
@@ -83,18 +83,18 @@ impl GBuffer {
 
     /// The binding layout of the G-buffer images (storage images at `PASS_BASE + 0..5`).
     pub fn layout() -> [BindingLayout; GBUFFER_BINDINGS as usize] {
-        std::array::from_fn(|i| BindingLayout::new(PASS_BASE + i as u32, BindingKind::StorageImage))
+        GBUFFER
     }
 
     /// The images to push at `PASS_BASE + 0..5` (they must be in a storage-image layout).
     pub fn bindings(&self) -> [(u32, Resource<'_>); GBUFFER_BINDINGS as usize] {
         [
-            (PASS_BASE, Resource::StorageImage(&self.position)),
-            (PASS_BASE + 1, Resource::StorageImage(&self.normal)),
-            (PASS_BASE + 2, Resource::StorageImage(&self.geometric)),
-            (PASS_BASE + 3, Resource::StorageImage(&self.albedo)),
-            (PASS_BASE + 4, Resource::StorageImage(&self.emission)),
-            (PASS_BASE + 5, Resource::StorageImage(&self.direct)),
+            (b::POSITION, Resource::StorageImage(&self.position)),
+            (b::NORMAL, Resource::StorageImage(&self.normal)),
+            (b::GEOMETRIC, Resource::StorageImage(&self.geometric)),
+            (b::ALBEDO, Resource::StorageImage(&self.albedo)),
+            (b::EMISSION, Resource::StorageImage(&self.emission)),
+            (b::DIRECT, Resource::StorageImage(&self.direct)),
         ]
     }
 

@@ -1,15 +1,14 @@
-//! The temporal steps of [`IcRenderer::render`] (`crate::temporal`): the records whose lifespan
+//! The temporal steps of [`IcRenderer::render`] (`passes/temporal.rs`): the records whose lifespan
 //! ended, and the look-ahead evaluation of them and of the frame's new records.
 
 use radcache_scene::{CameraView, Scene};
 use radcache_vk::Context;
 
-use super::IcRenderer;
-use crate::clock::FrameClock;
+use super::{FrameRun, IcRenderer};
 use crate::error::{Error, Result};
-use crate::gpu_scene::GpuScene;
-use crate::ic::{IcSettings, IcStats};
-use crate::temporal::{Lifespans, TemporalPass};
+use crate::frame::settings::{IcSettings, IcStats};
+use crate::passes::temporal::{Lifespans, TemporalPass};
+use crate::scene::GpuScene;
 
 impl IcRenderer {
     fn temporal_pass(&self) -> Result<&TemporalPass> {
@@ -26,7 +25,6 @@ impl IcRenderer {
     /// Adopts the frame's new records, evaluates them and the `expired` ones (listed by the
     /// advance) with the scene at `settings.time + settings.time_step_s`, and derives their rates
     /// and lifespans; the scene is back at the frame's time (and `view`) afterwards.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn look_ahead(
         &mut self,
         ctx: &Context,
@@ -34,12 +32,11 @@ impl IcRenderer {
         gpu: &mut GpuScene,
         settings: &IcSettings,
         view: &CameraView,
-        expired: u32,
-        stats: &mut IcStats,
-        clock: &mut FrameClock,
+        run: &mut FrameRun<'_>,
     ) -> Result<()> {
+        let (expired, stats, clock) = (run.expired, &mut run.stats, &mut run.clock);
         let t = self.temporal.as_mut().ok_or_else(no_time_step)?;
-        let count = self.state.read_counters()?.counts[0];
+        let count = self.state.read_counters()?.record_count;
         let first = stats.records_kept as u32;
         let listed = expired
             .saturating_add(count.saturating_sub(first))

@@ -1,0 +1,212 @@
+//! The irradiance cache's frame: [`IcRenderer`] owns the passes, the G-buffer and the cache
+//! state, so a sequence creates its pipelines once and can keep its records from frame to frame.
+//! [`IcRenderer::render`] is the list of the frame's phases (their bodies in `ic/phases.rs`, the
+//! temporal steps in `ic/temporal.rs`); the flow is described in [`crate::frame`].
+
+use std::time::Instant;
+
+use radcache_cache::IcParams;
+use radcache_scene::Scene;
+use radcache_shared::gpu::GpuRecord;
+use radcache_vk::{Context, ShaderCompiler};
+
+use crate::error::{Error, Result};
+use crate::frame::path::{FrameOutput, Progress};
+use crate::frame::settings::{IcDebug, IcSettings, IcStats};
+use crate::passes::composite::CompositePass;
+use crate::passes::direct::DirectPass;
+use crate::passes::emission::EmissionPass;
+use crate::passes::gbuffer::{GBuffer, GBufferPass};
+use crate::passes::holes::HolePass;
+use crate::passes::neighbours::NeighbourPass;
+use crate::passes::record::RecordPass;
+use crate::passes::splat::SplatPass;
+use crate::passes::temporal::TemporalPass;
+use crate::scene::GpuScene;
+use crate::state::IcState;
+
+mod phases;
+mod temporal;
+
+use phases::FrameRun;
+
+/// The cache's passes and state for one image size and one set of cache parameters.
+pub struct IcRenderer {
+    width: u32,
+    height: u32,
+    params: IcParams,
+    gbuffer: GBuffer,
+    gbuffer_pass: GBufferPass,
+    direct: DirectPass,
+    splat: SplatPass,
+    holes: HolePass,
+    neighbours: NeighbourPass,
+    records: RecordPass,
+    composite: CompositePass,
+    emission: EmissionPass,
+    state: IcState,
+    /// Records kept across frames (created for sequences: `settle_records` or a time step).
+    temporal: Option<TemporalPass>,
+    /// The previous frame's `clip_from_world` (kept records are re-clamped when it changes).
+    last_view: Option<[[f32; 4]; 4]>,
+    /// False until a frame has left records to keep.
+    has_records: bool,
+    /// Frames rendered (the last-use marks of `IcState::last_used`).
+    frames: u32,
+}
+
+impl std::fmt::Debug for IcRenderer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("IcRenderer")
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .field("params", &self.params)
+            .finish_non_exhaustive()
+    }
+}
+
+impl IcRenderer {
+    /// Creates the passes for `settings` (size, parameters, record capacity) and `gpu`'s plan.
+    pub fn new(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        gpu: &GpuScene,
+        settings: &IcSettings,
+    ) -> Result<IcRenderer> {
+        let (w, h) = (settings.width, settings.height);
+        if w == 0 || h == 0 {
+            return Err(Error::Invalid(format!("the image size {w}x{h} is empty")));
+        }
+        if !settings.params.is_valid() {
+            return Err(Error::Invalid(format!(
+                "invalid cache parameters: {:?}",
+                settings.params
+            )));
+        }
+        let params = settings.params;
+        Ok(IcRenderer {
+            width: w,
+            height: h,
+            params,
+            gbuffer: GBuffer::new(ctx, w, h)?,
+            gbuffer_pass: GBufferPass::new(ctx, shaders)?,
+            direct: DirectPass::new(ctx, shaders, gpu)?,
+            splat: SplatPass::new(ctx, shaders, w, h)?,
+            holes: HolePass::new(ctx, shaders)?,
+            neighbours: NeighbourPass::new(ctx, shaders)?,
+            records: RecordPass::new(ctx, shaders, gpu, &params)?,
+            composite: CompositePass::new(ctx, shaders, gpu, w, h)?,
+            emission: EmissionPass::new(ctx, shaders, gpu)?,
+            state: IcState::new(ctx, shaders, settings.record_capacity, w * h)?,
+            temporal: if settings.time_step_s > 0.0 || settings.settle_records {
+                let lifespans = settings.time_step_s > 0.0;
+                let capacity = settings.record_capacity;
+                Some(TemporalPass::new(ctx, shaders, gpu, capacity, lifespans)?)
+            } else {
+                None
+            },
+            last_view: None,
+            has_records: false,
+            frames: 0,
+        })
+    }
+
+    /// Drops every record: the next frame builds its cache from scratch.
+    pub fn forget(&mut self) {
+        self.has_records = false;
+    }
+
+    /// The cache's GPU state (records, counters).
+    pub fn state(&self) -> &IcState {
+        &self.state
+    }
+
+    /// Renders `scene` at `settings.time`, keeping the records of the previous frame unless
+    /// [`IcRenderer::forget`] was called (records are world-space: right for a static scene
+    /// under any camera motion). `settings` must have the size and parameters the renderer was
+    /// created with. The phases are described in [`crate::frame`].
+    pub fn render(
+        &mut self,
+        ctx: &Context,
+        scene: &Scene,
+        gpu: &mut GpuScene,
+        settings: &IcSettings,
+        progress: &mut dyn FnMut(Progress),
+    ) -> Result<(FrameOutput, IcStats)> {
+        self.check(settings)?;
+        let mut run = FrameRun::new(self.params.levels, settings.sub_frames, progress);
+        let view = self.setup(ctx, scene, gpu, settings, &mut run)?;
+        self.cache_phase(ctx, gpu, settings, &mut run)?;
+        if settings.time_step_s > 0.0 {
+            self.look_ahead(ctx, scene, gpu, settings, &view, &mut run)?;
+        }
+        run.add_rays("records", run.stats.record_rays);
+        self.has_records = true;
+        for k in 0..run.sub_frames {
+            self.shade_sub_frame(ctx, gpu, settings, k, &mut run)?;
+        }
+        self.finish(ctx, gpu, settings, run)
+    }
+
+    /// Refuses settings the renderer was not made for.
+    fn check(&self, settings: &IcSettings) -> Result<()> {
+        let same = (settings.width, settings.height, settings.params)
+            == (self.width, self.height, self.params);
+        let lifespans = self.temporal.as_ref().is_some_and(|t| t.lifespans());
+        if same && (settings.time_step_s <= 0.0 || lifespans) {
+            return Ok(());
+        }
+        Err(Error::Invalid(format!(
+            "the renderer was made for {}x{} and {:?}{}, not {}x{} and {:?} with a time step of {} s",
+            self.width,
+            self.height,
+            self.params,
+            if self.temporal.is_some() {
+                " with temporal caching"
+            } else {
+                ""
+            },
+            settings.width,
+            settings.height,
+            settings.params,
+            settings.time_step_s
+        )))
+    }
+
+    fn read_debug(&self, ctx: &Context, sub_frames: u32, records: u64) -> Result<IcDebug> {
+        let (indirect, weight_sum, records_per_pixel) =
+            self.composite.read_debug(ctx, sub_frames)?;
+        let mut record_positions = vec![0.0f32; (self.width * self.height) as usize];
+        let all: Vec<GpuRecord> = ctx.read_buffer(&self.state.records, records as usize)?;
+        for r in &all {
+            if let Some(p) = record_positions.get_mut(r.info[0] as usize) {
+                *p = 1.0;
+            }
+        }
+        Ok(IcDebug {
+            indirect,
+            weight_sum,
+            records_per_pixel,
+            record_positions,
+        })
+    }
+}
+
+/// Renders `scene` at `settings.time` with the irradiance cache, from an empty cache (a
+/// sequence keeps an [`IcRenderer`] instead, to create the pipelines once and keep records).
+pub fn render_ic(
+    ctx: &Context,
+    shaders: &ShaderCompiler,
+    scene: &Scene,
+    gpu: &mut GpuScene,
+    settings: &IcSettings,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<(FrameOutput, IcStats)> {
+    let start = Instant::now();
+    let mut renderer = IcRenderer::new(ctx, shaders, gpu, settings)?;
+    let pipelines_s = start.elapsed().as_secs_f64();
+    let (mut out, mut stats) = renderer.render(ctx, scene, gpu, settings, progress)?;
+    out.time_s += pipelines_s;
+    stats.phases_s.insert("pipelines".into(), pipelines_s);
+    Ok((out, stats))
+}

@@ -1,0 +1,354 @@
+//! The phases of [`IcRenderer::render`], in frame order: setup, the cache phase (hole filling
+//! per sub-frame and level), the shading of one sub-frame, and the finish (emission, read-back).
+//! The temporal look-ahead, between the cache phase and the shading, is in `temporal.rs`.
+//! [`FrameRun`] carries what the phases share: the clock, the figures and the progress report.
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use radcache_scene::{CameraView, Scene};
+use radcache_vk::Context;
+
+use super::IcRenderer;
+use crate::error::Result;
+use crate::frame::clock::FrameClock;
+use crate::frame::path::{FrameOutput, Progress};
+use crate::frame::settings::{sub_frame_jitter, IcSettings, IcStats};
+use crate::passes::holes::HoleSelection;
+use crate::passes::record::creation_seed;
+use crate::passes::splat::{SplatScope, SplatWeights};
+use crate::scene::GpuScene;
+
+/// Most passes of the cache phase over the sub-frames (see [`IcRenderer::cache_phase`]).
+const MAX_CACHE_PASSES: u32 = 4;
+
+/// What a frame's phases share.
+pub(super) struct FrameRun<'p> {
+    pub clock: FrameClock,
+    pub stats: IcStats,
+    /// Ray queries per kind of work (`records`, `direct`, `emission`).
+    pub rays: BTreeMap<String, u64>,
+    /// Jittered sub-frames of the frame (at least 1).
+    pub sub_frames: u32,
+    /// Records kept from the previous frame, before the setup's temporal advance.
+    pub kept: u32,
+    /// Records the temporal advance listed as expired (evaluated again by the look-ahead).
+    pub expired: u32,
+    start: Instant,
+    progress: &'p mut dyn FnMut(Progress),
+}
+
+impl<'p> FrameRun<'p> {
+    pub fn new(levels: u32, sub_frames: u32, progress: &'p mut dyn FnMut(Progress)) -> Self {
+        FrameRun {
+            clock: FrameClock::new(),
+            stats: IcStats {
+                records_per_level: vec![0; levels as usize],
+                ..IcStats::default()
+            },
+            rays: BTreeMap::new(),
+            sub_frames: sub_frames.max(1),
+            kept: 0,
+            expired: 0,
+            start: Instant::now(),
+            progress,
+        }
+    }
+
+    /// Reports `done` of the frame's `2 × sub_frames` steps (cache, then shade).
+    fn report(&mut self, done: u32) {
+        (self.progress)(Progress {
+            done,
+            total: 2 * self.sub_frames,
+            elapsed_s: self.start.elapsed().as_secs_f64(),
+        });
+    }
+
+    pub fn add_rays(&mut self, kind: &str, rays: u64) {
+        *self.rays.entry(kind.into()).or_default() += rays;
+    }
+
+    fn records_created(&self) -> u64 {
+        self.stats.records_per_level.iter().sum()
+    }
+}
+
+impl IcRenderer {
+    /// **Setup**: the scene at the frame's time and view; eviction of records unused for
+    /// `evict_after_frames`; the kept records moved with their instances (temporal caching) or
+    /// re-clamped to a new view; the neighbour grid rebuilt; the accumulators cleared. Returns
+    /// the camera view of the frame.
+    pub(super) fn setup(
+        &mut self,
+        ctx: &Context,
+        scene: &Scene,
+        gpu: &mut GpuScene,
+        settings: &IcSettings,
+        run: &mut FrameRun<'_>,
+    ) -> Result<CameraView> {
+        gpu.set_time(scene, settings.time)?;
+        let view = scene.camera_at(settings.time);
+        gpu.set_view(
+            &view,
+            self.width,
+            self.height,
+            settings.frame,
+            settings.seed,
+        )?;
+        self.frames += 1;
+        let now = self.frames;
+        if self.has_records {
+            let limit = settings.evict_after_frames;
+            let evicted = self
+                .state
+                .compact(ctx, |_, used| used != 0 && now - used <= limit)?;
+            run.stats.records_evicted = u64::from(evicted);
+            run.kept = self.state.read_counters()?.record_count;
+        }
+        let temporal = settings.time_step_s > 0.0;
+        let mut rec = ctx.begin("ic.setup")?;
+        gpu.record_update(ctx, &mut rec)?;
+        if !self.has_records {
+            self.state.record_reset(&mut rec)?;
+        }
+        // Kept records take the radius clamp of the new view when the camera moved.
+        let clip = gpu.constants().clip_from_world;
+        let view_changed = self.last_view.is_some_and(|v| v != clip);
+        self.last_view = Some(clip);
+        if let Some(t) = self.temporal.as_mut() {
+            if !self.has_records {
+                t.forget();
+            }
+            if temporal || view_changed {
+                let reclamp = view_changed.then_some(&self.params);
+                let lifespans = temporal.then_some((scene, settings.time, &self.params));
+                let kept = run.kept;
+                t.record_advance(&mut rec, gpu, &self.state, now, kept, lifespans, reclamp)?;
+            }
+        }
+        self.neighbours
+            .record_rebuild(&mut rec, &self.state, gpu.scene_scale())?;
+        self.composite.record_clear(&mut rec);
+        run.clock.submit(ctx, rec)?;
+        run.stats.records_kept = u64::from(self.state.read_counters()?.record_count);
+        run.clock.lap("setup");
+        if temporal {
+            run.expired = self.expired(&mut run.stats)?;
+        }
+        Ok(view)
+    }
+
+    /// **Cache phase**: hole filling for every sub-frame's jitter. Records created for a later
+    /// sub-frame shrink earlier ones (neighbour clamping), which can uncover a pixel an earlier
+    /// sub-frame had covered: with `settle_records`, passes repeat until one creates nothing (at
+    /// most [`MAX_CACHE_PASSES`]), so the records left are a fixed point and the next frame of a
+    /// static scene creates none and shades identically.
+    pub(super) fn cache_phase(
+        &self,
+        ctx: &Context,
+        gpu: &GpuScene,
+        settings: &IcSettings,
+        run: &mut FrameRun<'_>,
+    ) -> Result<()> {
+        let passes = if settings.settle_records {
+            MAX_CACHE_PASSES
+        } else {
+            1
+        };
+        for pass in 0..passes {
+            let before = run.records_created();
+            for k in 0..run.sub_frames {
+                self.fill_holes(ctx, gpu, settings, k, run)?;
+                if pass == 0 {
+                    run.report(k + 1);
+                }
+            }
+            run.stats.cache_passes = pass + 1;
+            if run.records_created() == before {
+                break;
+            }
+        }
+        Ok(())
+    }
+
+    /// The cache phase of sub-frame `k`: its G-buffer, then hole filling level by level. Each
+    /// level is two submissions, selection (coverage splat, holes) and creation (records,
+    /// neighbours), so the creation's wall time is the record pass's own. A level that finds no
+    /// hole ends the sub-frame (finer levels would find none either).
+    fn fill_holes(
+        &self,
+        ctx: &Context,
+        gpu: &GpuScene,
+        settings: &IcSettings,
+        k: u32,
+        run: &mut FrameRun<'_>,
+    ) -> Result<()> {
+        let creation = self.params.for_creation();
+        let creation_weights = SplatWeights::from_params(&creation);
+        let seed = creation_seed(settings.seed, k);
+        let mut rec = ctx.begin("ic.gbuffer")?;
+        self.gbuffer_pass
+            .record(&mut rec, gpu, &self.gbuffer, sub_frame_jitter(k))?;
+        run.clock.submit(ctx, rec)?;
+        run.clock.lap("cache_gbuffer");
+        for level in 0..self.params.levels {
+            let selection = Instant::now();
+            let mut rec = ctx.begin("ic.select")?;
+            self.state.record_begin_level(&mut rec)?;
+            // The first level splats every record; each later one adds what the level before
+            // created (radii that neighbour clamping shrank since are not redrawn: the final
+            // splat uses them).
+            let scope = if level == 0 {
+                SplatScope::All
+            } else {
+                SplatScope::LastBatch
+            };
+            let (gbuffer, state) = (&self.gbuffer, &self.state);
+            let name = "splat.coverage";
+            self.splat.record(
+                &mut rec,
+                name,
+                scope,
+                gpu,
+                gbuffer,
+                state,
+                &creation_weights,
+            )?;
+            let selection_mode = HoleSelection::Request {
+                spacing: self.params.level_spacing_px(level),
+                threshold: creation.coverage_threshold(),
+                seed: seed ^ (level << 16),
+            };
+            self.holes
+                .record(&mut rec, gbuffer, &self.splat, state, selection_mode)?;
+            self.state.record_begin_batch(&mut rec)?;
+            run.clock.submit(ctx, rec)?;
+            let c = self.state.read_counters()?;
+            run.stats.hole_filling_s += selection.elapsed().as_secs_f64();
+            run.clock.lap("hole_selection");
+            if c.dispatch.x == 0 {
+                if c.holes == 0 {
+                    break;
+                }
+                continue;
+            }
+            let creation_start = Instant::now();
+            let mut rec = ctx.begin("ic.create")?;
+            let (requests, counters) = (&state.requests, &state.counters);
+            let records = &state.records;
+            self.records.record(
+                &mut rec, gpu, gbuffer, requests, counters, records, level, k, seed,
+            )?;
+            self.state.record_end_batch(&mut rec)?;
+            self.neighbours
+                .record(&mut rec, &self.state, gpu.scene_scale())?;
+            run.clock.submit(ctx, rec)?;
+            let created_s = creation_start.elapsed().as_secs_f64();
+            run.stats.record_pass_s += created_s;
+            run.stats.hole_filling_s += created_s;
+            run.stats.record_rays += self.records.rays()?;
+            run.stats.records_per_level[level as usize] += u64::from(c.dispatch.x);
+            run.clock.lap("record_creation");
+        }
+        Ok(())
+    }
+
+    /// **Shade** sub-frame `k`: its G-buffer, direct light, the splat of every record with the
+    /// final weights (marking the records used this frame), the count of the holes left, and
+    /// the composite into the frame accumulator.
+    pub(super) fn shade_sub_frame(
+        &self,
+        ctx: &Context,
+        gpu: &GpuScene,
+        settings: &IcSettings,
+        k: u32,
+        run: &mut FrameRun<'_>,
+    ) -> Result<()> {
+        let final_weights = SplatWeights {
+            mark_frame: self.frames,
+            ..SplatWeights::from_params(&self.params)
+        };
+        let jitter = sub_frame_jitter(k);
+        let (gbuffer, state) = (&self.gbuffer, &self.state);
+        let mut rec = ctx.begin("ic.shade")?;
+        self.gbuffer_pass.record(&mut rec, gpu, gbuffer, jitter)?;
+        let samples = settings.direct_samples;
+        let first_sample = k * samples.max(1);
+        self.direct
+            .record(&mut rec, gpu, gbuffer, samples, first_sample, settings.seed)?;
+        self.splat.record(
+            &mut rec,
+            "splat",
+            SplatScope::All,
+            gpu,
+            gbuffer,
+            state,
+            &final_weights,
+        )?;
+        self.state.record_begin_level(&mut rec)?;
+        self.holes.record(
+            &mut rec,
+            gbuffer,
+            &self.splat,
+            state,
+            HoleSelection::CountOnly,
+        )?;
+        let debug = settings.debug_aovs;
+        self.composite
+            .record(&mut rec, gpu, gbuffer, &self.splat, jitter, debug)?;
+        run.clock.submit(ctx, rec)?;
+        run.add_rays("direct", self.direct.rays()?);
+        let c = self.state.read_counters()?;
+        run.stats.holes_left += u64::from(c.holes);
+        run.stats.records = u64::from(c.record_count);
+        run.stats.dropped_requests = u64::from(c.dropped_requests);
+        run.stats.rejected_records = u64::from(c.rejected_records);
+        run.clock.lap("shade");
+        run.report(run.sub_frames + k + 1);
+        Ok(())
+    }
+
+    /// **Finish**: the box-filtered emission, the instances kept for the next frame's motion,
+    /// the read-back of the mean over the sub-frames (and of the debug AOVs), the figures.
+    pub(super) fn finish(
+        &mut self,
+        ctx: &Context,
+        gpu: &GpuScene,
+        settings: &IcSettings,
+        mut run: FrameRun<'_>,
+    ) -> Result<(FrameOutput, IcStats)> {
+        let mut rec = ctx.begin("ic.emission")?;
+        self.emission.record(&mut rec, gpu, &self.composite)?;
+        if let Some(t) = self
+            .temporal
+            .as_mut()
+            .filter(|_| settings.time_step_s > 0.0)
+        {
+            t.record_keep_instances(&mut rec, gpu);
+        }
+        run.clock.submit(ctx, rec)?;
+        run.add_rays("emission", self.emission.rays()?);
+        run.clock.lap("emission");
+        let (pixels, nonfinite_pixels) = self.composite.read_mean(ctx)?;
+        if settings.debug_aovs {
+            let debug = self.read_debug(ctx, run.sub_frames, run.stats.records)?;
+            run.stats.debug = Some(debug);
+        }
+        run.clock.lap("readback");
+        let mut clock = run.clock;
+        run.stats.phases_s = std::mem::take(&mut clock.phases_s);
+        let output = FrameOutput {
+            width: self.width,
+            height: self.height,
+            pixels,
+            spp: run.sub_frames,
+            time_s: clock.elapsed_s(),
+            rays: run.rays,
+            passes_ms: std::mem::take(&mut clock.passes_ms),
+            spans: clock.spans,
+            nonfinite_pixels,
+            aovs: None,
+        };
+        Ok((output, run.stats))
+    }
+}

@@ -1,0 +1,324 @@
+//! Constants and step enums shared by Rust and GLSL, declared once here and generated into
+//! `shaders/shared/constants.glsl` by `cargo xtask codegen` (a test fails when that file is
+//! stale). No shader writes one of these values by hand.
+
+/// A scalar constant that has a GLSL spelling.
+pub trait GlslScalar: Copy {
+    /// The GLSL type name.
+    const GLSL: &'static str;
+    /// The value as a GLSL literal of that type (exact: floats round-trip).
+    fn literal(self) -> String;
+}
+
+impl GlslScalar for u32 {
+    const GLSL: &'static str = "uint";
+    fn literal(self) -> String {
+        format!("{self}u")
+    }
+}
+
+impl GlslScalar for i32 {
+    const GLSL: &'static str = "int";
+    fn literal(self) -> String {
+        format!("{self}")
+    }
+}
+
+impl GlslScalar for f32 {
+    const GLSL: &'static str = "float";
+    fn literal(self) -> String {
+        // `{:?}` is the shortest representation that round-trips, always with '.' or 'e'.
+        let s = format!("{self:?}");
+        assert!(self.is_finite(), "GLSL has no literal for {s}");
+        s
+    }
+}
+
+/// `const TYPE NAME = VALUE;` for one constant.
+pub fn glsl_const<T: GlslScalar>(name: &str, value: T) -> String {
+    format!("const {} {name} = {};\n", T::GLSL, value.literal())
+}
+
+/// Declares `pub const`s and the function that writes their GLSL declarations.
+#[macro_export]
+macro_rules! gpu_consts {
+    (
+        $(#[$gmeta:meta])*
+        fn $glsl_fn:ident;
+        $( $(#[$meta:meta])* pub const $name:ident : $ty:ty = $value:expr; )*
+    ) => {
+        $( $(#[$meta])* pub const $name: $ty = $value; )*
+
+        $(#[$gmeta])*
+        pub fn $glsl_fn() -> String {
+            let mut s = String::new();
+            $( s.push_str(&$crate::consts::glsl_const(stringify!($name), $name)); )*
+            s
+        }
+    };
+}
+
+/// Declares a `#[repr(u32)]` enum whose variants are a shader's steps or kinds, and its GLSL
+/// constants `PREFIX_VARIANT` (variant names in upper snake case).
+#[macro_export]
+macro_rules! gpu_enum {
+    (
+        $(#[$meta:meta])*
+        pub enum $name:ident ($prefix:literal) {
+            $( $(#[$vmeta:meta])* $variant:ident = $value:literal ),* $(,)?
+        }
+    ) => {
+        $(#[$meta])*
+        #[repr(u32)]
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum $name {
+            $( $(#[$vmeta])* $variant = $value ),*
+        }
+
+        impl $name {
+            /// Every variant, in declaration order.
+            pub const ALL: &'static [$name] = &[$($name::$variant),*];
+
+            /// The GLSL constants of the variants.
+            pub fn glsl() -> String {
+                let mut s = String::new();
+                $(
+                    let name = format!(
+                        "{}_{}",
+                        $prefix,
+                        $crate::consts::upper_snake(stringify!($variant))
+                    );
+                    s.push_str(&$crate::consts::glsl_const(&name, $name::$variant as u32));
+                )*
+                s
+            }
+        }
+    };
+}
+
+/// `BeginLevel` → `BEGIN_LEVEL`.
+pub fn upper_snake(camel: &str) -> String {
+    let mut s = String::new();
+    for (i, c) in camel.chars().enumerate() {
+        if c.is_uppercase() && i > 0 {
+            s.push('_');
+        }
+        s.push(c.to_ascii_uppercase());
+    }
+    s
+}
+
+gpu_consts! {
+    /// The irradiance-cache constants' GLSL (the CPU twins in `radcache-cache` use the same).
+    fn ircache_glsl;
+    /// Distances at or above this value are misses ("no geometry"); radii are capped to it.
+    /// Chosen well below 2^126 so that `x / r` stays inside Vulkan's guaranteed division range.
+    pub const IC_FAR: f32 = 1.0e30;
+    /// Smallest radius any weight or clamp divides by (the `R = 0` guard, docs/irradiance-cache.md).
+    pub const R_FLOOR: f32 = 1.0e-20;
+    /// Ward error floor: `w = 1 / max(ε, WARD_MIN_ERROR)` caps the weight at 1000 (RADIANCE's cap).
+    pub const WARD_MIN_ERROR: f32 = 1.0e-3;
+    /// `sqrt(1 − cos 10°)`: the Tabellion–Lamorlette normal-error scale.
+    pub const TL_NORMAL_SCALE: f32 = 0.123_256_41;
+    /// Smallest T&L κ accepted (κ = 0 would give an unbounded zone of influence).
+    pub const KAPPA_MIN: f32 = 1.0e-3;
+    /// `sin²(10°)`: rows lying entirely above 10° elevation (`cos²θ_j⁺ >= sin²10°`) take part in
+    /// the restricted minimum distance (Mitsuba's grazing-ray guard).
+    pub const ELEVATION_MIN_SIN2: f32 = 0.030_153_69;
+    /// Per-channel upper bound of the extrapolated irradiance relative to the record's value.
+    pub const EXTRAPOLATION_MAX_FACTOR: f32 = 4.0;
+    /// `WeightKind::Ward` on the GPU.
+    pub const WEIGHT_WARD: u32 = 0;
+    /// `WeightKind::TabellionLamorlette` on the GPU.
+    pub const WEIGHT_TL: u32 = 1;
+}
+
+gpu_consts! {
+    /// The record pass's and neighbour grid's constants' GLSL.
+    fn record_glsl;
+    /// Most strata (M·N) of one record's hemisphere (the shared-memory arrays of the record pass).
+    pub const MAX_STRATA: u32 = 1728;
+    /// Invocations per record (the record pass's workgroup size).
+    pub const RECORD_GROUP: u32 = 64;
+    /// `GpuRecord.info.w`: the gathered irradiance was not finite (stored as black).
+    pub const RECORD_FLAG_INVALID_IRRADIANCE: u32 = 1;
+    /// `GpuRecord.info.w`: the request's pixel held no surface (an empty record).
+    pub const RECORD_FLAG_NO_SURFACE: u32 = 2;
+    /// `GpuRecord.info.w`: the radius was clamped up to R⁻.
+    pub const RECORD_FLAG_CLAMPED_UP: u32 = 4;
+    /// `GpuRecord.info.w`: the radius was clamped down to R⁺.
+    pub const RECORD_FLAG_CLAMPED_DOWN: u32 = 8;
+    /// `GpuRecord.info.w`: the shading normal was folded toward the geometric one.
+    pub const RECORD_FLAG_FOLDED: u32 = 16;
+    /// Bits of `GpuRecord.info.w` that hold flags; the mesh instance is stored above them.
+    pub const RECORD_FLAGS_MASK: u32 = 0xff;
+    /// Shift of the mesh instance in `GpuRecord.info.w`.
+    pub const RECORD_INSTANCE_SHIFT: u32 = 8;
+    /// `GpuRecordTemporal.info.z`: the record was adopted by the temporal state.
+    pub const TEMPORAL_FLAG_ADOPTED: u32 = 1;
+    /// Multiplier of the pass seed in a sub-frame's creation seed
+    /// (`seed · SEED_SUB_FRAME_MUL ^ sub_frame`, the golden-ratio constant).
+    pub const SEED_SUB_FRAME_MUL: u32 = 0x9e37_79b9;
+    /// Levels of the neighbour grid: cell sizes from 2^level_max down to 2^(level_max − 11);
+    /// smaller radii use the finest level.
+    pub const GRID_LEVELS: u32 = 12;
+    /// Grid entries per record: one in table A, one per level in table B.
+    pub const GRID_SLOTS: u32 = 13;
+    /// Vertices of one splat quad (two triangles; `DrawArgs::vertex_count` of the splat draws).
+    pub const QUAD_VERTICES: u32 = 6;
+    /// Longest bucket list the neighbour pass walks (a guard; never reached in practice).
+    pub const GRID_MAX_LIST: u32 = 4096;
+    /// 32-bit words of one `GpuRecord` (the neighbour pass's atomic view of the records).
+    pub const GPU_RECORD_WORDS: u32 = (std::mem::size_of::<crate::gpu::GpuRecord>() / 4) as u32;
+    /// Word of `GpuRecord.normal_rorig.w` (`R_orig`) within a record.
+    pub const GPU_RECORD_R_ORIG_WORD: u32 =
+        ((std::mem::offset_of!(crate::gpu::GpuRecord, normal_rorig) + 12) / 4) as u32;
+}
+
+const _: () = assert!(GRID_SLOTS == GRID_LEVELS + 1);
+const _: () = assert!(RECORD_FLAG_FOLDED <= RECORD_FLAGS_MASK);
+const _: () = assert!(RECORD_FLAGS_MASK == (1 << RECORD_INSTANCE_SHIFT) - 1);
+
+gpu_enum! {
+    /// The steps of the cache's counter bookkeeping (`shaders/passes/ic_counters.comp`).
+    pub enum CounterStep("COUNTERS") {
+        /// No records, no requests; the capacities from the push constants.
+        Reset = 0,
+        /// A creation level starts: no requests, hole count 0.
+        BeginLevel = 1,
+        /// The requests become the record pass's indirect dispatch (one workgroup per request
+        /// that fits), and the batch starts at the record count.
+        BeginBatch = 2,
+        /// The batch joins the records: the record count grows, the splat draw covers every
+        /// record and the batch draw the batch's.
+        EndBatch = 3,
+    }
+}
+
+gpu_enum! {
+    /// The steps of the neighbour-clamping pass (`shaders/passes/neighbours.comp`).
+    pub enum NeighbourStep("NEIGHBOURS") {
+        /// Insert the records before the batch into the grid.
+        InsertOld = 0,
+        /// Insert the batch's records into the grid.
+        InsertBatch = 1,
+        /// Clamp the batch's radii against their neighbours (and the neighbours' against them).
+        Clamp = 2,
+    }
+}
+
+gpu_enum! {
+    /// The steps of the temporal pass (`shaders/passes/temporal.comp`).
+    pub enum TemporalStep("TEMPORAL") {
+        /// Clear the frame's list of records to evaluate.
+        Begin = 0,
+        /// Move the kept records with their instances, list the expired ones.
+        Advance = 1,
+        /// List the frame's new records.
+        Append = 2,
+        /// Give the listed new records their temporal state.
+        Adopt = 3,
+        /// Copy the listed records, moved to the next frame's time, for the look-ahead.
+        Shift = 4,
+        /// Derive rates and lifespans from the look-ahead values.
+        Finish = 5,
+    }
+}
+
+gpu_enum! {
+    /// Where the record pass's requests come from (`shaders/passes/record.comp`).
+    pub enum RecordSource("RECORD_SOURCE") {
+        /// Requests are pixels of the G-buffer: new records.
+        Pixels = 0,
+        /// Requests are record indices: evaluations of existing records (look-ahead, refresh).
+        Records = 1,
+    }
+}
+
+gpu_enum! {
+    /// The formula families of the GLSL twin test (`shaders/tests/ircache_twin.comp`).
+    pub enum TwinMode("TWIN") {
+        /// Stratified hemisphere sampling and hashing.
+        Sampling = 0,
+        /// Record weights and splat radii.
+        Weight = 1,
+        /// Extrapolation with gradients.
+        Extrapolate = 2,
+        /// Harmonic-mean radius and clamping.
+        Radius = 3,
+        /// A whole record from stratum samples.
+        Record = 4,
+        /// The temporal formulas.
+        Temporal = 5,
+    }
+}
+
+/// `shaders/shared/constants.glsl`.
+pub fn generated_glsl() -> String {
+    let mut s = String::from(
+        "// Generated by `cargo xtask codegen` from crates/radcache-shared/src/consts.rs. Do not edit.\n\
+         #ifndef RADCACHE_SHARED_CONSTANTS_GLSL\n#define RADCACHE_SHARED_CONSTANTS_GLSL\n\n",
+    );
+    for part in [
+        ircache_glsl(),
+        record_glsl(),
+        CounterStep::glsl(),
+        NeighbourStep::glsl(),
+        TemporalStep::glsl(),
+        RecordSource::glsl(),
+        TwinMode::glsl(),
+    ] {
+        s.push_str(&part);
+        s.push('\n');
+    }
+    s.push_str("#endif\n");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn literals_round_trip() {
+        for v in [
+            IC_FAR,
+            R_FLOOR,
+            TL_NORMAL_SCALE,
+            ELEVATION_MIN_SIN2,
+            4.0,
+            0.5,
+            1.0e-3,
+        ] {
+            let lit = v.literal();
+            assert!(lit.contains('.') || lit.contains('e'), "{lit}");
+            assert_eq!(lit.parse::<f32>().unwrap(), v, "{lit}");
+        }
+        assert_eq!(0x9e37_79b9u32.literal(), "2654435769u");
+        assert_eq!((-3i32).literal(), "-3");
+    }
+
+    #[test]
+    fn enums_name_their_variants() {
+        assert_eq!(upper_snake("BeginLevel"), "BEGIN_LEVEL");
+        let text = CounterStep::glsl();
+        assert!(
+            text.contains("const uint COUNTERS_BEGIN_LEVEL = 1u;"),
+            "{text}"
+        );
+        assert_eq!(TemporalStep::ALL.len(), 6);
+    }
+
+    #[test]
+    fn generated_glsl_is_up_to_date() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../shaders/shared/constants.glsl"
+        );
+        let on_disk = std::fs::read_to_string(path).unwrap_or_default();
+        assert!(
+            on_disk == generated_glsl(),
+            "shaders/shared/constants.glsl is stale: run `cargo xtask codegen`"
+        );
+    }
+}
