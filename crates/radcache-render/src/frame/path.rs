@@ -93,7 +93,8 @@ pub struct FrameOutput {
     pub aovs: Option<Aovs>,
 }
 
-/// Renders `scene` at `settings.time` with the reference path tracer.
+/// Renders `scene` at `settings.time` with the reference path tracer: setup, samples until the
+/// budget is spent, finish (see [`crate::frame`]).
 pub fn render_path(
     ctx: &Context,
     shaders: &ShaderCompiler,
@@ -107,14 +108,34 @@ pub fn render_path(
         return Err(Error::Invalid(format!("the image size {w}x{h} is empty")));
     }
     let start = Instant::now();
+    let (mut run, aovs) = path_setup(ctx, shaders, scene, gpu, settings)?;
+    path_sample(ctx, gpu, settings, &mut run, start, progress)?;
+    path_finish(ctx, run, start, aovs)
+}
+
+/// What the path tracer's phases share.
+struct PathRun {
+    tracer: PathTracer,
+    clock: FrameClock,
+    rays: u64,
+}
+
+/// **Setup**: the scene at the frame's time and view, the pipelines, the cleared accumulators
+/// and the AOVs (when asked for).
+fn path_setup(
+    ctx: &Context,
+    shaders: &ShaderCompiler,
+    scene: &Scene,
+    gpu: &mut GpuScene,
+    settings: &PathSettings,
+) -> Result<(PathRun, Option<Aovs>)> {
+    let (w, h) = (settings.width, settings.height);
     gpu.set_time(scene, settings.time)?;
     let view = scene.camera_at(settings.time);
     gpu.set_view(&view, w, h, settings.frame, settings.seed)?;
     let mut clock = FrameClock::new();
-    let mut tracer = PathTracer::new(ctx, shaders, gpu, w, h)?;
+    let tracer = PathTracer::new(ctx, shaders, gpu, w, h)?;
     clock.lap("pipelines");
-    let mut rays = 0u64;
-
     let aov_pass = if settings.aovs {
         Some(AovPass::new(ctx, shaders, w, h)?)
     } else {
@@ -133,11 +154,30 @@ pub fn render_path(
     };
     drop(aov_pass);
     clock.lap("setup");
+    let run = PathRun {
+        tracer,
+        clock,
+        rays: 0,
+    };
+    Ok((run, aovs))
+}
 
+/// **Samples**: submissions of `chunk` samples per pixel, each sized from the last one's time
+/// to take about `chunk_target_ms`, until the budget (samples, or seconds since `start`) is
+/// spent.
+fn path_sample(
+    ctx: &Context,
+    gpu: &GpuScene,
+    settings: &PathSettings,
+    run: &mut PathRun,
+    start: Instant,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<()> {
     let target = match settings.budget {
         Budget::Samples(n) => n.max(1),
         Budget::Seconds(_) => u32::MAX,
     };
+    let tracer = &mut run.tracer;
     let mut chunk = 1u32;
     while tracer.samples() < target {
         let count = chunk.min(target - tracer.samples());
@@ -146,8 +186,8 @@ pub fn render_path(
         let submitted = Instant::now();
         let timings = ctx.submit(rec)?.wait()?;
         let gpu_ms: f64 = timings.iter().map(|t| t.duration_ms).sum();
-        clock.gpu(submitted, timings);
-        rays += tracer.last_chunk_rays()?;
+        run.clock.gpu(submitted, timings);
+        run.rays += tracer.last_chunk_rays()?;
         let elapsed_s = start.elapsed().as_secs_f64();
         let total = match settings.budget {
             Budget::Samples(_) => target,
@@ -173,20 +213,29 @@ pub fn render_path(
             chunk = chunk.min(PathTracer::chunk_size(count, gpu_ms, left).max(1));
         }
     }
-    clock.lap("path_trace");
-    let (pixels, nonfinite_pixels) = tracer.read_mean(ctx)?;
-    clock.lap("readback");
-    let mut ray_map = BTreeMap::new();
-    ray_map.insert("path_trace".to_string(), rays);
+    run.clock.lap("path_trace");
+    Ok(())
+}
+
+/// **Finish**: the read-back of the mean over the samples, and the figures.
+fn path_finish(
+    ctx: &Context,
+    mut run: PathRun,
+    start: Instant,
+    aovs: Option<Aovs>,
+) -> Result<FrameOutput> {
+    let (pixels, nonfinite_pixels) = run.tracer.read_mean(ctx)?;
+    run.clock.lap("readback");
+    let (w, h) = run.tracer.size();
     Ok(FrameOutput {
         width: w,
         height: h,
         pixels,
-        spp: tracer.samples(),
+        spp: run.tracer.samples(),
         time_s: start.elapsed().as_secs_f64(),
-        rays: ray_map,
-        passes_ms: clock.passes_ms,
-        spans: clock.spans,
+        rays: BTreeMap::from([("path_trace".to_string(), run.rays)]),
+        passes_ms: run.clock.passes_ms,
+        spans: run.clock.spans,
         nonfinite_pixels,
         aovs,
     })

@@ -52,6 +52,11 @@ impl std::fmt::Debug for PathTracer {
 }
 
 impl PathTracer {
+    /// Width and height of the accumulators.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
     /// Compiles the pass for `scene`'s plan and allocates `width × height` accumulators.
     pub fn new(
         ctx: &Context,
