@@ -1,21 +1,21 @@
 //! Atomic file output: write a temporary file beside the destination, then rename it.
 //!
-//! The temporary file lives in the destination's directory (so the rename never crosses file
-//! systems) under a hidden name `.<file name>.<pid>.<n>.tmp`. Its contents are flushed and
-//! `fsync`ed before the rename, and it is removed again when writing fails. A reader polling the
-//! final path (e.g. a sequence viewer) therefore sees either the previous file or the complete
-//! new one, never a partial write. An interrupted process may leave a hidden `.tmp` file behind,
-//! but never a partial file at the final path.
+//! The temporary file is a `tempfile` named temporary file in the destination's directory (so the
+//! rename never crosses file systems) under a hidden name `.<file name>.<random>.tmp`, created
+//! with the permissions a plain `File::create` would give (not `tempfile`'s private 0600). Its
+//! contents are flushed and `fsync`ed before `persist` renames it onto the destination, and it
+//! is removed again when writing or renaming fails. A reader polling the final path (e.g. a
+//! sequence viewer) therefore sees either the previous file or the complete new one, never a
+//! partial write. A process killed mid-write may leave a hidden `.tmp` file behind, but never a
+//! partial file at the final path.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::path::Path;
+
+use tempfile::{Builder, NamedTempFile};
 
 use crate::error::{Error, Result};
-
-/// Distinguishes temporary files of concurrent writes from one process.
-static COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// Writes `path` atomically: `write` fills a buffered temporary file, which is renamed to `path`
 /// only when `write` and the flush succeed. Errors name `path`.
@@ -23,30 +23,8 @@ pub fn write_atomic<F>(path: &Path, write: F) -> Result<()>
 where
     F: FnOnce(&mut BufWriter<File>) -> Result<()>,
 {
-    let temp = temp_path(path)?;
-    let result = write_temp(path, &temp, write).and_then(|()| {
-        std::fs::rename(&temp, path).map_err(|source| Error::Io {
-            op: "cannot rename temporary file onto",
-            path: path.to_owned(),
-            source,
-        })
-    });
-    if result.is_err() {
-        // Best effort: the temporary file may not exist (e.g. missing directory).
-        let _ = std::fs::remove_file(&temp);
-    }
-    result
-}
-
-fn write_temp<F>(path: &Path, temp: &Path, write: F) -> Result<()>
-where
-    F: FnOnce(&mut BufWriter<File>) -> Result<()>,
-{
-    let file = File::create(temp).map_err(|source| Error::Io {
-        op: "cannot create temporary file for",
-        path: path.to_owned(),
-        source,
-    })?;
+    // Dropping `temp` (on any error below) deletes the temporary file.
+    let (file, temp) = create_temp(path)?.into_parts();
     let mut writer = BufWriter::new(file);
     write(&mut writer)?;
     let io_error = |source| Error::Io {
@@ -56,11 +34,17 @@ where
     };
     writer.flush().map_err(io_error)?;
     let file = writer.into_inner().map_err(|e| io_error(e.into_error()))?;
-    file.sync_all().map_err(io_error)
+    file.sync_all().map_err(io_error)?;
+    drop(file);
+    temp.persist(path).map_err(|e| Error::Io {
+        op: "cannot rename temporary file onto",
+        path: path.to_owned(),
+        source: e.error,
+    })
 }
 
-/// `.<file name>.<pid>.<n>.tmp` in the directory of `path`.
-fn temp_path(path: &Path) -> Result<PathBuf> {
+/// A hidden temporary file `.<file name>.<random>.tmp` in the directory of `path`.
+fn create_temp(path: &Path) -> Result<NamedTempFile> {
     let name = path.file_name().ok_or_else(|| Error::Io {
         op: "cannot write to",
         path: path.to_owned(),
@@ -69,14 +53,26 @@ fn temp_path(path: &Path) -> Result<PathBuf> {
             "the path does not name a file",
         ),
     })?;
-    let mut temp_name = std::ffi::OsString::from(".");
-    temp_name.push(name);
-    temp_name.push(format!(
-        ".{}.{}.tmp",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    Ok(path.with_file_name(temp_name))
+    let dir = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let mut prefix = std::ffi::OsString::from(".");
+    prefix.push(name);
+    prefix.push(".");
+    let mut builder = Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    #[cfg(unix)]
+    {
+        // 0666 before the umask, as `File::create`; tempfile's default is 0600.
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder.tempfile_in(dir).map_err(|source| Error::Io {
+        op: "cannot create temporary file for",
+        path: path.to_owned(),
+        source,
+    })
 }
 
 #[cfg(test)]
@@ -84,21 +80,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn temp_path_is_hidden_sibling() {
-        let temp = temp_path(Path::new("out/dir/frame.exr")).unwrap();
-        assert_eq!(temp.parent(), Some(Path::new("out/dir")));
-        let name = temp.file_name().unwrap().to_str().unwrap();
-        assert!(
-            name.starts_with(".frame.exr.") && name.ends_with(".tmp"),
-            "{name}"
-        );
-        let bare = temp_path(Path::new("frame.exr")).unwrap();
-        assert_eq!(bare.parent(), Some(Path::new("")));
-    }
-
-    #[test]
     fn rejects_paths_without_file_name() {
-        assert!(temp_path(Path::new("/")).is_err());
-        assert!(temp_path(Path::new("out/..")).is_err());
+        for bad in ["/", "out/.."] {
+            let err = write_atomic(Path::new(bad), |_| Ok(())).unwrap_err();
+            let text = err.to_string();
+            assert!(matches!(err, Error::Io { .. }), "{text}");
+            assert!(text.contains(bad), "{text}");
+        }
     }
 }

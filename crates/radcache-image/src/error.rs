@@ -3,14 +3,20 @@
 //! Every variant that concerns a file names its path, so a failed frame of a long sequence can be
 //! found from the message alone. Bad input (missing, corrupt or unexpected files, mismatched
 //! image sizes, malformed path patterns) is always reported through [`Error`], never by a panic.
+//!
+//! A variant that wraps an underlying error returns it from [`std::error::Error::source`] and
+//! does not repeat it in its own message, so a chain printed cause by cause (anyhow's `{:#}`)
+//! names each cause once: `cannot write EXR 'out.exr': No space left on device (os error 28)`.
+//! I/O failures inside the `exr` and `png` encoders become [`Error::Io`]: the `exr` crate's own
+//! error both shows and returns its I/O cause, which would print it twice.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Errors of `radcache-image`.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// An operating-system I/O operation on `path` failed.
-    #[error("{op} '{path}': {source}")]
+    #[error("{op} '{path}'")]
     Io {
         /// What was being done, e.g. "cannot create temporary file for".
         op: &'static str,
@@ -20,8 +26,8 @@ pub enum Error {
         source: std::io::Error,
     },
 
-    /// The `exr` crate failed to encode `path`.
-    #[error("cannot write EXR '{path}': {source}")]
+    /// The `exr` crate failed to encode `path` (other than by an I/O error, which is [`Error::Io`]).
+    #[error("cannot write EXR '{path}'")]
     ExrWrite {
         /// The destination file.
         path: PathBuf,
@@ -29,8 +35,9 @@ pub enum Error {
         source: exr::error::Error,
     },
 
-    /// The `exr` crate failed to decode `path` (missing, truncated or corrupt file).
-    #[error("cannot read EXR '{path}': {source}")]
+    /// The `exr` crate failed to decode `path` (truncated or corrupt file; a missing or
+    /// unreadable one is [`Error::Io`]).
+    #[error("cannot read EXR '{path}'")]
     ExrRead {
         /// The source file.
         path: PathBuf,
@@ -78,8 +85,8 @@ pub enum Error {
         message: String,
     },
 
-    /// The `png` crate failed to encode `path`.
-    #[error("cannot write PNG '{path}': {source}")]
+    /// The `png` crate failed to encode `path` (other than by an I/O error, which is [`Error::Io`]).
+    #[error("cannot write PNG '{path}'")]
     Png {
         /// The destination file.
         path: PathBuf,
@@ -148,3 +155,85 @@ pub enum Error {
 
 /// `Result` with this crate's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl Error {
+    /// An `exr` crate failure while writing `path` ([`Error::ExrWrite`], or [`Error::Io`]).
+    pub(crate) fn exr_write(path: &Path, error: exr::error::Error) -> Error {
+        match error {
+            exr::error::Error::Io(source) => Error::io("cannot write EXR", path, source),
+            source => Error::ExrWrite {
+                path: path.to_owned(),
+                source,
+            },
+        }
+    }
+
+    /// An `exr` crate failure while reading `path` ([`Error::ExrRead`], or [`Error::Io`]).
+    pub(crate) fn exr_read(path: &Path, error: exr::error::Error) -> Error {
+        match error {
+            exr::error::Error::Io(source) => Error::io("cannot read EXR", path, source),
+            source => Error::ExrRead {
+                path: path.to_owned(),
+                source,
+            },
+        }
+    }
+
+    /// A `png` crate failure while writing `path` ([`Error::Png`], or [`Error::Io`]).
+    pub(crate) fn png_write(path: &Path, error: png::EncodingError) -> Error {
+        match error {
+            png::EncodingError::IoError(source) => Error::io("cannot write PNG", path, source),
+            source => Error::Png {
+                path: path.to_owned(),
+                source,
+            },
+        }
+    }
+
+    fn io(op: &'static str, path: &Path, source: std::io::Error) -> Error {
+        Error::Io {
+            op,
+            path: path.to_owned(),
+            source,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::error::Error as _;
+
+    use super::*;
+
+    /// The chain as anyhow's `{:#}` prints it.
+    fn chain(e: &Error) -> String {
+        let mut text = e.to_string();
+        let mut cause = e.source();
+        while let Some(c) = cause {
+            text += &format!(": {c}");
+            cause = c.source();
+        }
+        text
+    }
+
+    #[test]
+    fn a_full_disk_is_named_once() {
+        let full = || std::io::Error::from_raw_os_error(28);
+        let os = full().to_string();
+        let path = Path::new("out/frame.exr");
+        for err in [
+            Error::exr_write(path, exr::error::Error::Io(full())),
+            Error::exr_read(path, exr::error::Error::Io(full())),
+            Error::png_write(path, png::EncodingError::IoError(full())),
+        ] {
+            let text = chain(&err);
+            assert_eq!(text.matches(&os).count(), 1, "{text}");
+            assert!(text.contains("'out/frame.exr'"), "{text}");
+        }
+        let text = chain(&Error::exr_write(
+            path,
+            exr::error::Error::Invalid("bad".into()),
+        ));
+        assert_eq!(text, "cannot write EXR 'out/frame.exr': invalid: bad");
+    }
+}

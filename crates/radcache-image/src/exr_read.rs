@@ -14,7 +14,7 @@
 //! mip/rip level is read. All parts must share one size.
 //!
 //! Decoding errors, and panics inside the `exr` crate on malformed input, become
-//! [`Error::ExrRead`] naming the file.
+//! [`Error::ExrRead`] naming the file; a missing or unreadable file is [`Error::Io`].
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -124,10 +124,7 @@ fn decode(path: &Path) -> Result<AnyImage> {
     // The `exr` crate is meant to return errors on malformed files; this guard turns any
     // remaining panic into an error as well (`AssertUnwindSafe`: nothing is shared).
     match std::panic::catch_unwind(std::panic::AssertUnwindSafe(read)) {
-        Ok(result) => result.map_err(|source| Error::ExrRead {
-            path: path.to_owned(),
-            source,
-        }),
+        Ok(result) => result.map_err(|e| Error::exr_read(path, e)),
         Err(_) => Err(Error::ExrRead {
             path: path.to_owned(),
             source: exr::error::Error::Invalid("the decoder panicked on this file".into()),

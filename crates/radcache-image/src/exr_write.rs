@@ -121,10 +121,7 @@ pub fn write_exr(
         exr_image
             .write()
             .to_buffered(file)
-            .map_err(|source| Error::ExrWrite {
-                path: path.to_owned(),
-                source,
-            })
+            .map_err(|e| Error::exr_write(path, e))
     })?;
     log::debug!(
         "wrote {}x{} EXR '{}'",

@@ -37,10 +37,7 @@ pub fn to_srgb8(image: &Image, options: &PngOptions) -> Vec<u8> {
 pub fn write_png(path: impl AsRef<Path>, image: &Image, options: &PngOptions) -> Result<()> {
     let path = path.as_ref();
     let pixels = to_srgb8(image, options);
-    let png_error = |source| Error::Png {
-        path: path.to_owned(),
-        source,
-    };
+    let png_error = |e| Error::png_write(path, e);
     write_atomic(path, |file| {
         let mut encoder = png::Encoder::new(file, image.width(), image.height());
         encoder.set_color(png::ColorType::Rgb);

@@ -234,6 +234,81 @@ fn final_path_appears_only_after_success() {
 }
 
 #[test]
+fn failed_rename_names_the_destination_and_removes_the_temporary_file() {
+    let dir = scratch_dir("rename_fails");
+    // A non-empty directory at the destination: the final rename fails.
+    let path = dir.join("frame.exr");
+    std::fs::create_dir(&path).unwrap();
+    std::fs::write(path.join("keep"), b"x").unwrap();
+    let err = write_atomic(&path, |file| {
+        use std::io::Write;
+        file.write_all(b"complete").map_err(|source| Error::Io {
+            op: "cannot write",
+            path: path.clone(),
+            source,
+        })
+    })
+    .unwrap_err();
+    let message = err.to_string();
+    assert!(matches!(err, Error::Io { .. }), "{message}");
+    assert!(message.contains("cannot rename"), "{message}");
+    assert!(message.contains(&path.display().to_string()), "{message}");
+    assert_eq!(entries(&dir), ["frame.exr"]);
+    assert_eq!(entries(&path), ["keep"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn atomic_files_get_the_permissions_of_a_plain_create() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch_dir("permissions");
+    let plain = dir.join("plain");
+    std::fs::File::create(&plain).unwrap();
+    let atomic = dir.join("atomic");
+    write_atomic(&atomic, |_| Ok(())).unwrap();
+    let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode(&atomic), mode(&plain));
+}
+
+/// The full error chain, cause by cause, as anyhow's `{:#}` prints it.
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut parts = vec![e.to_string()];
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        parts.push(c.to_string());
+        cause = c.source();
+    }
+    parts.join(": ")
+}
+
+#[test]
+fn error_chains_name_each_cause_once() {
+    let dir = scratch_dir("chains");
+    let os = std::fs::read(dir.join("missing")).unwrap_err().to_string();
+
+    let path = dir.join("no/such/dir/frame.exr");
+    let options = ExrOptions::default();
+    let err = write_exr(&path, &test_image(), &Metadata::new(), &options).unwrap_err();
+    let text = chain(&err);
+    assert_eq!(text.matches(&os).count(), 1, "{text}");
+    assert!(text.contains("no/such/dir/frame.exr"), "{text}");
+
+    // Through the `exr` crate's own I/O error.
+    let path = dir.join("missing.exr");
+    let text = chain(&read_exr(&path).unwrap_err());
+    assert_eq!(text.matches(&os).count(), 1, "{text}");
+    assert!(
+        text.starts_with(&format!("cannot read EXR '{}'", path.display())),
+        "{text}"
+    );
+
+    let path = dir.join("no/such/dir/frame.png");
+    let err = radcache_image::write_png(&path, &test_image(), &Default::default()).unwrap_err();
+    let text = chain(&err);
+    assert_eq!(text.matches(&os).count(), 1, "{text}");
+}
+
+#[test]
 fn rewriting_replaces_the_file() {
     let dir = scratch_dir("rewrite");
     let path = dir.join("frame.exr");

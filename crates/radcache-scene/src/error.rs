@@ -4,6 +4,10 @@
 //! node, camera, animation, image), with index and name where known, so that a user can find it in
 //! the JSON. Bad input never panics: it becomes an `Error`, or a [`Warning`] when the loader can
 //! carry on with a documented fallback (e.g. alpha-blended materials rendered opaque).
+//!
+//! A variant that wraps an I/O error returns it from [`std::error::Error::source`] and does not
+//! repeat it in its own message, so a chain printed cause by cause (anyhow's `{:#}`) names each
+//! cause once: `scene.gltf: cannot read glTF file: No such file or directory (os error 2)`.
 
 use std::fmt;
 use std::path::PathBuf;
@@ -15,7 +19,7 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// The glTF file itself cannot be read (missing, permissions, ...).
-    #[error("{path}: cannot read glTF file: {source}")]
+    #[error("{path}: cannot read glTF file")]
     Io {
         /// The glTF file.
         path: PathBuf,
@@ -29,6 +33,18 @@ pub enum Error {
         path: PathBuf,
         /// What the parser or validator reported.
         message: String,
+    },
+    /// `asset.version` is not 2.x, or `asset.minVersion` asks for more than glTF 2.0.
+    #[error("{path}: unsupported glTF version: asset.{field} is {version:?}, {reason}")]
+    UnsupportedVersion {
+        /// The glTF file.
+        path: PathBuf,
+        /// The offending field: `version` or `minVersion`.
+        field: &'static str,
+        /// Its value.
+        version: String,
+        /// What this loader reads instead.
+        reason: &'static str,
     },
     /// `extensionsRequired` names an extension this loader does not implement.
     #[error("{path}: unsupported required extension {name:?}")]
@@ -126,7 +142,7 @@ pub enum Error {
         reason: String,
     },
     /// Writing a glTF file (writer/assets) failed.
-    #[error("{path}: cannot write: {source}")]
+    #[error("{path}: cannot write")]
     Write {
         /// The file being written.
         path: PathBuf,

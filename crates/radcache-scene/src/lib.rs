@@ -24,13 +24,15 @@
 //!
 //! **Bad input** never panics (a seeded mutation test checks this). It is one [`Error`] naming the
 //! file and the element (buffer, accessor with its mesh/primitive/attribute user, node, camera,
-//! animation channel/sampler, light, image): unreadable or invalid files, missing or short buffers,
+//! animation channel/sampler, light, image): unreadable or invalid files, files that are not glTF
+//! 2.x, missing or short buffers, missing or undecodable image files (named with their path),
 //! accessors or buffer views out of range, vertex indices out of range, NaN/Inf vertex data or key
 //! values, unsupported required extensions, orthographic cameras, broken hierarchies. Droppable
 //! elements are dropped with a [`Warning`] that carries a count: degenerate triangles,
 //! non-TRIANGLES primitives, primitives without POSITION. Features outside the renderer's model are
 //! loaded with a documented fallback and a warning: alpha MASK/BLEND (opaque), skins and morph
-//! targets (rest pose), texCoord sets other than 0 (texture ignored), missing normals (flat).
+//! targets (rest pose), texCoord sets other than 0 (texture ignored), missing normals (flat), a
+//! negative `emissiveStrength` (not emissive).
 //!
 //! The [`writer`] module builds valid glTF files (used by tests and by [`assets`], which generates
 //! the bundled Cornell box, furnace and animated scenes).
@@ -39,7 +41,6 @@ mod accessor;
 pub mod alias;
 pub mod animation;
 pub mod assets;
-mod base64;
 pub mod camera;
 pub mod emissive;
 pub mod environment;

@@ -3,6 +3,8 @@
 //! Units: `emissive` is radiance in W/(sr·m²) (linear RGB): glTF `emissiveFactor` ×
 //! `KHR_materials_emissive_strength.emissiveStrength` (× the emissive texture, if any, per texel).
 //! Base colour factors are linear; base-colour and emissive textures are sRGB-encoded.
+//! A negative `emissiveStrength` (the extension requires ≥ 0) makes the material non-emissive
+//! with a warning, as non-finite factors do.
 //!
 //! **Emission rule.** An emissive triangle emits from its front face — the side from which its
 //! vertices appear counter-clockwise, i.e. the side its geometric normal `(p1-p0)×(p2-p0)` points
@@ -100,7 +102,14 @@ pub(crate) fn load_materials(
             }
         }
         let pbr = m.pbr_metallic_roughness();
-        let strength = m.emissive_strength().unwrap_or(1.0);
+        let mut strength = m.emissive_strength().unwrap_or(1.0);
+        if strength < 0.0 {
+            let msg = format!(
+                "{file}: {user}: negative emissiveStrength {strength}; using 0 (not emissive)"
+            );
+            warnings.push(WarningKind::Other, 1, msg);
+            strength = 0.0;
+        }
         let emissive = Vec3::from(m.emissive_factor()) * strength;
         let base_color = Vec4::from(pbr.base_color_factor());
         let mut sane = |v: f32, what: &str, lo: f32, hi: f32| -> f32 {

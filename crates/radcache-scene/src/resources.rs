@@ -8,8 +8,19 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::base64;
+use base64::alphabet::STANDARD;
+use base64::engine::{DecodePaddingMode, GeneralPurpose, GeneralPurposeConfig};
+use base64::Engine as _;
+
 use crate::error::{label, Error, Result};
+
+/// Standard base64 (RFC 4648, `+/` alphabet) for data URIs: padding optional, no whitespace.
+const BASE64: GeneralPurpose = GeneralPurpose::new(
+    &STANDARD,
+    GeneralPurposeConfig::new()
+        .with_decode_padding_mode(DecodePaddingMode::Indifferent)
+        .with_decode_allow_trailing_bits(true),
+);
 
 /// A parsed and validated glTF document with its buffers loaded.
 #[derive(Debug)]
@@ -42,6 +53,7 @@ impl Source {
         let gltf::Gltf { document, blob } =
             gltf::Gltf::from_slice_without_validation(&bytes).map_err(parse_err)?;
         let root = document.into_json();
+        check_version(path, &root.asset)?;
         for name in &root.extensions_required {
             if !SUPPORTED_REQUIRED.contains(&name.as_str()) {
                 return Err(Error::UnsupportedExtension {
@@ -104,7 +116,9 @@ impl Source {
             let (_, payload) = rest
                 .split_once(";base64,")
                 .ok_or_else(|| "data URI is not base64-encoded".to_string())?;
-            return base64::decode(payload).map_err(|e| format!("bad base64 data: {e}"));
+            return BASE64
+                .decode(payload)
+                .map_err(|e| format!("bad base64 data: {e}"));
         }
         let rel = relative_path(uri)?;
         let file = self.base.join(rel);
@@ -131,6 +145,8 @@ impl Source {
             Some(_) => {}
             None => return Err(invalid("image does not exist".into())),
         }
+        // The file an external image is read from, for messages.
+        let mut file = None;
         match image.source() {
             gltf::image::Source::View { view, .. } => {
                 let len = self
@@ -150,17 +166,66 @@ impl Source {
             }
             gltf::image::Source::Uri { uri, .. } => {
                 if !uri.starts_with("data:") {
-                    relative_path(uri).map_err(invalid)?;
+                    file = Some(self.base.join(relative_path(uri).map_err(invalid)?));
                 }
             }
         }
-        gltf::image::Data::from_source(image.source(), Some(&self.base), &self.buffers)
-            .map_err(|e| invalid(format!("cannot decode: {}", describe_gltf_error(&e))))
+        gltf::image::Data::from_source(image.source(), Some(&self.base), &self.buffers).map_err(
+            |e| match (&file, e) {
+                (Some(file), gltf::Error::Io(io)) => {
+                    invalid(format!("cannot read image file {}: {io}", file.display()))
+                }
+                (Some(file), e) => invalid(format!(
+                    "cannot decode image file {}: {}",
+                    file.display(),
+                    describe_gltf_error(&e)
+                )),
+                (None, e) => invalid(format!("cannot decode: {}", describe_gltf_error(&e))),
+            },
+        )
     }
 
     /// The glTF file path as an owned value (for error construction).
     pub(crate) fn path(&self) -> PathBuf {
         self.path.clone()
+    }
+}
+
+/// Refuses files that are not glTF 2.x (`asset.version`) or that need more than glTF 2.0
+/// (`asset.minVersion`); both have the form `<major>.<minor>`.
+fn check_version(path: &Path, asset: &gltf::json::Asset) -> Result<()> {
+    fn parse(v: &str) -> Option<(u32, u32)> {
+        let (major, minor) = v.split_once('.')?;
+        // Digits only (`str::parse` would also take a sign); empty fails to parse.
+        let number = |s: &str| {
+            s.bytes()
+                .all(|b| b.is_ascii_digit())
+                .then(|| s.parse().ok())?
+        };
+        Some((number(major)?, number(minor)?))
+    }
+    let refuse = |field, version: &str, reason| Error::UnsupportedVersion {
+        path: path.to_path_buf(),
+        field,
+        version: version.to_string(),
+        reason,
+    };
+    const FORM: &str = "expected <major>.<minor>, e.g. \"2.0\"";
+    match parse(&asset.version) {
+        Some((2, _)) => {}
+        Some(_) => {
+            return Err(refuse(
+                "version",
+                &asset.version,
+                "this loader reads glTF 2.x",
+            ))
+        }
+        None => return Err(refuse("version", &asset.version, FORM)),
+    }
+    match asset.min_version.as_deref().map(|v| (v, parse(v))) {
+        None | Some((_, Some((2, 0)))) => Ok(()),
+        Some((v, Some(_))) => Err(refuse("minVersion", v, "this loader implements glTF 2.0")),
+        Some((v, None)) => Err(refuse("minVersion", v, FORM)),
     }
 }
 
@@ -287,5 +352,20 @@ mod tests {
         assert_eq!(percent_decode("%zz%4"), b"%zz%4");
         assert!(relative_path("%FF").is_err());
         assert!(relative_path("http://x/y.bin").is_err());
+    }
+
+    #[test]
+    fn data_uri_base64() {
+        use base64::engine::general_purpose::STANDARD as ENCODE;
+        for len in 0..20 {
+            let data: Vec<u8> = (0..len).map(|i| (i * 37 + 11) as u8).collect();
+            let text = ENCODE.encode(&data);
+            assert_eq!(BASE64.decode(&text).unwrap(), data);
+            assert_eq!(BASE64.decode(text.trim_end_matches('=')).unwrap(), data);
+        }
+        assert_eq!(ENCODE.encode(b"Ma"), "TWE=");
+        assert!(BASE64.decode("T").is_err());
+        assert!(BASE64.decode("TW E").is_err());
+        assert!(BASE64.decode("TW\nE").is_err());
     }
 }

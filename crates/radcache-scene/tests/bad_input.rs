@@ -325,3 +325,126 @@ fn invalid_punctual_lights() {
         assert_mentions(&e, &["t.gltf", "KHR_lights_punctual light 1", needle]);
     }
 }
+
+/// The full error chain, cause by cause, as anyhow's `{:#}` prints it.
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut parts = vec![e.to_string()];
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        parts.push(c.to_string());
+        cause = c.source();
+    }
+    parts.join(": ")
+}
+
+#[test]
+fn error_chains_name_each_cause_once() {
+    let path = temp_dir("chain").join("nope.gltf");
+    let os = std::fs::read(&path).unwrap_err().to_string();
+    let text = chain(&load_err(&path));
+    assert_eq!(text.matches(&os).count(), 1, "{text}");
+    assert!(text.contains("nope.gltf: cannot read glTF file"), "{text}");
+
+    let b = triangle_scene(None, |_| {});
+    let path = temp_dir("chain-write").join("no/such/dir/w.gltf");
+    let e = b.write(&path, radcache_scene::writer::BufferLayout::External);
+    let text = chain(&e.unwrap_err());
+    assert_eq!(text.matches(&os).count(), 1, "{text}");
+    assert!(text.contains("w.gltf: cannot write"), "{text}");
+}
+
+/// The triangle scene with a material whose base colour texture is the image `uri`.
+fn textured(tag: &str, uri: &str) -> PathBuf {
+    mutated(tag, |r| {
+        r["images"] = json!([{"uri": uri, "name": "albedo"}]);
+        r["textures"] = json!([{"source": 0}]);
+        r["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
+        r["meshes"][0]["primitives"][0]["material"] = json!(0);
+    })
+}
+
+#[test]
+fn missing_and_corrupt_image_files_are_named() {
+    let path = textured("noimage", "tex/missing%20file.png");
+    let e = load_err(&path);
+    assert!(matches!(e, Error::Invalid { .. }), "{e:?}");
+    let file = path.with_file_name("tex/missing file.png");
+    assert_mentions(
+        &e,
+        &[
+            "t.gltf",
+            "image 0 \"albedo\"",
+            "cannot read image file",
+            &file.display().to_string(),
+        ],
+    );
+
+    let path = textured("badimage", "bad.png");
+    let file = path.with_file_name("bad.png");
+    std::fs::write(&file, b"\x89PNG\r\n\x1a\nthis is no PNG data").unwrap();
+    let e = load_err(&path);
+    assert!(matches!(e, Error::Invalid { .. }), "{e:?}");
+    assert_mentions(
+        &e,
+        &[
+            "image 0 \"albedo\"",
+            "cannot decode image file",
+            &file.display().to_string(),
+        ],
+    );
+}
+
+#[test]
+fn negative_emissive_strength_warns() {
+    let path = mutated("negstrength", |r| {
+        r["extensionsUsed"] = json!(["KHR_materials_emissive_strength"]);
+        r["materials"] = json!([{
+            "name": "lamp",
+            "emissiveFactor": [1.0, 1.0, 1.0],
+            "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": -2.0}},
+        }]);
+        r["meshes"][0]["primitives"][0]["material"] = json!(0);
+    });
+    let (s, w) = common::load(&path);
+    assert!(!s.materials[0].is_emissive());
+    let hits: Vec<_> = w
+        .iter()
+        .filter(|w| {
+            w.message.contains("material 0 \"lamp\"") && w.message.contains("emissiveStrength -2")
+        })
+        .collect();
+    assert_eq!(hits.len(), 1, "{w:?}");
+    assert_eq!(hits[0].kind, WarningKind::Other);
+}
+
+#[test]
+fn gltf_versions_other_than_2_are_refused() {
+    fn set(version: Value, min: Option<&'static str>) -> impl FnOnce(&mut Value) {
+        move |r: &mut Value| {
+            r["asset"]["version"] = version;
+            if let Some(min) = min {
+                r["asset"]["minVersion"] = json!(min);
+            }
+        }
+    }
+    for (tag, version, min, field, value) in [
+        ("v3", json!("3.0"), None, "version", "\"3.0\""),
+        ("v1", json!("1.0"), None, "version", "\"1.0\""),
+        ("v2bare", json!("2"), None, "version", "\"2\""),
+        ("v2x", json!("2.x"), None, "version", "\"2.x\""),
+        ("min21", json!("2.1"), Some("2.1"), "minVersion", "\"2.1\""),
+        ("min3", json!("2.0"), Some("3.0"), "minVersion", "\"3.0\""),
+    ] {
+        let e = load_err(&mutated(tag, set(version, min)));
+        assert!(
+            matches!(&e, Error::UnsupportedVersion { field: f, .. } if *f == field),
+            "{tag}: {e:?}"
+        );
+        assert_mentions(&e, &["t.gltf", "unsupported glTF version", field, value]);
+    }
+    // Later 2.x versions load, and so does minVersion 2.0.
+    for (tag, version, min) in [("v21", "2.1", None), ("min20", "2.1", Some("2.0"))] {
+        let path = mutated(tag, set(json!(version), min));
+        assert!(Scene::load(&path, &LoadOptions::default()).is_ok(), "{tag}");
+    }
+}

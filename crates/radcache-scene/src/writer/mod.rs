@@ -13,6 +13,7 @@ mod png;
 use std::collections::BTreeSet;
 use std::path::Path;
 
+use base64::Engine as _;
 use serde_json::{json, Map, Value};
 
 use crate::animation::{Interpolation, Property};
@@ -356,7 +357,7 @@ impl GltfBuilder {
                 Some(u) => u.to_string(),
                 None => format!(
                     "data:application/octet-stream;base64,{}",
-                    crate::base64::encode(&self.bin)
+                    base64::engine::general_purpose::STANDARD.encode(&self.bin)
                 ),
             };
             root["buffers"] = json!([{"byteLength": self.bin.len(), "uri": uri}]);
