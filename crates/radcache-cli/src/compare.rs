@@ -66,9 +66,9 @@ pub fn run(args: &CompareArgs) -> Result<ExitCode> {
             "metrics": metrics,
             "exceeded": exceeded,
         });
-        crate::emit(&format!("{}\n", serde_json::to_string_pretty(&value)?))?;
+        crate::output::emit(&format!("{}\n", serde_json::to_string_pretty(&value)?))?;
     } else {
-        crate::emit(&metrics.to_string())?;
+        crate::output::emit(&metrics.to_string())?;
         for e in &exceeded {
             eprintln!("limit exceeded: {e}");
         }

@@ -27,8 +27,9 @@ use radcache_render::{EnvMap, GpuScene};
 use radcache_scene::{Environment, LoadOptions, Scene};
 use radcache_vk::{Context, ShaderCompiler};
 
-use crate::ic_args::Weight;
-use crate::progress::ProgressLine;
+use crate::args::ic::Weight;
+use crate::args::{parse_resolution, shader_root};
+use crate::progress::{self, FrameBar};
 use crate::sequence::{FrameArgs, Sequence};
 use ladder::{Bench, Ladder, Point};
 use model::PtPoint;
@@ -72,16 +73,6 @@ pub struct ConvergenceArgs {
     /// No progress lines.
     #[arg(long, short)]
     quiet: bool,
-}
-
-fn parse_resolution(text: &str) -> Result<(u32, u32)> {
-    let parsed = text
-        .split_once(['x', 'X'])
-        .and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
-    match parsed {
-        Some((w, h)) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => Ok((w, h)),
-        _ => bail!("--resolution {text:?}: expected WxH with each side in 1..=16384, e.g. 128x128"),
-    }
 }
 
 /// Where the reference comes from.
@@ -134,18 +125,14 @@ pub fn run(args: &ConvergenceArgs) -> Result<ExitCode> {
 
     let reference = match &args.reference {
         Some(path) => {
-            let (image, meta) = read_exr(path)
-                .with_context(|| format!("reading the reference {}", path.display()))?;
+            let (image, meta) = read_exr(path).context("reading the reference")?;
             let spp = meta.spp.filter(|_| meta.method.as_deref() == Some("path"));
             Reference::File(path.clone(), image, spp)
         }
         None => Reference::Render(args.reference_spp),
     };
-    let (scene, warnings) = Scene::load(&args.scene, &LoadOptions::default())
-        .with_context(|| format!("loading the scene {}", args.scene.display()))?;
-    for w in &warnings {
-        log::warn!("{w}");
-    }
+    // The loader's errors name the file, and it logs its warnings itself.
+    let (scene, _warnings) = Scene::load(&args.scene, &LoadOptions::default())?;
     let env_map = match &scene.environment {
         Environment::Map { path, .. } => Some(EnvMap::load(path)?),
         _ => None,
@@ -176,7 +163,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<ExitCode> {
 
     let ctx = Context::new()?;
     let device = ctx.info().name.clone();
-    let shaders = ShaderCompiler::new(crate::shader_root())?;
+    let shaders = ShaderCompiler::new(shader_root())?;
     let mut gpu = GpuScene::new(&ctx, &scene, env_map.as_ref())?;
     let bench = Bench {
         ctx: &ctx,
@@ -188,7 +175,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<ExitCode> {
     };
     let say = |text: String| {
         if !args.quiet {
-            eprintln!("{text}");
+            progress::line(&text);
         }
     };
     bench.warm_up(&mut gpu)?;
@@ -207,9 +194,8 @@ pub fn run(args: &ConvergenceArgs) -> Result<ExitCode> {
             (image, spp, how)
         }
         Reference::Render(spp) => {
-            let mut bar = ProgressLine::new("reference", "spp", args.quiet);
-            let (image, out) =
-                bench.reference(&mut gpu, spp, &mut |d, t, e| bar.update(d, t, e))?;
+            let bar = FrameBar::new("reference", "spp", args.quiet);
+            let (image, out) = bench.reference(&mut gpu, spp, &mut |d, t, _| bar.update(d, t))?;
             bar.finish();
             let path = args.output.join("reference.exr");
             write_exr(
@@ -397,15 +383,5 @@ mod tests {
         let err = frame_time(&args(&["--frame", "0"]), None).unwrap_err();
         assert!(err.to_string().contains("--frame"), "{err}");
         assert!(frame_time(&args(&["--fps", "0"]), None).is_err());
-    }
-
-    #[test]
-    fn resolution_is_checked() {
-        assert_eq!(parse_resolution("64x48").unwrap(), (64, 48));
-        assert_eq!(parse_resolution(" 8 X 9 ").unwrap(), (8, 9));
-        for bad in ["64", "0x5", "ax5", "5x99999"] {
-            let err = parse_resolution(bad).unwrap_err().to_string();
-            assert!(err.contains("--resolution"), "{bad}: {err}");
-        }
     }
 }

@@ -87,7 +87,7 @@ pub fn run(args: &FlickerArgs) -> Result<ExitCode> {
     } else {
         table(args, &report, &numbers)
     };
-    crate::emit(&text)?;
+    crate::output::emit(&text)?;
     Ok(ExitCode::SUCCESS)
 }
 

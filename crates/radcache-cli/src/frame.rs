@@ -17,8 +17,8 @@ use radcache_scene::Scene;
 use radcache_vk::{Context, ShaderCompiler};
 use serde_json::{json, Value};
 
-use crate::progress::ProgressLine;
-use crate::render::{Method, RenderArgs};
+use crate::args::{Method, RenderArgs};
+use crate::progress::FrameBar;
 
 /// What stays the same over the frames of a run.
 pub struct FrameSetup<'a> {
@@ -79,7 +79,7 @@ pub fn render(
                 aovs: args.aov,
                 ..PathSettings::default()
             };
-            let mut bar = ProgressLine::new(format!("frame {frame}"), "spp", args.quiet);
+            let bar = FrameBar::new(format!("frame {frame}"), "spp", args.quiet);
             let started = Instant::now();
             let out = render_path(
                 setup.ctx,
@@ -87,7 +87,7 @@ pub fn render(
                 setup.scene,
                 gpu,
                 &settings,
-                &mut |p| bar.update(p.done, p.total, p.elapsed_s),
+                &mut |p| bar.update(p.done, p.total),
             )?;
             bar.finish();
             Ok(Rendered {
@@ -130,12 +130,11 @@ pub fn render(
             if !setup.temporal {
                 renderer.forget();
             }
-            let mut bar =
-                ProgressLine::new(format!("frame {frame}"), "sub-frame phases", args.quiet);
+            let bar = FrameBar::new(format!("frame {frame}"), "sub-frame phases", args.quiet);
             let started = Instant::now();
             let (mut out, stats) =
                 renderer.render(setup.ctx, setup.scene, gpu, &settings, &mut |p| {
-                    bar.update(p.done, p.total, p.elapsed_s)
+                    bar.update(p.done, p.total)
                 })?;
             bar.finish();
             if args.aov {
@@ -179,7 +178,7 @@ pub fn metadata(setup: &FrameSetup<'_>, r: &Rendered, frame: u32, time: f32) -> 
     let (width, height) = setup.size;
     let view = setup.scene.camera_at(time);
     let mut meta = Metadata::new();
-    meta.method = Some(method_name(args.method).into());
+    meta.method = Some(args.method.name().into());
     meta.spp = Some(r.out.spp);
     if let Some(stats) = &r.ic {
         meta.extra.insert(
@@ -203,14 +202,6 @@ pub fn metadata(setup: &FrameSetup<'_>, r: &Rendered, frame: u32, time: f32) -> 
     meta.extra
         .insert("device".into(), setup.ctx.info().name.clone());
     meta
-}
-
-/// The method's name in files and messages.
-pub fn method_name(method: Method) -> &'static str {
-    match method {
-        Method::Path => "path",
-        Method::Ic => "ic",
-    }
 }
 
 /// The PNG previews' exposure and tone curve.

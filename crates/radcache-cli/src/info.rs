@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::Args;
 use radcache_scene::{LoadOptions, Scene};
 
-use crate::render::EnvArgs;
+use crate::args::EnvArgs;
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
@@ -25,12 +25,8 @@ pub fn run(args: &InfoArgs) -> Result<ExitCode> {
         camera_name: args.camera.clone(),
         env: args.env.to_override()?,
     };
-    let (scene, warnings) = Scene::load(&args.scene, &opts)?;
-    let mut text = String::new();
-    for w in &warnings {
-        text.push_str(&format!("warning: {w}\n"));
-    }
-    text.push_str(&scene.to_string());
-    crate::emit(&text)?;
+    // The loader logs its warnings on stderr as it finds them; stdout has the summary only.
+    let (scene, _warnings) = Scene::load(&args.scene, &opts)?;
+    crate::output::emit(&scene.to_string())?;
     Ok(ExitCode::SUCCESS)
 }

@@ -1,10 +1,22 @@
 //! `radcache`: render glTF scenes with global illumination, inspect them, compare images.
+//!
+//! Modules depend only downward, in this order (each uses only modules below it):
+//!
+//! | layer | modules |
+//! |---|---|
+//! | commands | `render`, `info`, `compare`, `flicker`, `convergence` (with its `ladder`, `model`, `plot`, `report`) |
+//! | a frame of `render` | `frame` |
+//! | helpers | `sequence` (frames, contact sheet, per-frame lines), `profile` (trace, pass table) |
+//! | leaves | `args` (clap types of `render`, `args::ic` the cache's), `progress` (bars), `output` (stdout, files) |
+//!
+//! This root only parses the command line, sets up the logger and prints a failed command's
+//! error, each cause once.
 
+mod args;
 mod compare;
 mod convergence;
 mod flicker;
 mod frame;
-mod ic_args;
 mod info;
 mod output;
 mod profile;
@@ -12,7 +24,6 @@ mod progress;
 mod render;
 mod sequence;
 
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -31,7 +42,7 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Render a scene to an EXR (and optionally a PNG preview).
-    Render(Box<render::RenderArgs>),
+    Render(Box<args::RenderArgs>),
     /// Print a scene's summary and the plan of what its frames need.
     Info(info::InfoArgs),
     /// Compare a candidate image against a reference (RMSE, relMSE, MAE, block RMSE, FLIP, ...).
@@ -43,25 +54,25 @@ enum Command {
     Convergence(convergence::ConvergenceArgs),
 }
 
-/// Where the GLSL sources live: `RADCACHE_SHADERS`, else the source tree this binary was built
-/// from.
-pub(crate) fn shader_root() -> PathBuf {
-    std::env::var_os("RADCACHE_SHADERS")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shaders")))
-}
-
-/// Writes `text` to stdout; a closed pipe (`radcache info x | head`) is not an error.
-pub(crate) fn emit(text: &str) -> std::io::Result<()> {
-    use std::io::Write;
-    match std::io::stdout().lock().write_all(text.as_bytes()) {
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        other => other,
+/// The error's chain as one line, `outer: cause: cause`, each cause once: a cause whose message
+/// the text already holds (an error that prints its source and also returns it from
+/// `Error::source`) is not repeated.
+fn error_text(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let message = cause.to_string();
+        if text.is_empty() {
+            text = message;
+        } else if !text.contains(&message) {
+            text.push_str(": ");
+            text.push_str(&message);
+        }
     }
+    text
 }
 
 fn main() -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    progress::init_logger();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render::run(&args),
@@ -73,8 +84,43 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_text(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An error that prints its source and also returns it, as `#[error("…: {source}")]` does.
+    #[derive(Debug)]
+    struct Repeats(std::io::Error);
+
+    impl std::fmt::Display for Repeats {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            write!(f, "cannot read 'a.gltf': {}", self.0)
+        }
+    }
+
+    impl std::error::Error for Repeats {
+        fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+            Some(&self.0)
+        }
+    }
+
+    #[test]
+    fn each_cause_of_an_error_is_printed_once() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+        let e = anyhow::Error::new(Repeats(io)).context("loading the scene");
+        assert_eq!(
+            error_text(&e),
+            "loading the scene: cannot read 'a.gltf': no such file"
+        );
+        // A cause that its wrapper does not print is still shown.
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+        let e = anyhow::Error::new(io).context("reading 'b.exr'");
+        assert_eq!(error_text(&e), "reading 'b.exr': no such file");
     }
 }

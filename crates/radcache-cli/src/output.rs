@@ -1,8 +1,18 @@
-//! Text outputs of the CLI (stats, profiles): written atomically into a folder made on demand.
+//! Text outputs of the CLI: reports on stdout, and files (stats, profiles) written atomically into
+//! a folder made on demand.
 
 use std::path::Path;
 
 use anyhow::{Context as _, Result};
+
+/// Writes `text` to stdout; a closed pipe (`radcache info x | head`) is not an error.
+pub fn emit(text: &str) -> std::io::Result<()> {
+    use std::io::Write;
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => other,
+    }
+}
 
 /// Creates the folder `path` goes into, if any; errors name `what`.
 pub fn make_parent(path: &Path, what: &str) -> Result<()> {
@@ -13,7 +23,8 @@ pub fn make_parent(path: &Path, what: &str) -> Result<()> {
     Ok(())
 }
 
-/// Writes `text` to `path` atomically, creating its folder; errors name `what` and the path.
+/// Writes `text` to `path` atomically, creating its folder; errors name `what` (and the writer's
+/// name the path).
 pub fn write_text(path: &Path, text: &str, what: &str) -> Result<()> {
     make_parent(path, what)?;
     radcache_image::write_atomic(path, |w| {
@@ -25,5 +36,5 @@ pub fn write_text(path: &Path, text: &str, what: &str) -> Result<()> {
                 source,
             })
     })
-    .with_context(|| format!("writing the {what} {}", path.display()))
+    .with_context(|| format!("writing the {what}"))
 }

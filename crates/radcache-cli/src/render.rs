@@ -2,187 +2,23 @@
 //! (`-o out/frame_####.exr --frames 1..120`), resumable, with the cache kept across frames
 //! where the plan allows.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
-use std::time::Instant;
-
-use anyhow::{bail, Context as _, Result};
-use clap::{Args, ValueEnum};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
+use std::time::Instant;
 
+use anyhow::{bail, Result};
 use radcache_render::{Budget, EnvMap, GpuScene};
-use radcache_scene::{EnvOverride, Environment, LoadOptions, Scene};
+use radcache_scene::{Environment, LoadOptions, Scene};
 use radcache_vk::{Context, ShaderCompiler};
 use serde_json::json;
 
+use crate::args::{parse_resolution, shader_root, RenderArgs};
 use crate::frame::{self, FrameSetup};
-use crate::ic_args::IcArgs;
 use crate::profile::Profile;
+use crate::progress;
 use crate::sequence::{ContactSheet, FrameArgs, Sequence, SequenceProgress};
-
-/// Environment overrides shared by `render` and `info`.
-#[derive(Args, Debug, Clone)]
-pub struct EnvArgs {
-    /// Equirectangular EXR environment map (+Y up; see the README for the convention).
-    #[arg(long, value_name = "FILE.exr")]
-    pub env_map: Option<PathBuf>,
-    /// Constant environment radiance, linear RGB W/(sr·m²), e.g. `0.5,0.6,0.8`.
-    #[arg(long, value_name = "R,G,B")]
-    pub env_radiance: Option<String>,
-    /// Multiplier of the environment (map or constant).
-    #[arg(long, default_value_t = 1.0)]
-    pub env_scale: f32,
-}
-
-impl EnvArgs {
-    /// The loader's environment override.
-    pub fn to_override(&self) -> Result<EnvOverride> {
-        let radiance = match &self.env_radiance {
-            None => None,
-            Some(text) => Some(parse_rgb(text)?),
-        };
-        if !self.env_scale.is_finite() || self.env_scale < 0.0 {
-            bail!(
-                "--env-scale must be finite and non-negative, got {}",
-                self.env_scale
-            );
-        }
-        Ok(EnvOverride {
-            map: self.env_map.clone(),
-            radiance,
-            scale: self.env_scale,
-        })
-    }
-}
-
-fn parse_rgb(text: &str) -> Result<[f32; 3]> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let values: Vec<f32> = parts
-        .iter()
-        .map(|p| p.parse::<f32>())
-        .collect::<std::result::Result<_, _>>()
-        .with_context(|| format!("--env-radiance {text:?}: expected three numbers R,G,B"))?;
-    match values[..] {
-        [r, g, b] if values.iter().all(|v| v.is_finite() && *v >= 0.0) => Ok([r, g, b]),
-        _ => bail!("--env-radiance {text:?}: expected three finite non-negative numbers R,G,B"),
-    }
-}
-
-/// Rendering method.
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Method {
-    /// The unbiased reference path tracer.
-    Path,
-    /// The irradiance cache.
-    Ic,
-}
-
-#[derive(Args, Debug)]
-pub struct RenderArgs {
-    /// The glTF scene (.gltf or .glb).
-    pub(crate) scene: PathBuf,
-    /// Output EXR (or .png for a PNG only); `####` is replaced by the frame number.
-    #[arg(short, long)]
-    pub(crate) output: PathBuf,
-    /// Image size WxH; default 512 pixels high at the camera's aspect ratio.
-    #[arg(long, value_name = "WxH")]
-    pub(crate) resolution: Option<String>,
-    /// Rendering method.
-    #[arg(long, value_enum, default_value_t = Method::Ic)]
-    pub(crate) method: Method,
-    #[command(flatten)]
-    pub(crate) ic: IcArgs,
-    /// Samples per pixel (path tracer).
-    #[arg(long, conflicts_with = "time_budget")]
-    pub(crate) spp: Option<u32>,
-    /// Sample until this many seconds have passed instead of a fixed spp.
-    #[arg(long, value_name = "SECONDS")]
-    pub(crate) time_budget: Option<f64>,
-    /// Seed of the random sequences.
-    #[arg(long, default_value_t = 0)]
-    pub(crate) seed: u32,
-    /// Scene time in seconds of a single frame (default: from the frame number, see `--fps`).
-    #[arg(long)]
-    pub(crate) time: Option<f32>,
-    /// Render this one frame (the number replaces `####` in the output path).
-    #[arg(long)]
-    pub(crate) frame: Option<u32>,
-    /// Render a sequence: frames A..B inclusive (`####` in the output path); default with a
-    /// pattern on an animated scene: the animation's own range.
-    #[arg(long, value_name = "A..B")]
-    pub(crate) frames: Option<String>,
-    /// Frames per second: frame f shows the scene at start + (f − first)/fps.
-    #[arg(long, default_value_t = 24.0)]
-    pub(crate) fps: f32,
-    /// Scene time of the first frame (default: the animation's first key, else 0).
-    #[arg(long)]
-    pub(crate) start_time: Option<f32>,
-    /// Render frames again that are already on disk (a sequence skips them otherwise, so an
-    /// interrupted run resumes where it stopped).
-    #[arg(long)]
-    pub(crate) overwrite: bool,
-    /// Rebuild the cache every frame instead of keeping its records (by default records are
-    /// kept; with moving geometry or lights they carry lifespans and are refreshed in place).
-    #[arg(long)]
-    pub(crate) no_temporal: bool,
-    /// Use the camera with this name instead of the scene's first.
-    #[arg(long)]
-    pub(crate) camera: Option<String>,
-    #[command(flatten)]
-    pub(crate) env: EnvArgs,
-    /// Write the run's timeline (GPU passes, host work) in the Chrome trace event format, for
-    /// Perfetto or chrome://tracing.
-    #[arg(long, value_name = "FILE.json")]
-    pub(crate) profile: Option<PathBuf>,
-    /// Write per-frame statistics as JSON.
-    #[arg(long, value_name = "FILE.json")]
-    pub(crate) stats: Option<PathBuf>,
-    /// Store half floats in the EXR.
-    #[arg(long)]
-    pub(crate) half: bool,
-    /// Add albedo, normal and depth layers to the EXR.
-    #[arg(long)]
-    pub(crate) aov: bool,
-    /// Add the cache's debug layers to the EXR: `ic_indirect` (indirect radiance only),
-    /// `ic_weight` (Σw), `ic_records` (records per pixel), `ic_positions` (record positions).
-    #[arg(long)]
-    pub(crate) debug_aov: bool,
-    /// Also write a PNG preview beside the EXR.
-    #[arg(long)]
-    pub(crate) png: bool,
-    /// After a sequence, write its frames (rendered or already on disk as EXR) reduced to at
-    /// most 160 pixels and tiled into this PNG.
-    #[arg(long, value_name = "FILE.png")]
-    pub(crate) contact_sheet: Option<PathBuf>,
-    /// Exposure of the PNG preview, in stops.
-    #[arg(long, default_value_t = 0.0)]
-    pub(crate) exposure: f32,
-    /// Tone curve of the PNG preview.
-    #[arg(long, default_value = "none", value_parser = ["none", "filmic"])]
-    pub(crate) tonemap: String,
-    /// No progress line.
-    #[arg(long, short)]
-    pub(crate) quiet: bool,
-}
-
-fn parse_resolution(text: &str) -> Result<(u32, u32)> {
-    let (w, h) = text
-        .split_once(['x', 'X'])
-        .with_context(|| format!("--resolution {text:?}: expected WxH, e.g. 640x480"))?;
-    let w: u32 = w
-        .trim()
-        .parse()
-        .with_context(|| format!("--resolution {text:?}: bad width"))?;
-    let h: u32 = h
-        .trim()
-        .parse()
-        .with_context(|| format!("--resolution {text:?}: bad height"))?;
-    if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        bail!("--resolution {text:?}: each side must be in 1..=16384");
-    }
-    Ok((w, h))
-}
 
 pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let budget = match (args.spp, args.time_budget) {
@@ -200,10 +36,8 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         camera_name: args.camera.clone(),
         env: args.env.to_override()?,
     };
-    let (scene, warnings) = Scene::load(&args.scene, &opts)?;
-    for w in &warnings {
-        log::warn!("{w}");
-    }
+    // The loader logs its warnings as it finds them (`log::warn!`): they are not printed again.
+    let (scene, _warnings) = Scene::load(&args.scene, &opts)?;
     let env_map = match &scene.environment {
         Environment::Map { path, .. } => Some(EnvMap::load(path)?),
         _ => None,
@@ -233,7 +67,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     };
 
     let ctx = Context::new()?;
-    let shaders = ShaderCompiler::new(crate::shader_root())?;
+    let shaders = ShaderCompiler::new(shader_root())?;
     let t_upload = Instant::now();
     let mut gpu = GpuScene::new(&ctx, &scene, env_map.as_ref())?;
     let upload_s = t_upload.elapsed().as_secs_f64();
@@ -302,28 +136,31 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         let t_write = Instant::now();
         profile.cpu("image + metadata", t_image, t_write, Some(number));
         frame::write(args, &output, &image, &meta)?;
+        let written = Instant::now();
+        profile.cpu("write", t_write, written, Some(number));
+        let frame_write_s = written.duration_since(t_write).as_secs_f64();
+        write_s += frame_write_s;
         sheet.add(&image);
-        profile.cpu("write", t_write, Instant::now(), Some(number));
         let mut entry = frame::stats_entry(&rendered, number, time);
+        entry["write_s"] = json!(frame_write_s);
         entry["device_memory_bytes"] = json!(ctx.memory_by_category());
         entries.push(entry);
         if let Some(path) = &args.stats {
             write_stats(path, &setup, &entries, [load_s, upload_s, write_s])?;
         }
-        write_s += t_write.elapsed().as_secs_f64();
         if !args.quiet && sequence.frames.len() == 1 {
             let out = &rendered.out;
             let rays: u64 = out.rays.values().sum();
-            eprintln!(
+            progress::line(&format!(
                 "wrote {} ({}x{}, {}, {} spp, {:.2} s, {:.2} Mrays/s)",
                 output.display(),
                 size.0,
                 size.1,
-                frame::method_name(args.method),
+                args.method.name(),
                 out.spp,
                 out.time_s,
                 rays as f64 / out.time_s.max(1e-9) / 1e6
-            );
+            ));
         }
         progress.rendered(number, t_frame.elapsed().as_secs_f64());
     }
@@ -364,10 +201,10 @@ fn interrupt_flag(sequence: bool) -> Arc<AtomicBool> {
         let seen = flag.clone();
         let installed = ctrlc::set_handler(move || {
             if seen.swap(true, Ordering::SeqCst) {
-                eprintln!("\nabandoning the frame in flight");
+                progress::line("abandoning the frame in flight");
                 std::process::exit(130);
             }
-            eprintln!("\nfinishing the frame in flight (Ctrl-C again to abandon it)");
+            progress::line("finishing the frame in flight (Ctrl-C again to abandon it)");
         });
         if let Err(e) = installed {
             log::warn!("Ctrl-C will stop at once: {e}");
@@ -386,11 +223,12 @@ fn write_stats(
     let [load_s, upload_s, write_s] = cpu_s;
     let value = json!({
         "scene": setup.args.scene,
-        "method": frame::method_name(setup.args.method),
+        "method": setup.args.method.name(),
         "device": setup.ctx.info().name,
         "resolution": [setup.size.0, setup.size.1],
         "temporal": setup.temporal,
         "time_step_s": setup.time_step_s,
+        // Host seconds outside the frames; "write" sums the frames' `write_s`.
         "cpu_s": {"scene_load": load_s, "upload": upload_s, "write": write_s},
         "frames": frames,
     });

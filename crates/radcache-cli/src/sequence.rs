@@ -1,5 +1,5 @@
 //! Frame sequences of `radcache render`: which frames, at which scene times, the progress
-//! line across them and the optional contact sheet.
+//! across them (a bar and a line per frame) and the optional contact sheet.
 //!
 //! Frames are numbered like Blender's: `--frames 1..120` is inclusive. Frame `f` of a sequence
 //! starting at frame `first` shows the scene at `start + (f − first) / fps` (a single `--frame N`
@@ -8,13 +8,14 @@
 //! an output pattern with `#` on an animated scene renders the animation's own range (from its
 //! first to its last key at `fps`); anything else renders frame 1.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 use radcache_image::PngOptions;
 use radcache_image::{contact_sheet, read_exr, reduce, reduction_factor, write_png, Image};
+
+use crate::progress::{self, SequenceBar};
 
 /// Largest side of a contact sheet's cell, in pixels.
 pub const CONTACT_CELL: u32 = 160;
@@ -59,8 +60,8 @@ impl ContactSheet {
             );
             return Ok(());
         }
-        let (image, _) =
-            read_exr(path).with_context(|| format!("reading {} back", path.display()))?;
+        // The reader's errors name the file.
+        let (image, _) = read_exr(path).context("reading a frame back for the contact sheet")?;
         self.add(&image);
         Ok(())
     }
@@ -76,8 +77,7 @@ impl ContactSheet {
         }
         crate::output::make_parent(path, "contact sheet")?;
         let sheet = contact_sheet(&self.cells)?;
-        write_png(path, &sheet, options)
-            .with_context(|| format!("writing the contact sheet {}", path.display()))?;
+        write_png(path, &sheet, options).context("writing the contact sheet")?;
         Ok(())
     }
 }
@@ -176,7 +176,8 @@ impl Sequence {
     }
 }
 
-/// One line per finished frame on stderr: frame time, frames done and skipped, ETA.
+/// The progress of a sequence on stderr: a bar over its frames (on a terminal) and one line per
+/// finished frame: frame time, frames done and skipped, ETA.
 #[derive(Debug)]
 pub struct SequenceProgress {
     total: usize,
@@ -185,6 +186,7 @@ pub struct SequenceProgress {
     render_s: f64,
     start: Instant,
     quiet: bool,
+    bar: SequenceBar,
 }
 
 impl SequenceProgress {
@@ -197,18 +199,26 @@ impl SequenceProgress {
             render_s: 0.0,
             start: Instant::now(),
             quiet,
+            bar: SequenceBar::new(total, quiet),
         }
     }
 
     fn line(&self, text: &str) {
         if !self.quiet {
-            let _ = writeln!(std::io::stderr().lock(), "{text}");
+            progress::line(text);
         }
+    }
+
+    /// Seconds left at the mean time of the frames rendered so far.
+    fn eta_s(&self) -> f64 {
+        let left = self.total - self.done - self.skipped;
+        self.render_s / self.done.max(1) as f64 * left as f64
     }
 
     /// A frame already on disk was kept.
     pub fn skipped(&mut self, frame: u32, path: &std::path::Path) {
         self.skipped += 1;
+        self.bar.update(self.done + self.skipped, "");
         self.line(&format!(
             "frame {frame}: {} exists, skipped (--overwrite renders it again)",
             path.display()
@@ -222,8 +232,9 @@ impl SequenceProgress {
         if self.total <= 1 {
             return; // a single frame has its own "wrote" line
         }
-        let left = self.total - self.done - self.skipped;
-        let eta = self.render_s / self.done as f64 * left as f64;
+        let eta = self.eta_s();
+        self.bar
+            .update(self.done + self.skipped, &format!("ETA {eta:.0} s"));
         self.line(&format!(
             "frame {frame}: {seconds:.2} s [{}/{} done, {} skipped] ETA {eta:.0} s",
             self.done, self.total, self.skipped
@@ -232,6 +243,7 @@ impl SequenceProgress {
 
     /// The closing summary; `stopped` when Ctrl-C ended the run early.
     pub fn finish(&self, stopped: bool) {
+        self.bar.finish();
         if self.total <= 1 && !stopped {
             return;
         }

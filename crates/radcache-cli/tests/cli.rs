@@ -1,5 +1,6 @@
 //! The `radcache` binary end to end on lavapipe: render with metadata, AOVs and stats; compare
-//! with limits and JSON; info; bad input gives one clear error and no panic.
+//! with limits and JSON; info; bad input gives one clear error (each cause once) and no panic; a
+//! warning is printed once; a failed write keeps the frames before it and leaves no partial file.
 
 use std::path::PathBuf;
 use std::process::Output;
@@ -70,6 +71,10 @@ fn render_writes_exr_with_metadata_aovs_png_and_stats() {
     // At least one camera ray per pixel sample.
     assert!(frame["rays"]["path_trace"].as_u64().unwrap() >= 24 * 16 * 3);
     assert!(frame["passes_ms"]["path_trace"].as_f64().unwrap() > 0.0);
+    // The frame's write time is in its entry and in the run's total.
+    let write_s = frame["write_s"].as_f64().unwrap();
+    assert!(write_s > 0.0, "{frame}");
+    assert_eq!(json["cpu_s"]["write"].as_f64(), Some(write_s), "{json}");
     // Device memory by category: at least the scene's buffers (vertices, BVH inputs, ...).
     let memory = frame["device_memory_bytes"].as_object().unwrap();
     assert!(memory["scene"].as_u64().unwrap() > 0, "{memory:?}");
@@ -234,5 +239,125 @@ fn profile_writes_a_chrome_trace_and_prints_the_pass_table() {
     assert!(
         stderr.contains("Mrays/s") && stderr.contains("records "),
         "{stderr}"
+    );
+}
+
+/// How often `needle` occurs in `haystack`.
+fn occurrences(haystack: &str, needle: &str) -> usize {
+    haystack.matches(needle).count()
+}
+
+#[test]
+fn a_missing_scene_is_named_with_its_cause_once() {
+    let dir = out_dir("missing");
+    let out = radcache(&[
+        "render",
+        "/nonexistent.gltf",
+        "-o",
+        &text(&dir.join("x.exr")),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(stderr.contains("/nonexistent.gltf"), "{stderr}");
+    assert_eq!(
+        occurrences(&stderr, "No such file or directory"),
+        1,
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(!dir.join("x.exr").exists());
+}
+
+#[test]
+fn a_loader_warning_is_printed_once() {
+    // The Cornell box without its camera: the loader warns and frames the scene itself.
+    let dir = out_dir("warning");
+    let source = common::repo().join("assets/cornell");
+    let mut gltf: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(source.join("cornell.gltf")).unwrap())
+            .unwrap();
+    for node in gltf["nodes"].as_array_mut().unwrap() {
+        node.as_object_mut().unwrap().remove("camera");
+    }
+    let scene = dir.join("no_camera.gltf");
+    std::fs::write(&scene, serde_json::to_string(&gltf).unwrap()).unwrap();
+    std::fs::copy(source.join("cornell.bin"), dir.join("cornell.bin")).unwrap();
+    let warning = "has no camera";
+
+    let out = radcache(&[
+        "render",
+        &text(&scene),
+        "-o",
+        &text(&dir.join("x.exr")),
+        "--method",
+        "path",
+        "--resolution",
+        "8x8",
+        "--spp",
+        "1",
+    ]);
+    assert_ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(occurrences(&stderr, warning), 1, "{stderr}");
+
+    let out = radcache(&["info", &text(&scene)]);
+    assert_ok(&out);
+    let all = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(occurrences(&all, warning), 1, "{all}");
+}
+
+#[test]
+fn a_failed_write_keeps_the_frames_before_it_and_no_partial_file() {
+    let dir = out_dir("write_failure");
+    // Frame 2's output path is a folder: its EXR cannot be put there.
+    let blocked = dir.join("f_0002.exr");
+    std::fs::create_dir(&blocked).unwrap();
+    let stats = dir.join("stats.json");
+    let out = radcache(&[
+        "render",
+        &cornell(),
+        "-o",
+        &text(&dir.join("f_####.exr")),
+        "--frames",
+        "1..3",
+        "--overwrite",
+        "--method",
+        "path",
+        "--resolution",
+        "8x8",
+        "--spp",
+        "1",
+        "--stats",
+        &text(&stats),
+        "-q",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(stderr.contains("f_0002.exr"), "{stderr}");
+    assert_eq!(occurrences(&stderr, "Is a directory"), 1, "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    // Frame 1 is whole, frame 3 was not started, nothing else is left in the folder.
+    let (image, _) = read_exr(dir.join("f_0001.exr")).unwrap();
+    assert_eq!((image.width(), image.height()), (8, 8));
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["f_0001.exr", "f_0002.exr", "stats.json"]);
+    assert!(std::fs::read_dir(&blocked).unwrap().next().is_none());
+    // The stats file describes the frame written, its write time included in the total.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    let frames = json["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 1, "{json}");
+    let write_s = frames[0]["write_s"].as_f64().unwrap();
+    assert!(
+        write_s > 0.0 && json["cpu_s"]["write"].as_f64() == Some(write_s),
+        "{json}"
     );
 }
