@@ -9,7 +9,7 @@
 # Idempotent: a machine that already has everything is left as it is (a quick check, no apt call).
 set -euo pipefail
 
-need_pkgs=(libvulkan1 vulkan-tools vulkan-validationlayers spirv-tools build-essential cmake ninja-build python3 git pkg-config fonts-dejavu-core)
+need_pkgs=(libvulkan1 vulkan-tools vulkan-validationlayers spirv-tools glslang-tools build-essential cmake ninja-build python3 git pkg-config fonts-dejavu-core)
 
 have_all() {
   for p in "${need_pkgs[@]}"; do

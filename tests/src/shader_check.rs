@@ -2,7 +2,8 @@
 //! the SPIR-V with `spirv-val --target-env vulkan1.3`. Used by the `shaders` test and by
 //! `cargo xtask shaders`.
 
-use std::path::{Path, PathBuf};
+use std::collections::BTreeSet;
+use std::path::Path;
 use std::process::Command;
 
 use radcache_vk::{ShaderCompiler, ShaderStage};
@@ -18,21 +19,57 @@ pub struct ShaderCheck {
     pub words: usize,
 }
 
-fn entry_shaders(root: &Path, dir: &Path, out: &mut Vec<String>) -> std::io::Result<()> {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .collect();
-    entries.sort();
-    for p in entries {
-        if p.is_dir() {
-            entry_shaders(root, &p, out)?;
-        } else if let Some(rel) = p.strip_prefix(root).ok().and_then(|r| r.to_str()) {
-            if ShaderStage::from_path(rel).is_some() {
+/// Every file under `root` (recursively), relative to it with `/` separators, sorted.
+pub fn files_under(root: &Path) -> std::io::Result<Vec<String>> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) -> std::io::Result<()> {
+        for entry in std::fs::read_dir(dir)? {
+            let p = entry?.path();
+            if p.is_dir() {
+                walk(root, &p, out)?;
+            } else if let Some(rel) = p.strip_prefix(root).ok().and_then(|r| r.to_str()) {
                 out.push(rel.replace('\\', "/"));
             }
         }
+        Ok(())
     }
-    Ok(())
+    let mut out = Vec::new();
+    walk(root, root, &mut out)?;
+    out.sort();
+    Ok(out)
+}
+
+/// The entry shaders under `root` (a stage the compiler knows from the extension; includes are
+/// not entry points), relative to it, sorted.
+pub fn entry_shaders(root: &Path) -> std::io::Result<Vec<String>> {
+    Ok(files_under(root)?
+        .into_iter()
+        .filter(|p| ShaderStage::from_path(p).is_some())
+        .collect())
+}
+
+/// What is wrong with `results` when every shader of `expected` must have compiled to a
+/// non-empty module and validated: one line per shader not compiled, failed, empty, or compiled
+/// though not expected. Empty when all is well.
+pub fn coverage_errors(expected: &BTreeSet<String>, results: &[ShaderCheck]) -> Vec<String> {
+    let compiled: BTreeSet<&str> = results.iter().map(|r| r.path.as_str()).collect();
+    let mut errors: Vec<String> = expected
+        .iter()
+        .filter(|p| !compiled.contains(p.as_str()))
+        .map(|p| format!("{p}: not compiled"))
+        .collect();
+    for r in results {
+        if !expected.contains(&r.path) {
+            errors.push(format!(
+                "{}: compiled, but not an expected entry shader",
+                r.path
+            ));
+        } else if let Some(e) = &r.error {
+            errors.push(format!("{}: {e}", r.path));
+        } else if r.words == 0 {
+            errors.push(format!("{}: empty SPIR-V", r.path));
+        }
+    }
+    errors
 }
 
 /// Whether `spirv-val` is on the PATH.
@@ -42,8 +79,7 @@ pub fn has_spirv_val() -> bool {
 
 /// Compiles and validates every entry shader under `root`; SPIR-V files go to `out_dir`.
 pub fn check_all(root: &Path, out_dir: &Path, validate: bool) -> std::io::Result<Vec<ShaderCheck>> {
-    let mut paths = Vec::new();
-    entry_shaders(root, root, &mut paths)?;
+    let paths = entry_shaders(root)?;
     std::fs::create_dir_all(out_dir)?;
     let compiler = ShaderCompiler::new(root).map_err(std::io::Error::other)?;
     let mut results = Vec::new();
@@ -77,4 +113,70 @@ pub fn check_all(root: &Path, out_dir: &Path, validate: bool) -> std::io::Result
         results.push(check);
     }
     Ok(results)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ok(path: &str) -> ShaderCheck {
+        ShaderCheck {
+            path: path.into(),
+            error: None,
+            words: 100,
+        }
+    }
+
+    #[test]
+    fn coverage_reports_every_missing_failed_or_unexpected_shader() {
+        let expected: BTreeSet<String> = ["a.comp", "b.vert", "c.frag", "d.comp"]
+            .map(String::from)
+            .into();
+        let all = [ok("a.comp"), ok("b.vert"), ok("c.frag"), ok("d.comp")];
+        assert!(coverage_errors(&expected, &all).is_empty());
+        // b.vert missing, c.frag failed, d.comp empty, e.comp not expected.
+        let results = [
+            ok("a.comp"),
+            ShaderCheck {
+                error: Some("syntax error".into()),
+                ..ok("c.frag")
+            },
+            ShaderCheck {
+                words: 0,
+                ..ok("d.comp")
+            },
+            ok("e.comp"),
+        ];
+        let errors = coverage_errors(&expected, &results);
+        assert_eq!(
+            errors,
+            [
+                "b.vert: not compiled",
+                "c.frag: syntax error",
+                "d.comp: empty SPIR-V",
+                "e.comp: compiled, but not an expected entry shader",
+            ],
+            "{errors:?}"
+        );
+    }
+
+    #[test]
+    fn entry_shaders_are_the_stage_files_at_any_depth() {
+        let dir = std::env::temp_dir().join(format!("radcache-entry-{}", std::process::id()));
+        for f in [
+            "x.comp",
+            "common/inc.glsl",
+            "passes/p.vert",
+            "passes/deep/q.frag",
+        ] {
+            let p = dir.join(f);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(p, "").unwrap();
+        }
+        let entries = entry_shaders(&dir).unwrap();
+        let files = files_under(&dir).unwrap();
+        std::fs::remove_dir_all(&dir).ok();
+        assert_eq!(entries, ["passes/deep/q.frag", "passes/p.vert", "x.comp"]);
+        assert_eq!(files.len(), 4, "{files:?}");
+    }
 }

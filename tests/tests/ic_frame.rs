@@ -2,12 +2,13 @@
 //! Cornell box against the cached path-traced reference (`cargo xtask refs`), and the plan
 //! (passes a scene does not need are not recorded).
 
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use radcache_cache::IcParams;
 use radcache_image::{compare, read_exr, Image};
 use radcache_render::{render_ic, GpuScene, IcSettings};
-use radcache_scene::{LoadOptions, Scene};
+use radcache_scene::{EnvOverride, LoadOptions, Scene};
 use radcache_tests::{context, finish, shaders};
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -142,10 +143,30 @@ fn the_plan_leaves_out_unneeded_passes() {
     for p in &passes {
         assert!(allowed.contains(p), "unexpected pass {p} in {passes:?}");
     }
-    assert!(!gpu
-        .defines()
-        .iter()
-        .any(|(d, _)| d.contains("LIGHTS") || d.contains("ENV")));
+    // Exactly the emitters' define: no punctual lights, no constant or mapped environment.
+    let defines: BTreeSet<(&str, &str)> = gpu.defines().into_iter().collect();
+    assert_eq!(
+        defines,
+        BTreeSet::from([("HAS_EMITTERS", "1")]),
+        "the Cornell box's shader defines"
+    );
+    drop(gpu);
+    // The same box under a constant environment (`--env-radiance`) adds exactly its define.
+    let lit = LoadOptions {
+        env: EnvOverride {
+            radiance: Some([0.5, 0.5, 0.5]),
+            ..EnvOverride::default()
+        },
+        ..LoadOptions::default()
+    };
+    let (scene, _) = Scene::load(&root.join("assets/cornell/cornell.gltf"), &lit).unwrap();
+    let gpu = GpuScene::new(&ctx, &scene, None).unwrap();
+    let defines: BTreeSet<(&str, &str)> = gpu.defines().into_iter().collect();
+    assert_eq!(
+        defines,
+        BTreeSet::from([("HAS_EMITTERS", "1"), ("HAS_ENV_CONSTANT", "1")]),
+        "the Cornell box's shader defines under a constant environment"
+    );
     drop(gpu);
     finish(ctx);
 }

@@ -4,7 +4,6 @@ mod assets;
 mod bench;
 mod codegen;
 mod refs;
-mod results;
 mod shaders;
 mod stiff;
 mod test;

@@ -18,9 +18,8 @@ use radcache_cache::{IcParams, Preset};
 use radcache_image::{compare, read_exr, Image};
 use radcache_render::{render_ic, render_path, Budget, GpuScene, IcSettings, PathSettings};
 use radcache_scene::{LoadOptions, Scene};
-use radcache_vk::{Context, ShaderCompiler};
 
-use crate::results::{append, Figure};
+use super::harness::{Bench, Figure};
 
 pub fn run(args: &[&str]) -> Result<()> {
     anyhow::ensure!(args.is_empty(), "usage: cargo xtask bench ic");
@@ -33,11 +32,10 @@ pub fn run(args: &[&str]) -> Result<()> {
     let ref_spp = ref_meta
         .spp
         .ok_or_else(|| anyhow::anyhow!("the reference's EXR does not record its spp"))?;
-    let ctx = Context::new()?;
-    let device = ctx.info().name.clone();
-    let shaders = ShaderCompiler::new(root.join("shaders"))?;
-    let raw = super::scene_rays::incoherent_rate_in(&ctx, &shaders, &scene)?;
-    let mut gpu = GpuScene::new(&ctx, &scene, None)?;
+    let bench = Bench::new("ic")?;
+    let (ctx, shaders) = (bench.ctx(), bench.shaders());
+    let raw = super::scene_rays::incoherent_rate_in(ctx, shaders, &scene)?;
+    let mut gpu = GpuScene::new(ctx, &scene, None)?;
     let mut figures = vec![Figure::new(
         "cornell_raw_incoherent",
         "rays_per_s",
@@ -45,32 +43,16 @@ pub fn run(args: &[&str]) -> Result<()> {
         "rays/s",
     )];
     println!(
-        "device: {device}; raw incoherent rate in the Cornell box {:.2} Mrays/s",
+        "device: {}; raw incoherent rate in the Cornell box {:.2} Mrays/s",
+        bench.device(),
         raw / 1e6
     );
-
-    // Warm-up (shader compilation is not part of the figures).
-    let warm = IcSettings {
-        width: 16,
-        height: 16,
+    let draft = IcSettings {
         params: IcParams::draft(),
-        sub_frames: 1,
         ..IcSettings::default()
     };
-    render_ic(&ctx, &shaders, &scene, &mut gpu, &warm, &mut |_| {})?;
-    render_path(
-        &ctx,
-        &shaders,
-        &scene,
-        &mut gpu,
-        &PathSettings {
-            width: 16,
-            height: 16,
-            budget: Budget::Samples(1),
-            ..PathSettings::default()
-        },
-        &mut |_| {},
-    )?;
+    bench.warm_up_ic(&scene, &mut gpu, draft)?;
+    bench.warm_up_path(&scene, &mut gpu)?;
 
     // (size, preset): every preset at the reference's size, the default at 512².
     let cases = [
@@ -87,7 +69,7 @@ pub fn run(args: &[&str]) -> Result<()> {
             params: IcParams::preset(preset),
             ..IcSettings::default()
         };
-        let (out, stats) = render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
+        let (out, stats) = render_ic(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
         let record_rays = stats.record_rays as f64;
         let level_s = stats.record_pass_s;
         let rays: u64 = out.rays.values().sum();
@@ -158,7 +140,7 @@ pub fn run(args: &[&str]) -> Result<()> {
             seed: 777,
             ..PathSettings::default()
         };
-        let out = render_path(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
+        let out = render_path(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
         let image = Image::from_pixels(out.width, out.height, out.pixels)?;
         let m = compare(&reference, &image)?;
         println!(
@@ -214,8 +196,5 @@ pub fn run(args: &[&str]) -> Result<()> {
         figures.push(Figure::new(&case, "speedup", pt_time / time, "ratio"));
     }
     drop(gpu);
-    append("ic", &device, &figures)?;
-    let report = ctx.shutdown();
-    anyhow::ensure!(report.leaked.is_empty(), "leaked: {:?}", report.leaked);
-    Ok(())
+    bench.finish(&figures)
 }

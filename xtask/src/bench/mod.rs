@@ -1,8 +1,10 @@
 //! `cargo xtask bench <what>`: benchmarks whose figures go to `bench/results.csv`.
 //!
-//! Benchmarks run with validation off (it costs CPU time per call) unless `RADCACHE_VALIDATION` is
-//! set, and on the device `RADCACHE_DEVICE` names (the preferred one otherwise).
+//! Each one runs in the shared harness ([`harness::Bench`]): the device (validation off unless
+//! `RADCACHE_VALIDATION` is set; `RADCACHE_DEVICE` picks it), the warm-up, the CSV rows and the
+//! leak check at the end.
 
+mod harness;
 mod ic;
 mod pt;
 mod rays;
@@ -14,9 +16,6 @@ mod tessellate;
 use anyhow::{bail, Result};
 
 pub fn run(args: &[&str]) -> Result<()> {
-    if std::env::var_os("RADCACHE_VALIDATION").is_none() {
-        std::env::set_var("RADCACHE_VALIDATION", "0");
-    }
     match args {
         ["rays", rest @ ..] => rays::run(rest),
         ["pt", rest @ ..] => pt::run(rest),

@@ -5,9 +5,8 @@
 use anyhow::{Context as _, Result};
 use radcache_render::{render_path, Budget, GpuScene, PathSettings};
 use radcache_scene::{LoadOptions, Scene};
-use radcache_vk::{Context, ShaderCompiler};
 
-use crate::results::{append, Figure};
+use super::harness::{Bench, Figure};
 
 pub fn run(args: &[&str]) -> Result<()> {
     let spp: u32 = match args {
@@ -17,22 +16,14 @@ pub fn run(args: &[&str]) -> Result<()> {
     };
     let path = crate::root().join("assets/cornell/cornell.gltf");
     let (scene, _) = Scene::load(&path, &LoadOptions::default())?;
-    let ctx = Context::new()?;
-    let device = ctx.info().name.clone();
-    let shaders = ShaderCompiler::new(crate::root().join("shaders"))?;
-    let raw = super::rays::incoherent_rate(&ctx, &shaders)?;
-    println!("device: {device}");
+    let bench = Bench::new("pt")?;
+    let (ctx, shaders) = (bench.ctx(), bench.shaders());
+    let raw = super::rays::incoherent_rate(ctx, shaders)?;
+    println!("device: {}", bench.device());
     println!("raw incoherent ray-query rate: {:.2} Mrays/s", raw / 1e6);
     let mut figures = vec![Figure::new("raw_incoherent", "rays_per_s", raw, "rays/s")];
-    let mut gpu = GpuScene::new(&ctx, &scene, None)?;
-    // Warm-up: shader compilation and pipeline creation are not part of the figures.
-    let warm = PathSettings {
-        width: 16,
-        height: 16,
-        budget: Budget::Samples(1),
-        ..PathSettings::default()
-    };
-    render_path(&ctx, &shaders, &scene, &mut gpu, &warm, &mut |_| {})?;
+    let mut gpu = GpuScene::new(ctx, &scene, None)?;
+    bench.warm_up_path(&scene, &mut gpu)?;
     println!(
         "{:>6} {:>5} {:>9} {:>12} {:>10} {:>9}",
         "size", "spp", "time s", "Msamples/s", "Mrays/s", "of raw"
@@ -44,7 +35,7 @@ pub fn run(args: &[&str]) -> Result<()> {
             budget: Budget::Samples(spp),
             ..PathSettings::default()
         };
-        let out = render_path(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
+        let out = render_path(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
         let gpu_s = out.passes_ms.get("path_trace").copied().unwrap_or(0.0) / 1000.0;
         let samples = f64::from(size) * f64::from(size) * f64::from(out.spp);
         let rays: u64 = out.rays.values().sum();
@@ -71,8 +62,5 @@ pub fn run(args: &[&str]) -> Result<()> {
         figures.push(Figure::new(&case, "share_of_raw", rps / raw, "ratio"));
     }
     drop(gpu);
-    append("pt", &device, &figures)?;
-    let report = ctx.shutdown();
-    anyhow::ensure!(report.leaked.is_empty(), "leaked: {:?}", report.leaked);
-    Ok(())
+    bench.finish(&figures)
 }

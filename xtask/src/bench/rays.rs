@@ -17,7 +17,7 @@ use radcache_vk::{
     MemoryLocation, Pipeline, Resource, ShaderCompiler, Tlas, TlasInstance, TlasUpdate,
 };
 
-use crate::results::{append, Figure};
+use super::harness::{Bench, Figure};
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -176,12 +176,14 @@ pub fn run(args: &[&str]) -> Result<()> {
         [] => 2_000_000,
         _ => anyhow::bail!("usage: cargo xtask bench rays [--rays N]"),
     };
-    let ctx = Context::new()?;
-    let info = ctx.info().clone();
+    let mut bench = Bench::new("rays")?;
+    let info = bench.ctx().info().clone();
     println!("device: {} ({}), {}", info.name, info.kind, info.driver);
-    let compiler = ShaderCompiler::new(crate::root().join("shaders"))?;
-    let m = measure(&ctx, &compiler, n)?;
-    report(&m, n, &format!("{} ({})", info.name, info.driver))
+    // This benchmark's rows name the driver too.
+    bench.set_device_label(format!("{} ({})", info.name, info.driver));
+    let m = measure(bench.ctx(), bench.shaders(), n)?;
+    let figures = report(&m, n);
+    bench.finish(&figures)
 }
 
 /// The raw incoherent ray-query rate of `ctx`'s device, rays/s (1M hemisphere rays).
@@ -276,7 +278,8 @@ fn measure(ctx: &Context, compiler: &ShaderCompiler, n: usize) -> Result<Measure
     })
 }
 
-fn report(m: &Measured, n: usize, device: &str) -> Result<()> {
+/// Prints the figures of `m` and returns them.
+fn report(m: &Measured, n: usize) -> Vec<Figure> {
     let Measured {
         stats,
         blas_wall_ms,
@@ -314,22 +317,17 @@ fn report(m: &Measured, n: usize, device: &str) -> Result<()> {
         mrays(incoherent_ms)
     );
     let case = format!("sphere{}k_x4+room", tris / 1000);
-    append(
-        "rays",
-        device,
-        &[
-            Figure::new(&case, "coherent_mrays_per_s", mrays(coherent_ms), "Mrays/s"),
-            Figure::new(
-                &case,
-                "incoherent_mrays_per_s",
-                mrays(incoherent_ms),
-                "Mrays/s",
-            ),
-            Figure::new(&case, "blas_build_ms", stats.build_ms, "ms"),
-            Figure::new(&case, "blas_compact_ms", stats.compact_ms, "ms"),
-            Figure::new(&case, "tlas_build_ms", tlas_ms, "ms"),
-            Figure::new(&case, "rays", n as f64, "rays"),
-        ],
-    )?;
-    Ok(())
+    vec![
+        Figure::new(&case, "coherent_mrays_per_s", mrays(coherent_ms), "Mrays/s"),
+        Figure::new(
+            &case,
+            "incoherent_mrays_per_s",
+            mrays(incoherent_ms),
+            "Mrays/s",
+        ),
+        Figure::new(&case, "blas_build_ms", stats.build_ms, "ms"),
+        Figure::new(&case, "blas_compact_ms", stats.compact_ms, "ms"),
+        Figure::new(&case, "tlas_build_ms", tlas_ms, "ms"),
+        Figure::new(&case, "rays", n as f64, "rays"),
+    ]
 }

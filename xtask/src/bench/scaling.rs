@@ -26,10 +26,10 @@ use radcache_cache::{IcParams, Preset};
 use radcache_image::{compare, Image};
 use radcache_render::{render_ic, FrameOutput, GpuScene, IcSettings, IcStats};
 use radcache_scene::{LoadOptions, Scene};
-use radcache_vk::{Context, ShaderCompiler};
+use radcache_vk::Context;
 
+use super::harness::{Bench, Figure};
 use super::tessellate::subdivide_scene;
-use crate::results::{append, Figure};
 
 const USAGE: &str = "usage: cargo xtask bench scaling [--preset draft|default|high] [--max-size N]";
 
@@ -151,24 +151,21 @@ pub fn run(args: &[&str]) -> Result<()> {
         &root.join("assets/cornell/cornell.gltf"),
         &LoadOptions::default(),
     )?;
-    let ctx = Context::new()?;
-    let device = ctx.info().name.clone();
-    let shaders = ShaderCompiler::new(root.join("shaders"))?;
+    let bench = Bench::new("scaling")?;
+    let (ctx, shaders) = (bench.ctx(), bench.shaders());
     let mut figures = Vec::new();
 
-    // Warm-up: shader compilation is not part of the figures.
-    {
-        let (mut gpu, _, _) = upload(&ctx, &scene)?;
-        let warm = IcSettings {
-            sub_frames: 1,
-            ..settings(16, Preset::Draft, 0)
-        };
-        render_ic(&ctx, &shaders, &scene, &mut gpu, &warm, &mut |_| {})?;
-    }
+    // Warm-up (shader compilation is not part of the figures), on an upload of its own.
+    bench.warm_up_ic(
+        &scene,
+        &mut upload(ctx, &scene)?.0,
+        settings(16, Preset::Draft, 0),
+    )?;
 
     // 1. Resolution.
     println!(
-        "device: {device}; Cornell box, {} triangles; preset `{pname}`{}",
+        "device: {}; Cornell box, {} triangles; preset `{pname}`{}",
+        bench.device(),
         scene.instanced_triangle_count(),
         if preset == Preset::Draft {
             " (the default here, so that 1024² stays within minutes on lavapipe)"
@@ -188,11 +185,11 @@ pub fn run(args: &[&str]) -> Result<()> {
         head.join(" "),
         "other"
     );
-    let mut gpu = upload(&ctx, &scene)?.0;
+    let mut gpu = upload(ctx, &scene)?.0;
     for size in SIZES.into_iter().filter(|&s| s <= opts.max_size) {
         let (out, stats) = render_ic(
-            &ctx,
-            &shaders,
+            ctx,
+            shaders,
             &scene,
             &mut gpu,
             &settings(size, preset, 0),
@@ -253,10 +250,10 @@ pub fn run(args: &[&str]) -> Result<()> {
             subdivide_scene(&scene, n)?
         };
         let triangles = tess.instanced_triangle_count();
-        let (mut gpu, upload_s, tlas_s) = upload(&ctx, &tess)?;
+        let (mut gpu, upload_s, tlas_s) = upload(ctx, &tess)?;
         let (out, stats) = render_ic(
-            &ctx,
-            &shaders,
+            ctx,
+            shaders,
             &tess,
             &mut gpu,
             &settings(size, preset, 0),
@@ -270,8 +267,8 @@ pub fn run(args: &[&str]) -> Result<()> {
             None => {
                 // The noise level: the same scene and settings with another seed.
                 let (other, _) = render_ic(
-                    &ctx,
-                    &shaders,
+                    ctx,
+                    shaders,
                     &tess,
                     &mut gpu,
                     &settings(size, preset, 1),
@@ -326,8 +323,5 @@ pub fn run(args: &[&str]) -> Result<()> {
         }
     }
 
-    append("scaling", &device, &figures)?;
-    let report = ctx.shutdown();
-    anyhow::ensure!(report.leaked.is_empty(), "leaked: {:?}", report.leaked);
-    Ok(())
+    bench.finish(&figures)
 }

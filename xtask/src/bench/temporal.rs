@@ -24,7 +24,7 @@ use radcache_render::{
 use radcache_scene::{LoadOptions, Scene};
 use radcache_vk::{Context, ShaderCompiler};
 
-use crate::results::{append, Figure};
+use super::harness::{Bench, Figure};
 
 const FPS: f32 = 24.0;
 
@@ -168,36 +168,27 @@ pub fn run(args: &[&str]) -> Result<()> {
         &root.join("assets/animated/animated.gltf"),
         &LoadOptions::default(),
     )?;
-    let ctx = Context::new()?;
-    let device = ctx.info().name.clone();
-    let shaders = ShaderCompiler::new(root.join("shaders"))?;
-    let mut gpu = GpuScene::new(&ctx, &scene, None)?;
+    let bench = Bench::new("temporal")?;
+    let (ctx, shaders) = (bench.ctx(), bench.shaders());
+    let mut gpu = GpuScene::new(ctx, &scene, None)?;
     let first_ref = (o.frames - o.reference_frames) / 2 + 1;
     let range = first_ref..=first_ref + o.reference_frames - 1;
     let name = format!("{:?}", o.preset).to_lowercase();
     println!(
-        "device: {device}; animated scene, {} frames at {}², {name}, {FPS} fps",
-        o.frames, o.size
+        "device: {}; animated scene, {} frames at {}², {name}, {FPS} fps",
+        bench.device(),
+        o.frames,
+        o.size
     );
-    // Warm-up: shader compilation is not part of the figures.
     let warm = IcSettings {
-        width: 16,
-        height: 16,
         params: IcParams::preset(o.preset),
-        sub_frames: 1,
         time_step_s: 1.0 / FPS,
         ..IcSettings::default()
     };
-    IcRenderer::new(&ctx, &shaders, &gpu, &warm)?.render(
-        &ctx,
-        &scene,
-        &mut gpu,
-        &warm,
-        &mut |_| {},
-    )?;
+    bench.warm_up_ic(&scene, &mut gpu, warm)?;
 
-    let kept = run_sequence(&ctx, &shaders, &scene, &mut gpu, &o, true, range.clone())?;
-    let rebuilt = run_sequence(&ctx, &shaders, &scene, &mut gpu, &o, false, range.clone())?;
+    let kept = run_sequence(ctx, shaders, &scene, &mut gpu, &o, true, range.clone())?;
+    let rebuilt = run_sequence(ctx, shaders, &scene, &mut gpu, &o, false, range.clone())?;
 
     // The reference, and a second path-traced sequence with other seeds: its error and flicker
     // against the reference are twice the reference's own (independent noise adds), which is
@@ -215,7 +206,7 @@ pub fn run(args: &[&str]) -> Result<()> {
                 time: (frame - 1) as f32 / FPS,
                 ..PathSettings::default()
             };
-            let out = render_path(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
+            let out = render_path(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
             into.push(image(&out)?);
         }
     }
@@ -289,6 +280,6 @@ pub fn run(args: &[&str]) -> Result<()> {
         rebuilt.later_time()
     );
     figures.push(Figure::new(&case, "record_ray_share", share, "ratio"));
-    append("temporal", &device, &figures)?;
-    Ok(())
+    drop(gpu);
+    bench.finish(&figures)
 }
