@@ -1,3 +1,4 @@
+// common/hash.glsl — Rust: crates/radcache-cache/src/sampling.rs (ircache_hash)
 // Integer hashing and uniform random numbers.
 #ifndef RADCACHE_HASH_GLSL
 #define RADCACHE_HASH_GLSL

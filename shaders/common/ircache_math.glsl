@@ -1,3 +1,4 @@
+// common/ircache_math.glsl — Rust: crates/radcache-cache/src/*.rs (its CPU twin)
 // ircache_math.glsl: GLSL twin of the `radcache-cache` crate (crates/radcache-cache/src/*.rs).
 //
 // Irradiance-cache formulas of shared/docs/irradiance-caching.md: hemisphere sampling (§3.1, §3.2),

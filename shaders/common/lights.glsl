@@ -1,3 +1,4 @@
+// common/lights.glsl — Rust: crates/radcache-render/src/scene/lights.rs
 // Light sources: emissive triangles (power-proportional alias table, uniform area sampling),
 // punctual lights (KHR_lights_punctual units), and the environment (constant, or an
 // equirectangular map sampled texel-proportionally to luminance × solid angle).

@@ -1,3 +1,4 @@
+// common/path.glsl — Rust: crates/radcache-render/src/passes/path_trace.rs and record.rs
 // Path tracing shared by the reference path tracer, the IC direct-lighting pass and the IC
 // record (gather-ray) pass: next-event estimation at a diffuse vertex, and the continuation of a
 // path with MIS and Russian roulette.

@@ -1,3 +1,4 @@
+// common/random.glsl — Rust: crates/radcache-cache/src/sampling.rs
 // Per-sample random numbers: a counter-based generator seeded by (pixel or record, sample, seed),
 // so every sample is reproducible and independent of dispatch order.
 #ifndef RADCACHE_RANDOM_GLSL

@@ -1,3 +1,4 @@
+// common/sampling.glsl — Rust: crates/radcache-cache/src/sampling.rs
 // Sampling routines shared by the path tracer, direct lighting and record computation.
 #ifndef RADCACHE_SAMPLING_GLSL
 #define RADCACHE_SAMPLING_GLSL

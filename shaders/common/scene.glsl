@@ -1,3 +1,4 @@
+// common/scene.glsl — Rust: crates/radcache-render/src/scene/mod.rs
 // The scene as every scene-reading pass sees it: bindings 0-15 (see shared/bindings.glsl),
 // surface reconstruction at a ray-query hit, materials, textures and emission.
 #ifndef RADCACHE_SCENE_GLSL

@@ -1,3 +1,4 @@
+// passes/aov.comp — Rust: crates/radcache-render/src/passes/aov.rs
 // Auxiliary output variables (AOVs) of the first hit: diffuse albedo, shading normal (world) and
 // depth (distance from the camera along the ray, in scene units), each box-filtered over a 4×4
 // grid of sub-pixel positions. A sub-sample that sees the background contributes zeros (albedo,

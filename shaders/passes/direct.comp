@@ -1,3 +1,4 @@
+// passes/direct.comp — Rust: crates/radcache-render/src/passes/direct.rs
 // Direct lighting of the cache's frame (compute, ray queries): per surface pixel, `samples`
 // one-sample-MIS estimates of the light arriving straight from emissive triangles and the
 // environment (see one_sample), plus the punctual lights once (they need no sampling). Written:

@@ -1,3 +1,4 @@
+// passes/emission.comp — Rust: crates/radcache-render/src/passes/emission.rs
 // Box-filtered emission of the cache's frame. Emission is the brightest thing in most images, so
 // a handful of jittered sub-frames leaves its edges visibly stepped (all pixels of a sub-frame
 // share one jitter, so the errors along an edge are correlated and survive block averaging).

@@ -1,3 +1,4 @@
+// passes/gbuffer.frag — Rust: crates/radcache-render/src/passes/gbuffer.rs
 // G-buffer rasterization, fragment stage: the five attachments of shaders/common/gbuffer.glsl.
 // The geometric normal comes from the triangle's world-space corners (mirroring instances flip
 // it, as glTF's winding rule says); both normals are turned toward the camera, and the front

@@ -1,3 +1,4 @@
+// passes/gbuffer.vert — Rust: crates/radcache-render/src/passes/gbuffer.rs
 // G-buffer rasterization, vertex stage: vertex pulling from the scene buffers, one draw per TLAS
 // instance (push constant), the instance transform, the frame's projection and a sub-pixel
 // jitter (in pixels, (0, 0) = pixel centre) for anti-aliasing by jittered sub-frames.

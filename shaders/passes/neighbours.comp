@@ -1,3 +1,4 @@
+// passes/neighbours.comp — Rust: crates/radcache-render/src/passes/neighbours.rs
 // Neighbour clamping (Křivánek et al. 2006; IC reference §7.5) through a world-space hash grid.
 // For every pair (i new, j any) the radii must satisfy R_i ≤ R_j + ‖p_i − p_j‖ and
 // R_j ≤ R_i + ‖p_i − p_j‖ (atomic minimums on R_orig's float bits: IEEE order equals integer order

@@ -1,3 +1,4 @@
+// passes/path_trace.comp — Rust: crates/radcache-render/src/passes/path_trace.rs
 // Reference path tracer: unbiased, progressive, box-filtered.
 //
 // Per pixel and sample: a camera ray through a uniformly jittered point of the pixel (box filter),

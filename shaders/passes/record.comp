@@ -1,3 +1,4 @@
+// passes/record.comp — Rust: crates/radcache-render/src/passes/record.rs
 // Irradiance records (IC reference §3, §4, §6, §7, §16): one workgroup per requested pixel,
 // dispatched indirectly from IcCounters.dispatch (crates/radcache-render/src/records.rs).
 //

@@ -1,3 +1,4 @@
+// passes/splat.frag — Rust: crates/radcache-render/src/passes/splat.rs
 // Irradiance splatting, per pixel (IC reference §10.3): the record's weight at the pixel's
 // G-buffer point (normal and in-front tests included), the gradient-extrapolated irradiance
 // clamped to [0, 4·E_i] (§16.2), and (w·Ẽ, w) added into the RGBA32F target by (ONE, ONE)

@@ -1,3 +1,4 @@
+// passes/splat.vert — Rust: crates/radcache-render/src/passes/splat.rs
 // Irradiance splatting (Gautron et al. 2005, IC reference §10.2): one screen-aligned quad per record
 // (instance = record index), covering the projection of its zone of influence, a ball of radius
 // splat_radius(R_i) around p_i. The bound is conservative: the 8 corners of the ball's world-space

@@ -1,3 +1,4 @@
+// passes/splat_common.glsl — Rust: crates/radcache-render/src/passes/splat.rs
 // Declarations shared by the splat vertex and fragment shaders.
 #ifndef RADCACHE_SPLAT_COMMON_GLSL
 #define RADCACHE_SPLAT_COMMON_GLSL

@@ -1,3 +1,4 @@
+// tests/busy.comp — Rust: tests/tests/foundation.rs
 // Busy work for the profiler test: each invocation iterates a hash `iterations` times.
 #version 460
 #extension GL_GOOGLE_include_directive : require

@@ -1,3 +1,4 @@
+// tests/gbuffer_fill.comp — Rust: tests/tests/ic_records.rs
 // Test helper (tests/tests/ic_records.rs): writes given surface points into the G-buffer's
 // position, shading-normal and geometric-normal images (layout of common/gbuffer.glsl), one
 // invocation per texel, so the record pass can be tested without the raster G-buffer pass.

@@ -1,3 +1,4 @@
+// tests/ircache_twin.comp — Rust: tests/tests/ircache_glsl.rs (harness tests/src/twin.rs)
 // GPU side of tests/tests/ircache_glsl.rs: evaluates the production GLSL twin of radcache-cache
 // (common/ircache_math.glsl) over a table of input rows, one invocation per row, and writes the
 // results for comparison with the Rust functions. Every row is 16 vec4 in and 16 vec4 out; uint

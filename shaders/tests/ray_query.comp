@@ -1,3 +1,4 @@
+// tests/ray_query.comp — Rust: tests/tests/ray_query.rs and xtask/src/bench/rays.rs
 // Traces one ray per invocation against the TLAS (closest hit) and records what was hit.
 // Used by the foundation test (against a CPU ray-triangle reference) and by `cargo xtask bench
 // rays` (MODE_BENCH: only the distance is kept, summed per ray to stop dead-code elimination).

@@ -1,3 +1,4 @@
+// tests/splat.frag — Rust: tests/tests/foundation.rs
 #version 460
 
 layout(location = 0) in vec4 v_color;

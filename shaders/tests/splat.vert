@@ -1,3 +1,4 @@
+// tests/splat.vert — Rust: tests/tests/foundation.rs
 // Instanced screen-space quads for the blending test: quad i covers the pixel rectangle
 // quads[i].rect at depth quads[i].depth and carries quads[i].color.
 #version 460
