@@ -174,6 +174,9 @@ pub enum WarningKind {
     MatrixNodeAnimated,
     /// Two animation channels target the same node property; the later one wins.
     DuplicateChannel,
+    /// The scene has no light source at all (no emitter, no punctual light, no environment):
+    /// it renders black.
+    NoLight,
     /// Anything else the loader worked around.
     Other,
 }

@@ -123,6 +123,7 @@ impl Scene {
             dynamic,
         };
         scene.camera = select_camera(&src, &scene, opts, &mut w)?;
+        warn_if_unlit(&scene, &mut w);
         Ok((scene, w.list))
     }
 }
@@ -239,4 +240,25 @@ fn select_camera(
             reason: reason.clone(),
         }),
     }
+}
+
+/// Warns when nothing in `scene` emits light: no emissive material on any triangle, no
+/// punctual light, and a black (or absent) environment. Such a scene renders black.
+fn warn_if_unlit(scene: &Scene, w: &mut Warnings) {
+    let plan = scene.plan();
+    let environment_lit = match &scene.environment {
+        Environment::None => false,
+        Environment::Constant(c) => c.max_element() > 0.0,
+        Environment::Map { scale, .. } => *scale > 0.0,
+    };
+    if plan.has_emissive() || plan.has_punctual_lights() || environment_lit {
+        return;
+    }
+    let msg = format!(
+        "{}: the scene has no light source (no emissive material, no KHR_lights_punctual light, \
+         no environment), so it renders black; add light with `--env-radiance R,G,B` (a \
+         constant sky) or `--env-map FILE.exr`",
+        scene.path.display()
+    );
+    w.push(WarningKind::NoLight, 1, msg);
 }

@@ -336,3 +336,35 @@ fn skins_and_morph_targets_use_the_rest_pose_with_warnings() {
     // Rest pose: the morph target is not applied.
     assert_eq!(s.meshes[0].positions[0], Vec3::ZERO);
 }
+
+/// A scene with nothing that emits (no emissive material, no punctual light, no environment)
+/// renders black: the loader says so once, and says how to add light; light from any source,
+/// the command line's environment included, silences it.
+#[test]
+fn a_scene_without_light_gets_one_warning_naming_the_fix() {
+    let dir = temp_dir("unlit");
+    let path = write(&triangle_scene(None, |_| {}), &dir, "unlit");
+    let (_, warnings) = load(&path);
+    assert_eq!(warnings_of(&warnings, WarningKind::NoLight), (1, 1), "{warnings:?}");
+    let w = warnings.iter().find(|w| w.kind == WarningKind::NoLight).unwrap();
+    assert!(w.message.contains("unlit.gltf"), "{}", w.message);
+    assert!(w.message.contains("--env-radiance"), "{}", w.message);
+
+    let lit = LoadOptions {
+        env: EnvOverride {
+            radiance: Some([0.5, 0.5, 0.5]),
+            ..Default::default()
+        },
+        ..LoadOptions::default()
+    };
+    let (_, warnings) = Scene::load(&path, &lit).unwrap();
+    assert_eq!(warnings_of(&warnings, WarningKind::NoLight), (0, 0));
+
+    let emissive = MaterialDesc {
+        emissive: [1.0, 1.0, 1.0],
+        ..MaterialDesc::diffuse("light", [0.5; 3])
+    };
+    let path = write(&triangle_scene(Some(emissive), |_| {}), &dir, "emissive");
+    let (_, warnings) = load(&path);
+    assert_eq!(warnings_of(&warnings, WarningKind::NoLight), (0, 0));
+}

@@ -3,7 +3,7 @@
 //! rate (`bench rays`, incoherent case, measured by this run on the same device) it reaches.
 
 use anyhow::{Context as _, Result};
-use radcache_render::{render_path, Budget, GpuScene, PathSettings};
+use radcache_render::{render_path, Budget, GpuScene, PathSettings, Track};
 use radcache_scene::{LoadOptions, Scene};
 
 use super::harness::{Bench, Figure};
@@ -36,7 +36,14 @@ pub fn run(args: &[&str]) -> Result<()> {
             ..PathSettings::default()
         };
         let out = render_path(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
-        let gpu_s = out.passes_ms.get("path_trace").copied().unwrap_or(0.0) / 1000.0;
+        // The host's wall time of the sampling submissions: lavapipe's timestamps do not bracket
+        // compute work reliably (they gave rates several times the raw ray rate).
+        let gpu_s: f64 = out
+            .spans
+            .iter()
+            .filter(|s| s.track == Track::Cpu && s.name == "path_trace")
+            .map(|s| s.duration_s)
+            .sum();
         let samples = f64::from(size) * f64::from(size) * f64::from(out.spp);
         let rays: u64 = out.rays.values().sum();
         let sps = samples / gpu_s.max(1e-9);

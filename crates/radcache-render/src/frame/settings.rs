@@ -152,13 +152,17 @@ mod tests {
             let j = sub_frame_jitter(k);
             assert!(j.iter().all(|v| (-0.5..0.5).contains(v)), "{j:?}");
         }
-        // Four sub-frames fall in four different quadrants of the pixel.
-        let quads: std::collections::BTreeSet<(bool, bool)> = (0..4)
-            .map(|k| {
-                let j = sub_frame_jitter(k);
-                (j[0] >= 0.0, j[1] >= 0.0)
-            })
-            .collect();
-        assert!(quads.len() >= 3, "{quads:?}");
+        // The centre and the next R2 point share the (+, +) quadrant, so four sub-frames cover
+        // three quadrants and five (the centre and four R2 points) cover all four.
+        let quadrants = |n: u32| -> std::collections::BTreeSet<(bool, bool)> {
+            (0..n)
+                .map(|k| {
+                    let j = sub_frame_jitter(k);
+                    (j[0] >= 0.0, j[1] >= 0.0)
+                })
+                .collect()
+        };
+        assert_eq!(quadrants(4).len(), 3, "{:?}", quadrants(4));
+        assert_eq!(quadrants(5).len(), 4, "{:?}", quadrants(5));
     }
 }

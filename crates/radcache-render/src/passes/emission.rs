@@ -1,6 +1,8 @@
 //! Box-filtered emission (`shaders/passes/emission.comp`): after the sub-frames, pixels at or next
-//! to emitters get their emission from 8×8 stratified camera rays, so emitter edges are filtered
-//! like the reference's instead of being quantised by the few sub-frame jitters.
+//! to emitters get their emission from 64 camera rays on a Hammersley (0,6,2)-net, digitally
+//! shifted per pixel (every 8×8 stratum and every 1/64 row and column of the pixel holds one ray,
+//! so an axis-aligned edge's coverage is exact to 1/64), so emitter edges are filtered like the
+//! reference's instead of being quantised by the few sub-frame jitters.
 
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
