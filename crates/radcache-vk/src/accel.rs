@@ -12,7 +12,7 @@ use ash::vk;
 
 use crate::buffer::{Buffer, BufferDesc, MemoryLocation};
 use crate::context::{Context, DeviceShared, Garbage};
-use crate::error::{Result, VkResultExt};
+use crate::error::{Error, Result, VkResultExt};
 use crate::sync::Access;
 
 /// An acceleration structure and the buffer holding it.
@@ -103,7 +103,9 @@ impl Blas {
 }
 
 /// Triangle geometry of one BLAS: `R32G32B32_SFLOAT` positions and `u32` indices. Both buffers
-/// need `ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR | SHADER_DEVICE_ADDRESS` usage.
+/// need `ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR | SHADER_DEVICE_ADDRESS` usage and must
+/// hold the ranges described (both checked). The index values are GPU data the host does not
+/// read: each must be below `vertex_count`.
 #[derive(Debug, Clone, Copy)]
 pub struct BlasGeometry<'a> {
     /// Name of the BLAS.
@@ -138,6 +140,43 @@ pub struct BlasBuildStats {
 }
 
 fn triangles<'a>(g: &BlasGeometry<'_>) -> Result<vk::AccelerationStructureGeometryKHR<'a>> {
+    let usage = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
+        | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
+    let vertex_end = (u64::from(g.vertex_count).checked_sub(1))
+        .map(|last| g.vertex_offset + last * g.vertex_stride + 12)
+        .unwrap_or(g.vertex_offset);
+    let index_end = g.index_offset + u64::from(g.triangle_count) * 12;
+    for (b, what, end) in [
+        (g.vertices, "vertex", vertex_end),
+        (g.indices, "index", index_end),
+    ] {
+        if !b.usage().contains(usage) {
+            return Err(Error::Invalid(format!(
+                "BLAS {:?}: {what} buffer {:?} lacks {usage:?} usage",
+                g.name,
+                b.name()
+            )));
+        }
+        if end > b.size() {
+            return Err(Error::Invalid(format!(
+                "BLAS {:?}: the {what} data ends at byte {end}, past the end of buffer {:?} ({} \
+                 bytes)",
+                g.name,
+                b.name(),
+                b.size()
+            )));
+        }
+    }
+    let aligned = [g.index_offset, g.vertex_offset, g.vertex_stride]
+        .iter()
+        .all(|v| v.is_multiple_of(4));
+    if !aligned || g.vertex_stride < 12 {
+        return Err(Error::Invalid(format!(
+            "BLAS {:?}: index offset {}, vertex offset {} and vertex stride {} must be multiples \
+             of 4, the stride at least 12",
+            g.name, g.index_offset, g.vertex_offset, g.vertex_stride
+        )));
+    }
     let tri = vk::AccelerationStructureGeometryTrianglesDataKHR::default()
         .vertex_format(vk::Format::R32G32B32_SFLOAT)
         .vertex_data(vk::DeviceOrHostAddressConstKHR {
@@ -239,8 +278,9 @@ impl Context {
         let mut rec = self.begin("accel.blas_build")?;
         rec.barrier(Access::ALL_WRITES, Access::AS_BUILD_READ);
         rec.pass("accel.blas_build", |rec| {
-            // SAFETY: recording; inputs, destinations and scratch are live device-address buffers
-            // kept alive until the submission is waited for below; one range per geometry.
+            // SAFETY: recording outside a rendering; inputs (usage and ranges checked by
+            // `triangles`), destinations and scratch are live device-address buffers kept alive
+            // until the submission is waited for below; one range per geometry.
             unsafe {
                 rec.shared
                     .device

@@ -4,8 +4,20 @@
 //! device-local ones are filled through a staging copy ([`Context::create_buffer_init`]) and read
 //! back the same way ([`Context::read_buffer`]). lavapipe maps everything, but nothing here relies
 //! on that.
+//!
+//! # Host access and the GPU
+//! Every recording that takes a buffer (as a binding, indirect arguments, a copy or fill source or
+//! destination, an index buffer) records its index in the buffer. A host write ([`Buffer::write`])
+//! or read ([`Buffer::read`]) is refused with [`Error::Invalid`] while one of those recordings is
+//! submitted and not yet waited for (its [`Submission`](crate::Submission) neither waited nor
+//! dropped): the GPU may be reading what the host would overwrite, or writing what the host would
+//! read. A recording still being recorded does not count: the host writes made before
+//! `vkQueueSubmit` are visible to the submitted commands (host-coherent memory), so filling a
+//! buffer after recording the pass that reads it and before submitting it is sound. Refusing is
+//! simpler than waiting (a buffer holds no fence to wait on) and turns a silent race into an error
+//! that names the buffer; radcache waits for each submission before touching its buffers again.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use ash::vk;
 use bytemuck::Pod;
@@ -36,6 +48,10 @@ pub struct Buffer {
     raw: vk::Buffer,
     allocation: Option<Allocation>,
     size: u64,
+    /// The usage it was created with (`TRANSFER_SRC | TRANSFER_DST` included).
+    usage: vk::BufferUsageFlags,
+    /// Indices of the recordings that took this buffer and had not ended when it was last taken.
+    uses: Mutex<Vec<u64>>,
     address: Option<u64>,
     name: String,
     alloc_id: u64,
@@ -101,6 +117,8 @@ impl Buffer {
             raw,
             allocation: Some(allocation),
             size,
+            usage,
+            uses: Mutex::new(Vec::new()),
             address: None,
             name: desc.name.to_string(),
             alloc_id,
@@ -125,6 +143,35 @@ impl Buffer {
         self.size
     }
 
+    /// The usage flags it was created with (`TRANSFER_SRC | TRANSFER_DST` always included).
+    pub fn usage(&self) -> vk::BufferUsageFlags {
+        self.usage
+    }
+
+    /// Records that recording `index` takes this buffer (forgetting recordings that have ended).
+    pub(crate) fn used_by(&self, index: u64) {
+        let mut uses = self.uses.lock().unwrap_or_else(|p| p.into_inner());
+        if uses.contains(&index) {
+            return;
+        }
+        self.shared.retain_outstanding(&mut uses);
+        uses.push(index);
+    }
+
+    /// Refuses host access (`what`: "write" or "read") while a submitted recording that took
+    /// this buffer has not been waited for.
+    fn check_idle(&self, what: &str) -> Result<()> {
+        let uses = self.uses.lock().unwrap_or_else(|p| p.into_inner());
+        match self.shared.first_in_flight(&uses) {
+            None => Ok(()),
+            Some(index) => Err(Error::Invalid(format!(
+                "host {what} of buffer {:?} while submission {index}, which uses it, is still in \
+                 flight (wait for it first)",
+                self.name
+            ))),
+        }
+    }
+
     /// The allocation name.
     pub fn name(&self) -> &str {
         &self.name
@@ -140,18 +187,28 @@ impl Buffer {
         })
     }
 
-    /// Whether the buffer is mapped into host memory.
+    /// Whether the buffer is mapped into host-coherent memory (what [`Self::write`] and
+    /// [`Self::read`] need: they neither flush nor invalidate).
     pub fn is_mapped(&self) -> bool {
-        self.allocation
-            .as_ref()
-            .is_some_and(|a| a.mapped_slice().is_some())
+        self.allocation.as_ref().is_some_and(|a| {
+            a.mapped_slice().is_some()
+                && a.memory_properties()
+                    .contains(vk::MemoryPropertyFlags::HOST_COHERENT)
+        })
     }
 
-    /// Writes `data` at byte `offset` of a host-visible buffer. The caller must make sure no
-    /// pending GPU work reads this range (e.g. write before recording, or after waiting).
+    /// Writes `data` at byte `offset` of a host-visible buffer. Refused (an error naming the
+    /// buffer) while a submitted recording that uses the buffer has not been waited for: see the
+    /// module documentation.
     pub fn write<T: Pod>(&mut self, offset: u64, data: &[T]) -> Result<()> {
+        self.check_idle("write")?;
         let bytes: &[u8] = bytemuck::cast_slice(data);
         let name = self.name.clone();
+        if !self.is_mapped() {
+            return Err(Error::Invalid(format!(
+                "buffer {name:?} is not host visible and coherent"
+            )));
+        }
         let slice = self
             .allocation
             .as_mut()
@@ -170,9 +227,17 @@ impl Buffer {
         Ok(())
     }
 
-    /// Reads `count` elements of `T` from a host-visible buffer (after the GPU wrote them and the
-    /// submission was waited for).
+    /// Reads `count` elements of `T` from a host-visible buffer. Refused (an error naming the
+    /// buffer) while a submitted recording that uses the buffer has not been waited for: the GPU
+    /// may still be writing it (see the module documentation).
     pub fn read<T: Pod>(&self, count: usize) -> Result<Vec<T>> {
+        self.check_idle("read")?;
+        if !self.is_mapped() {
+            return Err(Error::Invalid(format!(
+                "buffer {:?} is not host visible and coherent",
+                self.name
+            )));
+        }
         let slice = self
             .allocation
             .as_ref()

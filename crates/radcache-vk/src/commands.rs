@@ -18,11 +18,12 @@ use crate::profiler::{PassTiming, ProfilerRecording, Scope, MAX_QUERIES};
 pub struct Recorder {
     pub(crate) shared: Arc<DeviceShared>,
     pub(crate) cmd: vk::CommandBuffer,
-    index: u64,
+    /// This recording's index (`DeviceShared::begin_recording`), which buffers remember.
+    pub(crate) index: u64,
     pub(crate) profiler: ProfilerRecording,
-    /// Pipeline bound last: (bind point, layout, binding table, push-constant size, stages).
-    pub(crate) bound: Option<crate::bind::BoundPipeline>,
-    label: String,
+    /// The bound pipeline, the open rendering and the index buffer, for the record-time checks.
+    pub(crate) state: crate::state::RecordState,
+    pub(crate) label: String,
     finished: bool,
 }
 
@@ -62,7 +63,7 @@ impl Context {
             cmd,
             index,
             profiler,
-            bound: None,
+            state: crate::state::RecordState::default(),
             label: label.to_string(),
             finished: false,
         };
@@ -88,8 +89,14 @@ impl Context {
             "recording {:?} submitted with open pass scopes",
             rec.label
         );
+        assert!(
+            rec.state.rendering.is_none(),
+            "recording {:?} submitted with an open rendering (end_rendering first)",
+            rec.label
+        );
         let shared = rec.shared.clone();
-        // SAFETY: the command buffer is in the recording state with every scope closed.
+        // SAFETY: the command buffer is in the recording state, outside a rendering, with every
+        // scope (debug label) closed (both asserted above).
         unsafe { shared.device.end_command_buffer(rec.cmd) }.call("vkEndCommandBuffer")?;
         // SAFETY: the device is live.
         let fence = unsafe {
@@ -106,6 +113,9 @@ impl Context {
             unsafe { shared.device.queue_submit2(*queue, &submit, fence) }
         };
         rec.finished = true;
+        if result.is_ok() {
+            shared.mark_submitted(rec.index);
+        }
         let profiler = std::mem::replace(
             &mut rec.profiler,
             ProfilerRecording {
@@ -220,7 +230,16 @@ impl Recorder {
 impl Drop for Recorder {
     fn drop(&mut self) {
         if !self.finished {
-            // Abandoned: the command buffer never reached the queue.
+            // Abandoned: the command buffer never reached the queue, so the layouts its
+            // `use_image` calls recorded never happened; UNDEFINED is always a valid old layout.
+            for image in &self.state.touched {
+                let mut track = image.lock().unwrap_or_else(|p| p.into_inner());
+                if track.recording == self.index {
+                    track.layout = vk::ImageLayout::UNDEFINED;
+                    track.access = crate::sync::Access::ALL_WRITES;
+                    track.recording = 0;
+                }
+            }
             self.shared.retire(Garbage::CommandBuffer(self.cmd));
             self.shared.retire(Garbage::QueryPool(self.profiler.pool));
             self.shared.end_recording(self.index);

@@ -16,38 +16,8 @@ use gpu_allocator::vulkan::{Allocation, Allocator, AllocatorCreateDesc};
 use crate::device::{self, DeviceInfo};
 use crate::error::{Error, Result, VkResultExt};
 use crate::instance::{self, InstanceParts};
+use crate::options::ContextOptions;
 use crate::select;
-
-/// How to create a [`Context`].
-#[derive(Debug, Clone, Default)]
-pub struct ContextOptions {
-    /// Enable the Khronos validation layer (if installed).
-    pub validation: bool,
-    /// Keep only devices whose name contains this (case-insensitive).
-    pub device_filter: Option<String>,
-    /// Device extensions to require on top of radcache's own.
-    pub extra_device_extensions: Vec<String>,
-}
-
-impl ContextOptions {
-    /// Options from the environment: `RADCACHE_VALIDATION=0/1` (default: on in debug builds) and
-    /// `RADCACHE_DEVICE=<substring of the device name>`.
-    pub fn from_env() -> Self {
-        let validation = match std::env::var("RADCACHE_VALIDATION").as_deref() {
-            Ok("0") | Ok("false") | Ok("off") | Ok("no") => false,
-            Ok("1") | Ok("true") | Ok("on") | Ok("yes") => true,
-            _ => cfg!(debug_assertions),
-        };
-        let device_filter = std::env::var("RADCACHE_DEVICE")
-            .ok()
-            .filter(|s| !s.is_empty());
-        ContextOptions {
-            validation,
-            device_filter,
-            extra_device_extensions: Vec::new(),
-        }
-    }
-}
 
 /// A GPU object waiting for the GPU to be done with it.
 pub(crate) enum Garbage {
@@ -67,6 +37,8 @@ pub(crate) struct Tracking {
     begun: u64,
     /// Recordings begun and neither completed nor abandoned.
     outstanding: BTreeSet<u64>,
+    /// The outstanding recordings that were submitted: the GPU may be executing them.
+    submitted: BTreeSet<u64>,
     graveyard: Vec<(u64, Garbage)>,
     /// Live allocations: id -> name.
     live: BTreeMap<u64, String>,
@@ -129,10 +101,37 @@ impl DeviceShared {
         index
     }
 
+    /// Marks a recording submitted: until it ends, the GPU may be executing it.
+    pub(crate) fn mark_submitted(&self, index: u64) {
+        lock(&self.tracking).submitted.insert(index);
+    }
+
     /// Marks a recording completed (or abandoned) and destroys what no recording needs any more.
     pub(crate) fn end_recording(&self, index: u64) {
-        lock(&self.tracking).outstanding.remove(&index);
+        {
+            let mut t = lock(&self.tracking);
+            t.outstanding.remove(&index);
+            t.submitted.remove(&index);
+        }
         self.collect();
+    }
+
+    /// Whether recording `index` is still being recorded (begun, neither submitted nor ended).
+    pub(crate) fn is_unsubmitted(&self, index: u64) -> bool {
+        let t = lock(&self.tracking);
+        t.outstanding.contains(&index) && !t.submitted.contains(&index)
+    }
+
+    /// Keeps, of the recording indices `uses`, those that have not ended.
+    pub(crate) fn retain_outstanding(&self, uses: &mut Vec<u64>) {
+        let t = lock(&self.tracking);
+        uses.retain(|i| t.outstanding.contains(i));
+    }
+
+    /// The first of the recording indices `uses` that is submitted and not yet waited for.
+    pub(crate) fn first_in_flight(&self, uses: &[u64]) -> Option<u64> {
+        let t = lock(&self.tracking);
+        uses.iter().copied().find(|i| t.submitted.contains(i))
     }
 
     /// Queues `g` for destruction after every recording begun so far has ended.
@@ -239,6 +238,7 @@ impl Drop for DeviceShared {
         let (garbage, leaked) = {
             let mut t = lock(&self.tracking);
             t.outstanding.clear();
+            t.submitted.clear();
             let g: Vec<Garbage> = t.graveyard.drain(..).map(|(_, g)| g).collect();
             (g, std::mem::take(&mut t.live))
         };
@@ -475,6 +475,7 @@ impl Context {
         {
             let mut t = lock(&self.shared.tracking);
             t.outstanding.clear();
+            t.submitted.clear();
         }
         self.shared.collect();
         let state = &self.shared.inst.messenger_state;

@@ -29,6 +29,14 @@ pub struct DeviceInfo {
     pub max_compute_work_group_count: [u32; 3],
     /// `maxStorageBufferRange` in bytes.
     pub max_storage_buffer_range: u32,
+    /// `maxUniformBufferRange` in bytes.
+    pub max_uniform_buffer_range: u32,
+    /// `minStorageBufferOffsetAlignment` in bytes.
+    pub min_storage_buffer_offset_alignment: u64,
+    /// `minUniformBufferOffsetAlignment` in bytes.
+    pub min_uniform_buffer_offset_alignment: u64,
+    /// `maxColorAttachments`.
+    pub max_color_attachments: u32,
     /// `maxPushConstantsSize` in bytes.
     pub max_push_constants_size: u32,
     /// `minAccelerationStructureScratchOffsetAlignment`.
@@ -183,6 +191,10 @@ pub(crate) fn device_info(
         timestamp_valid_bits,
         max_compute_work_group_count: p.limits.max_compute_work_group_count,
         max_storage_buffer_range: p.limits.max_storage_buffer_range,
+        max_uniform_buffer_range: p.limits.max_uniform_buffer_range,
+        min_storage_buffer_offset_alignment: p.limits.min_storage_buffer_offset_alignment,
+        min_uniform_buffer_offset_alignment: p.limits.min_uniform_buffer_offset_alignment,
+        max_color_attachments: p.limits.max_color_attachments,
         max_push_constants_size: p.limits.max_push_constants_size,
         min_scratch_alignment: as_props.min_acceleration_structure_scratch_offset_alignment,
         subgroup_size: sub.subgroup_size,

@@ -8,7 +8,7 @@ use gpu_allocator::MemoryLocation;
 
 use crate::context::{Context, DeviceShared, Garbage};
 use crate::error::{Error, Result, VkResultExt};
-use crate::sync::Access;
+use crate::state::{ImageState, ImageTrack};
 
 /// What to create.
 #[derive(Debug, Clone)]
@@ -34,8 +34,11 @@ pub struct Image {
     format: vk::Format,
     extent: vk::Extent2D,
     aspect: vk::ImageAspectFlags,
-    /// Current layout and the last access, for the barrier of the next use.
-    pub(crate) state: Mutex<(vk::ImageLayout, Access)>,
+    /// The usage it was created with (`TRANSFER_SRC | TRANSFER_DST` included).
+    usage: vk::ImageUsageFlags,
+    /// Current layout and the last access, for the barrier of the next use; shared with the
+    /// recordings that pushed the image as a descriptor, which check it at each draw or dispatch.
+    pub(crate) state: ImageState,
     name: String,
     alloc_id: u64,
 }
@@ -127,7 +130,8 @@ impl Image {
                 height: desc.height,
             },
             aspect,
-            state: Mutex::new((vk::ImageLayout::UNDEFINED, Access::NONE)),
+            usage,
+            state: Arc::new(Mutex::new(ImageTrack::new())),
             name: desc.name.to_string(),
             alloc_id,
         };
@@ -175,6 +179,11 @@ impl Image {
     /// Whether this is a depth image.
     pub fn is_depth(&self) -> bool {
         self.aspect == vk::ImageAspectFlags::DEPTH
+    }
+
+    /// The usage flags it was created with (`TRANSFER_SRC | TRANSFER_DST` always included).
+    pub fn usage(&self) -> vk::ImageUsageFlags {
+        self.usage
     }
 
     /// Pixel format.

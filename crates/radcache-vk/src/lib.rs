@@ -4,7 +4,13 @@
 //! report), RAII GPU objects with deferred destruction ([`Buffer`], [`Image`], [`Pipeline`],
 //! [`Blas`], [`Tlas`]), command recording with named, timed pass scopes ([`Recorder::pass`]),
 //! synchronization2 barriers ([`Access`], [`ImageUse`]) and run-time GLSL compilation
-//! ([`ShaderCompiler`]). Every unsafe block carries a `SAFETY:` note; the public API is safe.
+//! ([`ShaderCompiler`]). Every unsafe block carries a `SAFETY:` note; the public API is safe:
+//! each recording function checks its preconditions against the recording's state (a pipeline of
+//! the right kind bound, every declared binding pushed, a rendering open for draws, the usage and
+//! range of indirect arguments) and panics on a violation, which is a programming error; a host
+//! write into a buffer that a submitted, unwaited recording uses is refused ([`Buffer::write`]).
+//! What no host check can see (values the GPU writes into indirect arguments) is written down on
+//! the function that reads them.
 
 mod accel;
 mod bind;
@@ -12,26 +18,32 @@ mod buffer;
 mod commands;
 mod context;
 mod device;
+mod draw;
 mod error;
 mod image;
 mod instance;
+mod options;
 mod pipeline;
 mod profiler;
+mod reflect;
 pub mod select;
 mod shader;
+mod state;
 mod sync;
 mod tlas;
 mod transfer;
 
 pub use accel::{Blas, BlasBuildStats, BlasGeometry};
 pub use ash::vk;
-pub use bind::{ColorTarget, DepthTarget, Resource};
+pub use bind::Resource;
 pub use buffer::{Buffer, BufferDesc, MemoryLocation};
 pub use commands::{Recorder, Submission};
-pub use context::{Context, ContextOptions, ShutdownReport};
+pub use context::{Context, ShutdownReport};
 pub use device::DeviceInfo;
+pub use draw::{ColorTarget, DepthTarget};
 pub use error::{Error, Result};
 pub use image::{Image, ImageDesc, Sampler};
+pub use options::ContextOptions;
 pub use pipeline::{BindingKind, BindingLayout, Blend, DepthState, GraphicsDesc, Pipeline};
 pub use profiler::PassTiming;
 pub use select::DeviceKind;

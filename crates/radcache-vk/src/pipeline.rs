@@ -10,6 +10,7 @@ use ash::vk;
 
 use crate::context::{Context, DeviceShared, Garbage};
 use crate::error::{Error, Result, VkResultExt};
+use crate::reflect;
 
 /// The kind of resource at a binding.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -115,6 +116,9 @@ pub struct Pipeline {
     pub(crate) bindings: Vec<BindingLayout>,
     pub(crate) push_constant_size: u32,
     pub(crate) stages: vk::ShaderStageFlags,
+    /// Attachment formats of a graphics pipeline (none and `UNDEFINED` for compute).
+    pub(crate) color_formats: Vec<vk::Format>,
+    pub(crate) depth_format: vk::Format,
     name: String,
 }
 
@@ -185,14 +189,32 @@ fn create_layouts(
     }
 }
 
+/// The first word of every SPIR-V module.
+pub(crate) const SPIRV_MAGIC: u32 = 0x0723_0203;
+
+/// A shader module. The SPIR-V must be a valid module: its header and the resources it uses
+/// (`reflect::check_layout`) are checked, the rest is trusted to come from
+/// [`crate::ShaderCompiler`] (shaderc emits valid modules).
 fn shader_module(shared: &DeviceShared, spirv: &[u32]) -> Result<vk::ShaderModule> {
+    if spirv.len() < 5 || spirv[0] != SPIRV_MAGIC {
+        return Err(Error::Invalid(format!(
+            "not a SPIR-V module ({} words, first {:#010x})",
+            spirv.len(),
+            spirv.first().copied().unwrap_or(0)
+        )));
+    }
     let info = vk::ShaderModuleCreateInfo::default().code(spirv);
-    // SAFETY: `spirv` is SPIR-V produced by shaderc (validated by the driver/validation layer).
+    // SAFETY: the device is live; `spirv` has a SPIR-V header (checked above). Its body is not
+    // validated here: radcache's modules come from `ShaderCompiler` (shaderc), and the pipeline
+    // constructors document that the words must be a valid module (a residual contract).
     unsafe { shared.device.create_shader_module(&info, None) }.call("vkCreateShaderModule")
 }
 
 impl Pipeline {
-    /// A compute pipeline from SPIR-V with entry point `main`.
+    /// A compute pipeline from SPIR-V with entry point `main`. The words must be a valid SPIR-V
+    /// module (as [`crate::ShaderCompiler::compile`] returns); the header, and the binding table
+    /// and push constants against the resources the shader uses, are checked (an error names
+    /// the pipeline and the binding).
     pub fn compute(
         ctx: &Context,
         name: &str,
@@ -212,8 +234,11 @@ impl Pipeline {
             bindings: bindings.to_vec(),
             push_constant_size,
             stages,
+            color_formats: Vec::new(),
+            depth_format: vk::Format::UNDEFINED,
             name: name.to_string(),
         };
+        reflect::check_layout(name, &[spirv], bindings, push_constant_size)?;
         let module = shader_module(shared, spirv)?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
@@ -222,7 +247,8 @@ impl Pipeline {
         let info = [vk::ComputePipelineCreateInfo::default()
             .stage(stage)
             .layout(layouts.pipeline)];
-        // SAFETY: module and layout are live; `info` is valid for the call.
+        // SAFETY: module and layout are live; the layout declares every resource and the push
+        // constants the shader uses (`reflect::check_layout` above); `info` outlives the call.
         let created = unsafe {
             shared
                 .device
@@ -238,7 +264,9 @@ impl Pipeline {
         Ok(pipeline)
     }
 
-    /// A graphics pipeline for dynamic rendering (viewport and scissor are dynamic).
+    /// A graphics pipeline for dynamic rendering (viewport and scissor are dynamic). The shaders
+    /// must be valid SPIR-V modules (as [`crate::ShaderCompiler::compile`] returns); headers,
+    /// binding table and push constants are checked as for [`Self::compute`].
     pub fn graphics(ctx: &Context, desc: &GraphicsDesc<'_>) -> Result<Self> {
         let shared = &ctx.shared;
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
@@ -252,8 +280,16 @@ impl Pipeline {
             bindings: desc.bindings.to_vec(),
             push_constant_size: desc.push_constant_size,
             stages,
+            color_formats: desc.color_formats.to_vec(),
+            depth_format: desc.depth.map_or(vk::Format::UNDEFINED, |d| d.format),
             name: desc.name.to_string(),
         };
+        reflect::check_layout(
+            desc.name,
+            &[desc.vertex, desc.fragment],
+            desc.bindings,
+            desc.push_constant_size,
+        )?;
         let vs = shader_module(shared, desc.vertex)?;
         let fs = match shader_module(shared, desc.fragment) {
             Ok(m) => m,
@@ -326,7 +362,9 @@ impl Pipeline {
             .dynamic_state(&dynamic)
             .layout(layouts.pipeline)
             .push_next(&mut rendering)];
-        // SAFETY: every state struct lives until the call returns; modules and layout are live.
+        // SAFETY: every state struct lives until the call returns; modules and layout are live;
+        // the layout declares every resource and the push constants the shaders use
+        // (`reflect::check_layout` above).
         let created = unsafe {
             shared
                 .device

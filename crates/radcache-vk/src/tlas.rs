@@ -145,6 +145,16 @@ impl Tlas {
     pub fn instance_count(&self) -> u32 {
         self.count.unwrap_or(0)
     }
+
+    /// Whether a build was recorded (ray queries on a never-built TLAS are undefined).
+    pub(crate) fn is_built(&self) -> bool {
+        self.count.is_some()
+    }
+
+    /// The TLAS's name.
+    pub fn name(&self) -> &str {
+        &self.structure.name
+    }
 }
 
 impl Recorder {
@@ -157,6 +167,7 @@ impl Recorder {
         instances: &[TlasInstance<'_>],
         update: TlasUpdate,
     ) -> Result<()> {
+        self.check_outside_rendering("build_tlas");
         let n = instances.len() as u32;
         if n > tlas.capacity {
             return Err(Error::Invalid(format!(
@@ -215,8 +226,10 @@ impl Recorder {
                 primitive_count: n,
                 ..Default::default()
             }];
-            // SAFETY: recording; instance data was copied above (barrier), the storage and scratch
-            // were sized for `capacity` ≥ n, and refit only happens with an unchanged count.
+            tlas.scratch.used_by(rec.index);
+            // SAFETY: recording outside a rendering (checked above); instance data was copied
+            // above (barrier), the storage and scratch were sized for `capacity` ≥ n, refit only
+            // happens with an unchanged count, and every BLAS referenced is kept alive by `tlas`.
             unsafe {
                 rec.shared
                     .accel

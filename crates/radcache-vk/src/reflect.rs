@@ -1,0 +1,248 @@
+//! The resources a SPIR-V module uses, read from its instructions, so that pipeline creation can
+//! check the binding table against the shader instead of trusting it.
+//!
+//! Vulkan requires the pipeline layout to declare every resource a shader statically uses, with
+//! the right descriptor type and enough descriptors. From SPIR-V 1.4 on, an entry point's
+//! interface lists every global variable it uses, so the used resources are the interface's
+//! variables that carry a `Binding` decoration; older modules fall back to every decorated
+//! variable. Only what the check needs is parsed: the variables, their pointer and base types,
+//! and the decorations `Binding`, `DescriptorSet`, `Block` and `BufferBlock`.
+
+use std::collections::{HashMap, HashSet};
+
+use crate::error::{Error, Result};
+use crate::pipeline::{BindingKind, BindingLayout};
+
+// Opcodes, storage classes and decorations of the SPIR-V specification.
+const OP_ENTRY_POINT: u32 = 15;
+const OP_TYPE_IMAGE: u32 = 25;
+const OP_TYPE_SAMPLER: u32 = 26;
+const OP_TYPE_SAMPLED_IMAGE: u32 = 27;
+const OP_TYPE_ARRAY: u32 = 28;
+const OP_TYPE_RUNTIME_ARRAY: u32 = 29;
+const OP_TYPE_STRUCT: u32 = 30;
+const OP_TYPE_POINTER: u32 = 32;
+const OP_CONSTANT: u32 = 43;
+const OP_VARIABLE: u32 = 59;
+const OP_DECORATE: u32 = 71;
+const OP_TYPE_ACCELERATION_STRUCTURE: u32 = 5341;
+const SC_UNIFORM_CONSTANT: u32 = 0;
+const SC_UNIFORM: u32 = 2;
+const SC_PUSH_CONSTANT: u32 = 9;
+const SC_STORAGE_BUFFER: u32 = 12;
+const DEC_BLOCK: u32 = 2;
+const DEC_BUFFER_BLOCK: u32 = 3;
+const DEC_BINDING: u32 = 33;
+const DEC_DESCRIPTOR_SET: u32 = 34;
+
+/// A type, as far as the check needs it.
+#[derive(Debug, Clone, Copy)]
+enum Type {
+    /// `OpTypeImage` with its `Sampled` operand (1: sampled, 2: storage).
+    Image(u32),
+    Sampler,
+    SampledImage,
+    /// Element type and the id of the length constant.
+    Array(u32, u32),
+    RuntimeArray(u32),
+    Struct,
+    AccelerationStructure,
+    /// The pointee (the variable's storage class decides the kind).
+    Pointer(u32),
+}
+
+/// A resource the shader uses: (set, binding) → (kind, array length if known), or its complaint.
+type Used = Vec<(
+    u32,
+    u32,
+    std::result::Result<(BindingKind, Option<u32>), String>,
+)>;
+
+/// What a module uses: its descriptor resources and whether it reads push constants.
+struct Uses {
+    resources: Used,
+    push_constants: bool,
+}
+
+fn literal_string_words(words: &[u32]) -> usize {
+    words
+        .iter()
+        .position(|w| w.to_le_bytes().contains(&0))
+        .map_or(words.len(), |i| i + 1)
+}
+
+fn parse(spirv: &[u32]) -> std::result::Result<Uses, String> {
+    if spirv.len() < 5 || spirv[0] != crate::pipeline::SPIRV_MAGIC {
+        return Err("not a SPIR-V module (no SPIR-V header)".into());
+    }
+    let version = spirv.get(1).copied().unwrap_or(0);
+    let interface_lists_all = version >= 0x0001_0400;
+    let mut types: HashMap<u32, Type> = HashMap::new();
+    let mut constants: HashMap<u32, u32> = HashMap::new();
+    let mut variables: Vec<(u32, u32, u32)> = Vec::new(); // (id, pointer type, storage class)
+    let mut bindings: HashMap<u32, u32> = HashMap::new();
+    let mut sets: HashMap<u32, u32> = HashMap::new();
+    let mut blocks: HashSet<u32> = HashSet::new();
+    let mut buffer_blocks: HashSet<u32> = HashSet::new();
+    let mut interface: HashSet<u32> = HashSet::new();
+    let mut at = 5;
+    while at < spirv.len() {
+        let count = (spirv[at] >> 16) as usize;
+        let op = spirv[at] & 0xffff;
+        if count == 0 || at + count > spirv.len() {
+            return Err(format!("malformed instruction at word {at}"));
+        }
+        let w = &spirv[at + 1..at + count];
+        match op {
+            OP_ENTRY_POINT if w.len() >= 2 => {
+                let skip = 2 + literal_string_words(&w[2..]);
+                interface.extend(w.iter().skip(skip));
+            }
+            OP_DECORATE if w.len() >= 2 => match (w[1], w.get(2)) {
+                (DEC_BINDING, Some(&b)) => {
+                    bindings.insert(w[0], b);
+                }
+                (DEC_DESCRIPTOR_SET, Some(&s)) => {
+                    sets.insert(w[0], s);
+                }
+                (DEC_BLOCK, _) => {
+                    blocks.insert(w[0]);
+                }
+                (DEC_BUFFER_BLOCK, _) => {
+                    buffer_blocks.insert(w[0]);
+                }
+                _ => {}
+            },
+            OP_TYPE_IMAGE if w.len() >= 7 => {
+                types.insert(w[0], Type::Image(w[6]));
+            }
+            OP_TYPE_SAMPLER if !w.is_empty() => {
+                types.insert(w[0], Type::Sampler);
+            }
+            OP_TYPE_SAMPLED_IMAGE if !w.is_empty() => {
+                types.insert(w[0], Type::SampledImage);
+            }
+            OP_TYPE_ARRAY if w.len() >= 3 => {
+                types.insert(w[0], Type::Array(w[1], w[2]));
+            }
+            OP_TYPE_RUNTIME_ARRAY if w.len() >= 2 => {
+                types.insert(w[0], Type::RuntimeArray(w[1]));
+            }
+            OP_TYPE_STRUCT if !w.is_empty() => {
+                types.insert(w[0], Type::Struct);
+            }
+            OP_TYPE_ACCELERATION_STRUCTURE if !w.is_empty() => {
+                types.insert(w[0], Type::AccelerationStructure);
+            }
+            OP_TYPE_POINTER if w.len() >= 3 => {
+                types.insert(w[0], Type::Pointer(w[2]));
+            }
+            OP_CONSTANT if w.len() >= 3 => {
+                constants.insert(w[1], w[2]);
+            }
+            OP_VARIABLE if w.len() >= 3 => variables.push((w[1], w[0], w[2])),
+            _ => {}
+        }
+        at += count;
+    }
+    let used = |id: &u32| !interface_lists_all || interface.contains(id);
+    let push_constants = variables
+        .iter()
+        .any(|(id, _, class)| *class == SC_PUSH_CONSTANT && used(id));
+    let mut resources = Vec::new();
+    for (id, pointer, class) in &variables {
+        let Some(&binding) = bindings.get(id) else {
+            continue;
+        };
+        if !used(id) {
+            continue;
+        }
+        let set = sets.get(id).copied().unwrap_or(0);
+        let pointee = match types.get(pointer) {
+            Some(Type::Pointer(t)) => *t,
+            _ => return Err(format!("variable %{id} is not a pointer")),
+        };
+        // Unwrap arrays: the element type decides the kind, the length the count.
+        let (mut base, mut length) = (pointee, Some(1));
+        loop {
+            match types.get(&base) {
+                Some(Type::Array(elem, len)) => {
+                    length = constants.get(len).copied();
+                    base = *elem;
+                }
+                Some(Type::RuntimeArray(elem)) => {
+                    length = None;
+                    base = *elem;
+                }
+                _ => break,
+            }
+        }
+        let kind = match (*class, types.get(&base)) {
+            (SC_STORAGE_BUFFER, _) => Ok(BindingKind::StorageBuffer),
+            (SC_UNIFORM, _) if buffer_blocks.contains(&base) => Ok(BindingKind::StorageBuffer),
+            (SC_UNIFORM, _) if blocks.contains(&base) => Ok(BindingKind::UniformBuffer),
+            (SC_UNIFORM_CONSTANT, Some(Type::Image(2))) => Ok(BindingKind::StorageImage),
+            (SC_UNIFORM_CONSTANT, Some(Type::SampledImage)) => Ok(BindingKind::SampledImage),
+            (SC_UNIFORM_CONSTANT, Some(Type::AccelerationStructure)) => {
+                Ok(BindingKind::AccelerationStructure)
+            }
+            (_, t) => Err(format!(
+                "a resource radcache has no binding kind for (storage class {class}, {t:?})"
+            )),
+        };
+        resources.push((set, binding, kind.map(|k| (k, length))));
+    }
+    Ok(Uses {
+        resources,
+        push_constants,
+    })
+}
+
+/// Checks that `bindings` (set 0) declares every resource the modules use, with its kind and
+/// enough descriptors, and that push constants are declared when a module reads them.
+pub(crate) fn check_layout(
+    pipeline: &str,
+    modules: &[&[u32]],
+    bindings: &[BindingLayout],
+    push_constant_size: u32,
+) -> Result<()> {
+    let invalid = |m: String| Error::Invalid(format!("pipeline {pipeline:?}: {m}"));
+    for spirv in modules {
+        let uses = parse(spirv).map_err(|m| invalid(format!("cannot read its SPIR-V: {m}")))?;
+        if uses.push_constants && push_constant_size == 0 {
+            return Err(invalid(
+                "the shader reads push constants, the pipeline declares none".into(),
+            ));
+        }
+        for (set, binding, used) in uses.resources {
+            let (kind, length) = used.map_err(|m| invalid(format!("binding {binding}: {m}")))?;
+            if set != 0 {
+                return Err(invalid(format!(
+                    "the shader uses set {set} (binding {binding}); radcache pipelines have set 0 only"
+                )));
+            }
+            let declared = bindings
+                .iter()
+                .find(|b| b.binding == binding)
+                .ok_or_else(|| {
+                    invalid(format!(
+                        "the shader uses binding {binding} ({kind:?}), which its binding table \
+                         does not declare"
+                    ))
+                })?;
+            if declared.kind != kind {
+                return Err(invalid(format!(
+                    "binding {binding} is declared {:?}, the shader uses it as {kind:?}",
+                    declared.kind
+                )));
+            }
+            if let Some(n) = length.filter(|n| *n > declared.count) {
+                return Err(invalid(format!(
+                    "binding {binding} declares {} descriptors, the shader's array has {n}",
+                    declared.count
+                )));
+            }
+        }
+    }
+    Ok(())
+}
