@@ -345,8 +345,15 @@ fn a_scene_without_light_gets_one_warning_naming_the_fix() {
     let dir = temp_dir("unlit");
     let path = write(&triangle_scene(None, |_| {}), &dir, "unlit");
     let (_, warnings) = load(&path);
-    assert_eq!(warnings_of(&warnings, WarningKind::NoLight), (1, 1), "{warnings:?}");
-    let w = warnings.iter().find(|w| w.kind == WarningKind::NoLight).unwrap();
+    assert_eq!(
+        warnings_of(&warnings, WarningKind::NoLight),
+        (1, 1),
+        "{warnings:?}"
+    );
+    let w = warnings
+        .iter()
+        .find(|w| w.kind == WarningKind::NoLight)
+        .unwrap();
     assert!(w.message.contains("unlit.gltf"), "{}", w.message);
     assert!(w.message.contains("--env-radiance"), "{}", w.message);
 

@@ -134,7 +134,7 @@ fn path_setup(
     let view = scene.camera_at(settings.time);
     gpu.set_view(&view, w, h, settings.frame, settings.seed)?;
     let mut clock = FrameClock::new();
-    let tracer = PathTracer::new(ctx, shaders, gpu, w, h)?;
+    let mut tracer = PathTracer::new(ctx, shaders, gpu, w, h)?;
     clock.lap("pipelines");
     let aov_pass = if settings.aovs {
         Some(AovPass::new(ctx, shaders, w, h)?)
