@@ -1,16 +1,17 @@
 // common/ircache_math.glsl — Rust: crates/radcache-cache/src/*.rs (its CPU twin)
 // ircache_math.glsl: GLSL twin of the `radcache-cache` crate (crates/radcache-cache/src/*.rs).
 //
-// Irradiance-cache formulas of shared/docs/irradiance-caching.md: hemisphere sampling (§3.1, §3.2),
-// record sums and gradients (§6.1, §6.2, §7.1), radius post-processing (§7.2-§7.7), weights and
-// splat radius (§5.1-§5.5, §10.2, §16.1), extrapolation (§5.6, §16.2), temporal formulas (§11.2).
-// Each function has the same name, arguments (in order) and guards as its Rust reference; Rust
-// tuples/structs become `out` parameters, `[Vec3; 3]` RGB gradients become three vec3 (R, G, B).
-// The Rust docs hold the formulas; comments here only name the section. GLSL 4.60 core, no
-// extension; include once (guarded). Conventions: right-handed frames t x b = n; stratum (j, k) at
-// index j*N + k; distances >= IC_FAR are misses, <= r_eps invalid; outputs never divide by inf.
-// Test: crates/radcache-cache/tests/glsl.rs checks that every Rust function has a twin here and
-// compiles this file with glslangValidator when it is installed.
+// Irradiance-cache formulas of docs/irradiance-cache.md (cited in this file as a bare §N; other
+// docs/ files by name): hemisphere sampling (§2.1, §2.2), record sums and gradients (§2.5, §3.1,
+// §3.2), radius post-processing (§4.2-§4.7), weights and splat radius (§5.1-§5.4, §5.6, §7.2),
+// extrapolation (§6.1, §6.2), temporal formulas (docs/temporal.md §3.3). Each function has the same
+// name, arguments (in order) and guards as its Rust reference; Rust tuples/structs become `out`
+// parameters, `[Vec3; 3]` RGB gradients become three vec3 (R, G, B). The Rust docs hold the
+// formulas; comments here only name the section. GLSL 4.60 core, no extension; include once
+// (guarded). Conventions: right-handed frames t x b = n; stratum (j, k) at index j*N + k; distances
+// >= IC_FAR are misses, <= r_eps invalid; outputs never divide by inf. Test:
+// crates/radcache-cache/tests/glsl.rs checks that every Rust function has a twin here and compiles
+// this file with glslangValidator when it is installed.
 
 #ifndef IRCACHE_MATH_GLSL
 #define IRCACHE_MATH_GLSL
@@ -24,7 +25,7 @@ const float IC_TAU = 6.28318530717959;
 
 float luminance_rec709(vec3 c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 
-// ---- sampling (§3.1, §3.2, §11.4, §16.3) ----
+// ---- sampling (§2.1, §2.2, §2.3, §7.3) ----
 
 uint stratum_index(uint j, uint k, uint n) { return j * n + k; }
 
@@ -107,7 +108,7 @@ void stratum_jitter(uint seed, uint index, out float xi, out float psi) {
 
 float stratum_projected_solid_angle(uint m, uint n) { return IC_PI / (float(max(m, 1u)) * float(max(n, 1u))); }
 
-// ---- record sums and gradients (§3.1, §6.1, §6.2, §7.1) ----
+// ---- record sums and gradients (§2.5, §3.1, §3.2) ----
 
 bool is_valid_sample(float r, float r_eps) { return r > max(r_eps, 0.0); }
 
@@ -166,7 +167,7 @@ vec3 wall_term(vec3 l_cur, vec3 l_prev, float r_cur, float r_prev, float r_eps) 
 // NaN fails every comparison, so it is rejected too (where the driver keeps NaN).
 bool irradiance_is_valid(vec3 e) { return all(greaterThanEqual(e, vec3(0.0))) && all(lessThan(e, vec3(3.0e38))); }
 
-// ---- radius (§7.2-§7.7) ----
+// ---- radius (§4.2-§4.7) ----
 
 float sanitize_radius(float r) { return min(max(r, 0.0), IC_FAR); }
 
@@ -213,7 +214,7 @@ float gradient_attenuation(float r_unclamped, float r_lo) {
     return min(sanitize_radius(r_unclamped) / min(max(r_lo, R_FLOOR), IC_FAR), 1.0);
 }
 
-// §7.7 steps 3-7; outputs in the order of the Rust `FinalRadius` fields.
+// §4.7 steps 1-5; outputs in the order of the Rust `FinalRadius` fields.
 void finalize_radius(float r, vec3 e, vec3 gt_r, vec3 gt_g, vec3 gt_b, float r_neighbour, float r_lo, float r_hi,
                      out float r_orig, out float r_used, out float r_lo_out, out float r_hi_out, out float grad_t_scale) {
     float limited = gradient_limit_radius(r, e, gt_r, gt_g, gt_b);
@@ -224,7 +225,7 @@ void finalize_radius(float r, vec3 e, vec3 gt_r, vec3 gt_g, vec3 gt_b, float r_n
     grad_t_scale = gradient_attenuation(r_orig, r_lo_out);
 }
 
-// ---- weights (§5.1-§5.5, §10.2, §16.1) ----
+// ---- weights (§5.1-§5.4, §5.6, §7.2) ----
 
 bool normal_test(vec3 n, vec3 n_i) { return dot(n, n_i) > 0.0; }
 
@@ -292,7 +293,7 @@ float coverage_threshold(uint kind, float param, float hole_threshold) {
     return max(hole_threshold, 0.0) * weight_unit(kind, param);
 }
 
-// ---- extrapolation (§5.6, §16.2) ----
+// ---- extrapolation (§6.1, §6.2) ----
 
 vec3 clamp_extrapolation(vec3 x, vec3 e) {
     vec3 hi = max(e, vec3(0.0)) * EXTRAPOLATION_MAX_FACTOR;
@@ -307,7 +308,7 @@ vec3 extrapolate_irradiance(vec3 e_i, vec3 gr_r, vec3 gr_g, vec3 gr_b, vec3 gt_r
     return clamp_extrapolation(raw, e_i);
 }
 
-// ---- temporal (§11.2) ----
+// ---- temporal (docs/temporal.md §3.3) ----
 
 vec3 temporal_gradient(vec3 e_t0, vec3 e_t1) { return e_t1 - e_t0; }
 

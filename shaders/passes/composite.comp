@@ -1,5 +1,5 @@
 // passes/composite.comp — Rust: crates/radcache-render/src/passes/composite.rs
-// Composite of one sub-frame (IC reference §10.3 normalisation): on surfaces
+// Composite of one sub-frame (docs/cache-frame.md §6.4 normalisation): on surfaces
 // L = direct + albedo/π · Σw·Ẽ / Σw (0 where no record reaches the pixel), on the background the
 // environment along the camera ray; added with weight 1 to the frame accumulator (a = sub-frames
 // so far). The emission seen at the sub-frame's sample goes to a separate accumulator: the

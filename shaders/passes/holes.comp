@@ -1,8 +1,9 @@
 // passes/holes.comp — Rust: crates/radcache-render/src/passes/holes.rs
-// Hole selection (IC reference §10.4): at level spacing S, each S×S block of the image with at least
-// one hole (a surface pixel whose splatted weight sum is below the coverage threshold) requests one
-// new record, at the block's hole with the smallest hash (a deterministic, unbiased pick); the
-// number of hole pixels is counted. With `count_only`, holes are counted and nothing is requested.
+// Hole selection (docs/cache-frame.md §3.3): at level spacing S, each S×S block of the image with
+// at least one hole (a surface pixel whose splatted weight sum is below the coverage threshold)
+// requests one new record, at the block's hole with the smallest hash (a deterministic, unbiased
+// pick); the number of hole pixels is counted. With `count_only`, holes are counted and nothing is
+// requested.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 

@@ -1,8 +1,9 @@
 // passes/neighbours.comp — Rust: crates/radcache-render/src/passes/neighbours.rs
-// Neighbour clamping (Křivánek et al. 2006; IC reference §7.5) through a world-space hash grid.
-// For every pair (i new, j any) the radii must satisfy R_i ≤ R_j + ‖p_i − p_j‖ and
-// R_j ≤ R_i + ‖p_i − p_j‖ (atomic minimums on R_orig's float bits: IEEE order equals integer order
-// for non-negative floats, so the order of the updates does not matter).
+// Neighbour clamping (Křivánek et al. 2006; docs/cache-frame.md §5; docs/irradiance-cache.md §4.5)
+// through a world-space hash grid. For every pair (i new, j any) the radii must satisfy
+// R_i ≤ R_j + ‖p_i − p_j‖ and R_j ≤ R_i + ‖p_i − p_j‖ (atomic minimums on R_orig's float bits:
+// IEEE order equals integer order for non-negative floats, so the order of the updates does not
+// matter).
 //
 // Only pairs closer than max(R⁺_i, R⁺_j) can change a radius the splat uses (R_used =
 // clamp(R_orig, R⁻, R⁺)), once every R_orig is capped at its R⁺: a new record's R_orig is first

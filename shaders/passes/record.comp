@@ -1,16 +1,17 @@
 // passes/record.comp — Rust: crates/radcache-render/src/passes/record.rs
-// Irradiance records (IC reference §3, §4, §6, §7, §16): one workgroup per requested pixel,
-// dispatched indirectly from IcCounters.dispatch (crates/radcache-render/src/records.rs).
+// Irradiance records (docs/cache-frame.md §4; docs/irradiance-cache.md §2, §2.6, §3, §4, §7; bare
+// §N below cite docs/irradiance-cache.md): one workgroup per requested pixel, dispatched indirectly
+// from IcCounters.dispatch (crates/radcache-render/src/records.rs).
 //
 // Request i (gl_WorkGroupID.x) exists when i < min(requested, request_capacity); it creates
 // record batch_first + i, or, past record_capacity, is dropped and counted in dropped_requests.
 //
-// Gather (§3.1, §3.3): the M×N stratified cosine-weighted directions (stratum_direction_local with
+// Gather (§2.1, §2.4): the M×N stratified cosine-weighted directions (stratum_direction_local with
 // the deterministic jitter stratum_jitter(record_seed, j·N + k), record_seed = ircache_hash(pixel ^
 // ircache_hash(seed)), in the frame basis_from_normal of the SHADING normal) are traced in
 // parallel from offset_ray_origin(p, n_geo). A direction below the geometric surface (possible
 // only where the shading normal differs from the geometric one) is mirrored about the geometric
-// tangent plane, so it stays above both (§3.3 folds them like pbrt's Faceforward; the mirror keeps
+// tangent plane, so it stays above both (§2.4 folds them like pbrt's Faceforward; the mirror keeps
 // the azimuth); it still counts for its stratum. Each ray returns the full indirect radiance
 // arriving along it: next-event estimation at its first hit plus the path continued from there
 // (MIS, Russian roulette from the path's second vertex: a record averages M·N paths, so early
@@ -19,7 +20,7 @@
 // direct pass accounts for both at the shading point).
 // r_jk is the first hit's distance, IC_FAR on a miss. A non-finite sample counts as 0.
 //
-// Record (§4.1, §6, §7): one invocation sums the strata exactly as the CPU twin
+// Record (§2.6, §3, §4): one invocation sums the strata exactly as the CPU twin
 // radcache_cache::compute_record does (E, rotational and Křivánek's translational gradients,
 // harmonic-mean and elevation-restricted minimum distances; the same per-stratum functions of
 // ircache_math.glsl, in the same order), takes R = max(R_harm, R_min_restricted), then
@@ -27,7 +28,7 @@
 // [R⁻, R⁺] = radius_bounds(footprint, min_px, max_px, v_scale). The translational gradient is
 // stored unattenuated, its attenuation min(1, R_orig/R⁻) in irradiance.w.
 //
-// Guards (§16): irradiance that is not storable (irradiance_is_valid) or a requested pixel without
+// Guards (§2.7): irradiance that is not storable (irradiance_is_valid) or a requested pixel without
 // a surface gives a REJECTED record: E = 0, no gradients, zero normal (every weight's normal test
 // fails), R_orig = IC_FAR (it clamps no neighbour) and R⁻ = R⁺ = R_FLOOR (its splat is empty);
 // it is flagged and counted in rejected_records. No field is ever NaN or Inf.
@@ -287,7 +288,7 @@ void main() {
         return;
     }
 
-    // Radius (§7.7 steps 3, 5-7; step 4, neighbour clamping, is the neighbour pass).
+    // Radius (§4.7 steps 1, 3-5; step 2, neighbour clamping, is the neighbour pass).
     float r_harm = harmonic_mean_distance(sum_inv, float(valid));
     float r_raw = max(r_harm, min(r_min_restricted, IC_FAR));
     float r_lo, r_hi;

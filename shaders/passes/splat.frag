@@ -1,8 +1,9 @@
 // passes/splat.frag — Rust: crates/radcache-render/src/passes/splat.rs
-// Irradiance splatting, per pixel (IC reference §10.3): the record's weight at the pixel's
+// Irradiance splatting, per pixel (docs/cache-frame.md §6.3): the record's weight at the pixel's
 // G-buffer point (normal and in-front tests included), the gradient-extrapolated irradiance
-// clamped to [0, 4·E_i] (§16.2), and (w·Ẽ, w) added into the RGBA32F target by (ONE, ONE)
-// blending (and 1 into the record-count target). Weights are bounded (T&L ≤ 1, Ward ≤ 1/10⁻³), so the float sums cannot overflow.
+// clamped to [0, 4·E_i] (docs/irradiance-cache.md §6.2), and (w·Ẽ, w) added into the RGBA32F target
+// by (ONE, ONE) blending (and 1 into the record-count target). Weights are bounded (T&L ≤ 1,
+// Ward ≤ 1/10⁻³), so the float sums cannot overflow.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 

@@ -1,9 +1,10 @@
 // passes/splat.vert — Rust: crates/radcache-render/src/passes/splat.rs
-// Irradiance splatting (Gautron et al. 2005, IC reference §10.2): one screen-aligned quad per record
-// (instance = record index), covering the projection of its zone of influence, a ball of radius
-// splat_radius(R_i) around p_i. The bound is conservative: the 8 corners of the ball's world-space
-// box are projected and their screen rectangle taken; a box reaching behind the camera (clip
-// w ≤ 0) or a ball too large to project gets the full viewport.
+// Irradiance splatting (Gautron et al. 2005, docs/cache-frame.md §6.2;
+// docs/irradiance-cache.md §5.6): one screen-aligned quad per record (instance = record index),
+// covering the projection of its zone of influence, a ball of radius splat_radius(R_i) around p_i.
+// The bound is conservative: the 8 corners of the ball's world-space box are projected and their
+// screen rectangle taken; a box reaching behind the camera (clip w ≤ 0) or a ball too large to
+// project gets the full viewport.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 

@@ -1,5 +1,5 @@
 // passes/temporal.comp — Rust: crates/radcache-render/src/passes/temporal.rs
-// Temporal radiance caching (IC reference §11.2; crates/radcache-render/src/temporal.rs): records
+// Temporal radiance caching (docs/temporal.md §3; crates/radcache-render/src/temporal.rs): records
 // live on their mesh instance, carry the change of their irradiance to the next frame and a
 // lifespan, and are evaluated again (at their own points, one frame ahead) when they expire.
 //
@@ -43,9 +43,10 @@
 // a change of that fraction of the incident light is what the lifespan allows.
 // Every evaluation is one frame ahead: a record shows values that were exact at most `lifespan`
 // frames ago (one frame more while its next evaluation is made), and costs one evaluation per
-// refresh. Carrying E_k forward more than one frame at the rate (linear extrapolation, §11.2)
-// measured worse: a difference between two evaluations carries the noise of the paths that
-// diverge between the two scenes (relMSE +12 % on the animated scene with one-frame gradients).
+// refresh. Carrying E_k forward more than one frame at the rate (linear extrapolation,
+// docs/temporal.md §3.4) measured worse: a difference between two evaluations carries the noise of
+// the paths that diverge between the two scenes (relMSE +12 % on the animated scene with one-frame
+// gradients).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 

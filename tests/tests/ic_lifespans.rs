@@ -1,4 +1,4 @@
-//! Temporal radiance caching (`TemporalPass`, IC reference §11.2) on lavapipe: in a room where a
+//! Temporal radiance caching (`TemporalPass`, docs/temporal.md §3.3) on lavapipe: in a room where a
 //! box slides along the floor, records follow their instance, only records near the box are
 //! refreshed, lifespans follow the CPU formula (`radcache_cache::temporal`), and a frame
 //! rendered with kept records stays as close to a path-traced reference of that frame as a

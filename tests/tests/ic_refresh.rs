@@ -1,7 +1,7 @@
-//! Refreshing records in place (temporal caching, IC reference §11.2 step 6 and §11.4) on
-//! lavapipe: a record computed again at its own point with its own seeds reproduces its
-//! irradiance and gradients bit for bit under unchanged lighting; with another frame seed it
-//! draws other samples (the comparison can fail) and stays within noise.
+//! Refreshing records in place (temporal caching, docs/temporal.md §3.5 and
+//! docs/irradiance-cache.md §2.3) on lavapipe: a record computed again at its own point with its
+//! own seeds reproduces its irradiance and gradients bit for bit under unchanged lighting; with
+//! another frame seed it draws other samples (the comparison can fail) and stays within noise.
 
 use radcache_cache::IcParams;
 use radcache_render::{GBuffer, GpuScene, IcRenderer, IcSettings, RecordPass};

@@ -1,17 +1,18 @@
 //! `radcache-cache`: the CPU reference ("Rust twin") of every irradiance-cache formula used by the
 //! GPU passes, plus the parameter set of the cache.
 //!
-//! Spec: `shared/docs/irradiance-caching.md` (cited below as §N). Each formula lives in one module:
+//! Algorithm: `docs/irradiance-cache.md` (cited in this crate as a bare §N; other files of `docs/`
+//! by name, e.g. `docs/temporal.md §3.3`). Each formula lives in one module:
 //!
-//! | Module | What | Spec |
+//! | Module | What | Section |
 //! |---|---|---|
-//! | [`sampling`] | orthonormal basis, stratified cosine-weighted directions, per-stratum jitter | §3.1, §3.2, §16.3 |
-//! | [`record`] | irradiance, harmonic-mean / minimum distance, rotational and translational gradients | §3.1, §4, §6.1, §6.2, §7.1 |
-//! | [`radius`] | gradient limit, pixel footprint, screen-space clamp, gradient attenuation, neighbour clamping, `finalize_radius` | §7.2–§7.7 |
-//! | [`weight`] | Ward and Tabellion–Lamorlette weights with in-front and normal tests, weight cap, splat radius | §5.1–§5.5, §10.2, §16.1 |
-//! | [`extrapolate`] | gradient extrapolation with the negative/exploding guards | §5.6, §16.2 |
-//! | [`temporal`] | temporal gradient, lifespan, temporal extrapolation | §11.2 |
-//! | [`params`] | [`IcParams`] and its `draft`/`default`/`high` presets | §3.2, §19 |
+//! | [`sampling`] | orthonormal basis, stratified cosine-weighted directions, per-stratum jitter | §2.1, §2.2, §2.3, §7.3 |
+//! | [`record`] | irradiance, harmonic-mean / minimum distance, rotational and translational gradients | §2.5, §2.6, §3.1, §3.2 |
+//! | [`radius`] | gradient limit, pixel footprint, screen-space clamp, gradient attenuation, neighbour clamping, `finalize_radius` | §4.2–§4.7 |
+//! | [`weight`] | Ward and Tabellion–Lamorlette weights with in-front and normal tests, weight cap, splat radius | §5.1–§5.4, §5.6, §7.2 |
+//! | [`extrapolate`] | gradient extrapolation with the negative/exploding guards | §6.1, §6.2 |
+//! | [`temporal`] | temporal gradient, lifespan, temporal extrapolation | `docs/temporal.md` §3.3 |
+//! | [`params`] | [`IcParams`] and its `draft`/`default`/`high` presets | §2.2, §8.1 |
 //!
 //! **GLSL twin.** `shaders/common/ircache_math.glsl` implements the same functions under the same
 //! (snake_case) names, argument order and guards, in f32. Every public function here takes plain
@@ -24,7 +25,7 @@
 //! names, arities and constants and compiles the GLSL when `glslangValidator` is installed.
 //!
 //! **Conventions.**
-//! * Local frames are right-handed: `t × b = n` (§1); directions in the local frame are
+//! * Local frames are right-handed: `t × b = n` (§1.2); directions in the local frame are
 //!   `(sinθ cosφ, sinθ sinφ, cosθ)`.
 //! * Stratum `(j, k)` of an `M × N` grid is stored at index `j * N + k` ([`sampling::stratum_index`]).
 //! * Hit distances: a miss is any distance `>= IC_FAR` (e.g. `f32::INFINITY`); a distance `<= r_eps`
@@ -64,7 +65,7 @@ pub(crate) fn clamp_lo_hi(x: f32, lo: f32, hi: f32) -> f32 {
     x.max(lo).min(hi)
 }
 
-/// Rec. 709 luminance of an RGB triple (used by the temporal lifespan, §11.2).
+/// Rec. 709 luminance of an RGB triple (used by the temporal lifespan, docs/temporal.md §3.3).
 pub fn luminance_rec709(c: Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }

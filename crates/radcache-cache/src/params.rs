@@ -1,48 +1,48 @@
-//! Irradiance-cache parameters and presets (spec §3.2, §5, §7.3, §9, §11.2, §19).
+//! Irradiance-cache parameters and presets (docs/irradiance-cache.md §2.2, §4.3, §5, §8,
+//! cited below as a bare §N; docs/cache-frame.md §3.2, §3.3; docs/temporal.md §3.3).
 //!
 //! | Field | draft | default | high | Source / reason |
 //! |---|---|---|---|---|
 //! | `weight_kind` | T&L | T&L | T&L | see [`crate::weight`] for why T&L is the default |
-//! | `accuracy` (Ward `a`) | 0.3 | 0.15 | 0.1 | §19 start value 0.15; RADIANCE `rvu` 0.3, `rtrace` 0.1 |
-//! | `kappa` (T&L `κ`) | 0.75 | 0.5 | 1.5 | §19 "T&L κ = 1", Mitsuba's `qualityAdjustment` 0.5 after the overture; default measured (below); larger κ = smaller zones |
-//! | `min_spacing_px` | 3 | 4 | 1.5 | validity radius floor in pixels; §19 starts at "R⁻ = 2 px", Mitsuba 3; 4 measured (below) |
-//! | `max_spacing_px` | 32 | 20 | 15 | validity radius cap in pixels, §19 "R⁺ = 20 px"; pbrt-v2 15 |
-//! | `strata_m × strata_n` | 8×24 | 16×48 | 24×72 | §3.2: interactive 192 rays, offline 768; high ≈ 1.7k (`N = 3M`) |
+//! | `accuracy` (Ward `a`) | 0.3 | 0.15 | 0.1 | §8.1; RADIANCE `rvu` 0.3, `rtrace` 0.1 |
+//! | `kappa` (T&L `κ`) | 0.75 | 0.5 | 1.5 | Mitsuba's κ = 1 with `qualityAdjustment` 0.5 after the overture; default measured (below, §8.2); larger κ = smaller zones |
+//! | `min_spacing_px` | 3 | 4 | 1.5 | validity radius floor in pixels; Mitsuba 3; 4 measured (below, §8.2) |
+//! | `max_spacing_px` | 32 | 20 | 15 | validity radius cap in pixels (§8.1); pbrt-v2 15 |
+//! | `strata_m × strata_n` | 8×24 | 16×48 | 24×72 | §2.2: interactive 192 rays, offline 768; high ≈ 1.7k (`N = 3M`) |
 //! | `hole_threshold` | 0.25 | 0.5 | 0.75 | Σw, in units of [`weight_unit`], below which a pixel is a hole (pbrt-v2 minWeight 0.5) |
-//! | `levels` | 5 | 6 | 6 | coarse-to-fine spacings `2^(levels−1) … 1` px (§9: 32, 16, 8, 4, 2, 1) |
-//! | `creation_strictness` | 0.7 | 0.7 | 0.7 | §9: create at `a·0.7` (Ward) or `κ/0.7` (T&L) |
-//! | `front_tolerance_px` | 0.5 | 0.5 | 0.5 | §5.4 design: in-front tolerance `0.5·s(p)` |
-//! | `temporal_accuracy` (`a_t`) | 0.1 | 0.05 | 0.02 | §19 `a_t = 0.05` |
-//! | `max_age_frames` (`Δt_max`) | 20 | 30 | 15 | §19 `Δt_max = 30`; draft measured (below) |
+//! | `levels` | 5 | 6 | 6 | coarse-to-fine spacings `2^(levels−1) … 1` px (docs/cache-frame.md §3.3: 32, 16, 8, 4, 2, 1) |
+//! | `creation_strictness` | 0.7 | 0.7 | 0.7 | docs/cache-frame.md §3.2: create at `a·0.7` (Ward) or `κ/0.7` (T&L) |
+//! | `front_tolerance_px` | 0.5 | 0.5 | 0.5 | §5.4: in-front tolerance `0.5·s(p)` |
+//! | `temporal_accuracy` (`a_t`) | 0.1 | 0.05 | 0.02 | docs/temporal.md §3.3 |
+//! | `max_age_frames` (`Δt_max`) | 20 | 30 | 15 | docs/temporal.md §3.3; draft measured (below) |
 //!
 //! Draft's `Δt_max` of 20 frames was measured with `cargo xtask bench temporal` (animated scene,
 //! 60 frames at 256²): 60 frames gave 9.3 % of a per-frame rebuild's record rays but 3.9× its
 //! image error (own relMSE 5.8e-3 against 1.5e-3: records whose first one-frame change was small
 //! lived 60 frames while the objects moved nearer); 20 gives 13.3 % and 2.9e-3. With the
 //! motion-aware expiry (a record also expires when moving objects' cover of its hemisphere changed
-//! by more than `a_t`; `temporal.comp`) 20 gives 14.4 % and 2.6e-3; draft with the spec's
+//! by more than `a_t`; `temporal.comp`) 20 gives 14.4 % and 2.6e-3; draft with the default's
 //! `a_t = 0.05` and `Δt_max = 60` gave 16.3 % and 4.5e-3 (records living 60 frames go stale in
 //! ways neither their one-frame rate nor the moving cover sees).
 //!
-//! Draft trades accuracy for speed (4× fewer rays, bigger zones, fewer refreshes); high halves
-//! the ray noise (2.25× rays), shrinks zones and refreshes more often. On lavapipe (≈0.3 Mrays/s
-//! for incoherent gather rays, shared/docs/toolchain.md) the default's 768 rays per record is the
-//! dominant cost, so `draft` is the preset for tests and previews.
+//! Draft trades accuracy for speed (4× fewer rays, bigger zones, fewer refreshes); high halves the
+//! ray noise (2.25× rays), shrinks zones and refreshes more often. On lavapipe (≈0.3 Mrays/s for
+//! incoherent gather rays, measured) the default's 768 rays per record is the dominant cost, so
+//! `draft` is the preset for tests and previews.
 //!
-//! The default R⁻ of 4 px (the spec's starting value is 2 px) was measured on the Cornell box at
-//! 256² against its 2048-spp reference (`tests/refs/`): 2, 3 and 4 px gave the same relMSE
-//! (2.49e-4, 2.51e-4, 2.54e-4) with 8,720, 6,544 and 5,209 records; the records clamped to R⁻ sit
-//! along edges and in corners, where the finest creation levels otherwise put one per pixel or
-//! two. `high` keeps 1.5 px for scenes with fine geometric detail.
+//! The default R⁻ of 4 px (§8.2) was measured on the Cornell box at 256² against its 2048-spp
+//! reference (`tests/refs/`): 2, 3 and 4 px gave the same relMSE (2.49e-4, 2.51e-4, 2.54e-4) with
+//! 8,720, 6,544 and 5,209 records; the records clamped to R⁻ sit along edges and in corners, where
+//! the finest creation levels otherwise put one per pixel or two. `high` keeps 1.5 px for scenes
+//! with fine geometric detail.
 //!
-//! The default κ of 0.5 (§19's starting value is 1; Mitsuba renders with κ = 1 × its
-//! `qualityAdjustment` 0.5 after the overture, which our coarse-to-fine creation at κ/0.7 plays
-//! the part of) was measured on the same frame: κ = 1 gave relMSE 2.14e-4 (own 1.07e-4, net of
-//! the reference's noise) in 7.3 s with 4,390 records, κ = 0.75 2.16e-4 in 6.4 s, κ = 0.5 2.31e-4
-//! in 4.8–4.9 s with 2,243 records: error × time 7.8e-4, 6.9e-4 and 6.0e-4. Zones stay capped at
-//! R⁺ = 20 px, so the larger κ only widens zones where the irradiance is smooth. `draft` keeps
-//! 0.75: at 0.5 its frame is 15 % faster and 13 % worse (the same error × time), and its R⁺ of
-//! 32 px already makes its zones the widest.
+//! The default κ of 0.5 (§8.2; Mitsuba renders with κ = 1 × its `qualityAdjustment` 0.5 after the
+//! overture, which our coarse-to-fine creation at κ/0.7 plays the part of) was measured on the same
+//! frame: κ = 1 gave relMSE 2.14e-4 (own 1.07e-4, net of the reference's noise) in 7.3 s with 4,390
+//! records, κ = 0.75 2.16e-4 in 6.4 s, κ = 0.5 2.31e-4 in 4.8–4.9 s with 2,243 records: error ×
+//! time 7.8e-4, 6.9e-4 and 6.0e-4. Zones stay capped at R⁺ = 20 px, so the larger κ only widens
+//! zones where the irradiance is smooth. `draft` keeps 0.75: at 0.5 its frame is 15 % faster and
+//! 13 % worse (the same error × time), and its R⁺ of 32 px already makes its zones the widest.
 
 use crate::radius::radius_bounds;
 use crate::weight::{coverage_threshold, validity_scale, weight_unit, WeightKind};
@@ -52,7 +52,7 @@ use crate::weight::{coverage_threshold, validity_scale, weight_unit, WeightKind}
 pub enum Preset {
     /// Fast previews and tests.
     Draft,
-    /// The §19 starting values.
+    /// The default preset (§8.1).
     #[default]
     Default,
     /// Offline quality.
@@ -64,29 +64,32 @@ pub enum Preset {
 pub struct IcParams {
     /// Interpolation weight (§5).
     pub weight_kind: WeightKind,
-    /// Ward accuracy `a` (§5.1); used when `weight_kind` is Ward.
+    /// Ward accuracy `a` (§5.2); used when `weight_kind` is Ward.
     pub accuracy: f32,
     /// Tabellion–Lamorlette `κ` (§5.3); used when `weight_kind` is T&L.
     pub kappa: f32,
-    /// Smallest validity radius, in pixel footprints (§7.3, `R⁻`).
+    /// Smallest validity radius, in pixel footprints (§4.3, `R⁻`).
     pub min_spacing_px: f32,
-    /// Largest validity radius, in pixel footprints (§7.3, `R⁺`).
+    /// Largest validity radius, in pixel footprints (§4.3, `R⁺`).
     pub max_spacing_px: f32,
-    /// Polar strata `M` (§3.2).
+    /// Polar strata `M` (§2.2).
     pub strata_m: u32,
-    /// Azimuthal strata `N` (§3.2).
+    /// Azimuthal strata `N` (§2.2).
     pub strata_n: u32,
-    /// Σw, in units of [`weight_unit`], below which a pixel counts as a hole (§9, §10.4).
+    /// Σw, in units of [`weight_unit`], below which a pixel counts as a hole (§5.6;
+    /// docs/cache-frame.md §3.3).
     pub hole_threshold: f32,
-    /// Number of coarse-to-fine creation levels; the coarsest spacing is `2^(levels−1)` px (§9).
+    /// Number of coarse-to-fine creation levels; the coarsest spacing is `2^(levels−1)` px
+    /// (docs/cache-frame.md §3.3).
     pub levels: u32,
-    /// Creation-pass strictness `s` (§9): records are created with `a·s` (Ward) or `κ/s` (T&L).
+    /// Creation-pass strictness `s` (docs/cache-frame.md §3.2): records are created with `a·s`
+    /// (Ward) or `κ/s` (T&L).
     pub creation_strictness: f32,
     /// In-front test tolerance in pixel footprints (§5.4).
     pub front_tolerance_px: f32,
-    /// Temporal accuracy `a_t` (§11.2).
+    /// Temporal accuracy `a_t` (docs/temporal.md §3.3).
     pub temporal_accuracy: f32,
-    /// Largest record lifespan `Δt_max`, in frames (§11.2).
+    /// Largest record lifespan `Δt_max`, in frames (docs/temporal.md §3.3).
     pub max_age_frames: f32,
 }
 
@@ -162,12 +165,12 @@ impl IcParams {
         }
     }
 
-    /// Validity radius / `R` for the selected kind (§10.2).
+    /// Validity radius / `R` for the selected kind (§5.6).
     pub fn validity_scale(&self) -> f32 {
         validity_scale(self.weight_kind, self.weight_param())
     }
 
-    /// `(R⁻, R⁺)` for a record whose pixel footprint is `footprint` (§7.3).
+    /// `(R⁻, R⁺)` for a record whose pixel footprint is `footprint` (§4.3).
     pub fn radius_bounds(&self, footprint: f32) -> (f32, f32) {
         radius_bounds(
             footprint,
@@ -177,7 +180,7 @@ impl IcParams {
         )
     }
 
-    /// Σw below which a pixel is a hole (§10.4).
+    /// Σw below which a pixel is a hole (§5.6).
     pub fn coverage_threshold(&self) -> f32 {
         coverage_threshold(self.weight_kind, self.weight_param(), self.hole_threshold)
     }
@@ -192,7 +195,8 @@ impl IcParams {
         self.front_tolerance_px * footprint.max(0.0)
     }
 
-    /// The stricter parameters used while creating records (§9): `a·s` and `κ/s`.
+    /// The stricter parameters used while creating records (docs/cache-frame.md §3.2): `a·s` and
+    /// `κ/s`.
     pub fn for_creation(&self) -> Self {
         let s = self.creation_strictness.clamp(0.05, 1.0);
         Self {

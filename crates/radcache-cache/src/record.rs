@@ -1,5 +1,6 @@
 //! Record computation from one stratified sample set: irradiance, characteristic distances and the
-//! rotational and translational gradients (spec §3.1, §4, §6.1, §6.2, §7.1, §7.6, §16.1).
+//! rotational and translational gradients (docs/irradiance-cache.md §2.5, §2.6, §3.1, §3.2, §4.6,
+//! §7.1).
 //!
 //! Inputs per stratum `(j, k)` (index `j * N + k`): RGB radiance `L_jk` and hit distance `r_jk`
 //! (a miss is `r >= IC_FAR`, e.g. `+inf`; `r <= r_eps` or NaN is an invalid sample). The strata must
@@ -7,24 +8,24 @@
 //!
 //! Formulas (all sums over strata, per colour channel):
 //!
-//! * Irradiance (§3.1): `E = π/(MN) · Σ_jk L_jk`. Every sample's `L` counts, valid or not.
-//! * Harmonic-mean distance (§7.1): `R_harm = n_valid / Σ_valid 1/r_jk`, misses contributing
+//! * Irradiance (§2.5): `E = π/(MN) · Σ_jk L_jk`. Every sample's `L` counts, valid or not.
+//! * Harmonic-mean distance (§2.5): `R_harm = n_valid / Σ_valid 1/r_jk`, misses contributing
 //!   `1/r = 0`; no finite hit gives `IC_FAR`. Minimum distance `R_min = min_valid r_jk`, and the
 //!   elevation-restricted minimum over the rows lying entirely above 10° elevation
 //!   (`cos²θ_j⁺ >= sin²10°`; Mitsuba tests each sample's own elevation, which this reduction does
 //!   not see; the horizon row is always excluded). [`RecordEstimate::radius`] is
-//!   `max(R_harm, R_min_restricted)` (§19: harmonic mean with the restricted minimum as a lower
-//!   bound, which keeps a few short grazing hits from collapsing `R`, §7.6).
-//! * Rotational gradient (§6.1): `∇_r E = Σ_k Σ_j (π/(MN)) · T_j · v(φ_k) · L_jk`, `φ_k` the column
+//!   `max(R_harm, R_min_restricted)` (§2.5: harmonic mean with the restricted minimum as a lower
+//!   bound, which keeps a few short grazing hits from collapsing `R`, §4.6).
+//! * Rotational gradient (§3.1): `∇_r E = Σ_k Σ_j (π/(MN)) · T_j · v(φ_k) · L_jk`, `φ_k` the column
 //!   centre and `T_j` the **mean of `tan θ` over row `j`** under the cosine-weighted pdf,
-//!   `T_j = M·[θ − sinθ cosθ]_{θ_j⁻}^{θ_j⁺}` ([`crate::sampling::stratum_tan_mean`]). §6.1 (and
+//!   `T_j = M·[θ − sinθ cosθ]_{θ_j⁻}^{θ_j⁺}` ([`crate::sampling::stratum_tan_mean`]). §3.1 (and
 //!   RADIANCE/Mitsuba) use `tan` at the row centre; both avoid the infinite `tan` of a jittered
 //!   horizon sample, but the centre value underestimates the horizon row by `≈ 1/√2`, a bias that
 //!   decays only like `1/√M`. The row mean is the exact expectation of the per-sample derivative
 //!   `L tanθ cos(φ − ψ)` for radiance constant over the row. Measured against finite differences
 //!   (the room scenes of tests/gradients.rs, 16×48, mean of 8 seeds): 2.5–12 % error with the
 //!   centre value, 1.5–5 % with the row mean.
-//! * Translational gradient (§6.2), **Křivánek et al. 2005 "improved" form as written in §6.2**:
+//! * Translational gradient (§3.2), **Křivánek et al. 2005 "improved" form [KGBP05]**:
 //!   ```text
 //!   ∇_t E = Σ_k [ u(φ_k)  Σ_{j=1}^{M−1} (2π/N) sinθ_j⁻ cos²θ_j⁻ (L_jk − L_{j−1,k}) / min(r_jk, r_{j−1,k})
 //!               + v(φ_k⁻) Σ_{j=0}^{M−1} cosθ_j (cosθ_j⁻ − cosθ_j⁺)/sinθ_j (L_jk − L_{j,k−1}) / min(r_jk, r_{j,k−1}) ]
@@ -32,7 +33,7 @@
 //!   with `sin²θ_j⁻ = j/M`, `sin²θ_j⁺ = (j+1)/M`, `sin²θ_j = (j+½)/M` (centre), `φ_k` the centre and
 //!   `φ_k⁻ = 2πk/N` the start azimuth, `k − 1` wrapping to `N − 1`, the polar sum starting at `j = 1`
 //!   (not Mitsuba's `j > 1`), and the `2π/N` approximation of `∫u dφ` over a column.
-//!   A wall with an invalid side, or whose nearer side is a miss, contributes 0 (§6.2 notes); the
+//!   A wall with an invalid side, or whose nearer side is a miss, contributes 0 (§3.2); the
 //!   wall distance is floored at `R_FLOOR`.
 //!   Accuracy: first order in the stratum size (an edge is moved to the nearest stratum wall and
 //!   its distance read from the adjacent sample; grazing surfaces make that distance too short).
@@ -58,7 +59,7 @@ pub fn is_valid_sample(r: f32, r_eps: f32) -> bool {
     r > r_eps.max(0.0)
 }
 
-/// `1/r` for a valid hit, 0 for a miss (`r >= IC_FAR`) or an invalid sample (§7.1).
+/// `1/r` for a valid hit, 0 for a miss (`r >= IC_FAR`) or an invalid sample (§2.5).
 pub fn inverse_distance(r: f32, r_eps: f32) -> f32 {
     if is_valid_sample(r, r_eps) && r < IC_FAR {
         1.0 / r
@@ -67,8 +68,8 @@ pub fn inverse_distance(r: f32, r_eps: f32) -> f32 {
     }
 }
 
-/// Harmonic mean `count / Σ(1/r)` from its two sums (§7.1). `IC_FAR` when nothing was hit; 0 when
-/// the sum overflowed (hits at distance ≈ 0, handled later by the clamps of §7.3/§7.6).
+/// Harmonic mean `count / Σ(1/r)` from its two sums (§2.5). `IC_FAR` when nothing was hit; 0 when
+/// the sum overflowed (hits at distance ≈ 0, handled later by the clamps of §4.3/§4.6).
 pub fn harmonic_mean_distance(sum_inv_r: f32, valid_count: f32) -> f32 {
     if sum_inv_r > 0.0 && valid_count > 0.0 {
         if sum_inv_r < IC_FAR {
@@ -81,21 +82,21 @@ pub fn harmonic_mean_distance(sum_inv_r: f32, valid_count: f32) -> f32 {
     }
 }
 
-/// True when all of row `j` lies above 10° elevation (`cos²θ_j⁺ = 1 − (j+1)/M >= sin²10°`, §7.1).
+/// True when all of row `j` lies above 10° elevation (`cos²θ_j⁺ = 1 − (j+1)/M >= sin²10°`, §2.5).
 /// The horizon row never qualifies; with a centre-based test no row would be excluded at `M <= 16`.
 pub fn stratum_elevation_ok(j: u32, m: u32) -> bool {
     1.0 - (j as f32 + 1.0) / m.max(1) as f32 >= ELEVATION_MIN_SIN2
 }
 
 /// Local-frame coefficient of `L_jk` in the rotational gradient: `π/(MN) · mean_j(tanθ) · v(φ_k)`
-/// (§6.1 with the row mean of `tan θ`, see the module docs).
+/// (§3.1 with the row mean of `tan θ`, see the module docs).
 pub fn rotational_gradient_coeff(j: u32, k: u32, m: u32, n: u32) -> Vec3 {
     horizontal_v(stratum_phi_centre(k, n))
         * (stratum_projected_solid_angle(m, n) * stratum_tan_mean(j, m))
 }
 
 /// Local-frame coefficient of the polar wall between rows `j − 1` and `j` in column `k`:
-/// `(2π/N) · sinθ_j⁻ · cos²θ_j⁻ · u(φ_k)`; zero for `j = 0` or `j >= M` (§6.2).
+/// `(2π/N) · sinθ_j⁻ · cos²θ_j⁻ · u(φ_k)`; zero for `j = 0` or `j >= M` (§3.2).
 pub fn polar_wall_coeff(j: u32, k: u32, m: u32, n: u32) -> Vec3 {
     let m = m.max(1);
     if j == 0 || j >= m {
@@ -107,7 +108,7 @@ pub fn polar_wall_coeff(j: u32, k: u32, m: u32, n: u32) -> Vec3 {
 }
 
 /// Local-frame coefficient of the azimuthal wall between columns `k − 1` and `k` in row `j`
-/// (Křivánek's improved form): `cosθ_j (cosθ_j⁻ − cosθ_j⁺) / sinθ_j · v(φ_k⁻)` (§6.2).
+/// (Křivánek's improved form): `cosθ_j (cosθ_j⁻ − cosθ_j⁺) / sinθ_j · v(φ_k⁻)` (§3.2).
 /// `j` is clamped to `M − 1`; `sinθ_j >= sqrt(1/(2M)) > 0`.
 pub fn azimuthal_wall_coeff(j: u32, k: u32, m: u32, n: u32) -> Vec3 {
     let m = m.max(1);
@@ -122,7 +123,7 @@ pub fn azimuthal_wall_coeff(j: u32, k: u32, m: u32, n: u32) -> Vec3 {
 
 /// Radiance difference across one wall divided by the wall's distance:
 /// `(L_cur − L_prev) / max(min(r_cur, r_prev), R_FLOOR)` per channel; 0 when either side is
-/// invalid or the nearer side is a miss (two misses: an infinitely distant wall moves by 0) (§6.2).
+/// invalid or the nearer side is a miss (two misses: an infinitely distant wall moves by 0) (§3.2).
 pub fn wall_term(l_cur: Vec3, l_prev: Vec3, r_cur: f32, r_prev: f32, r_eps: f32) -> Vec3 {
     if !is_valid_sample(r_cur, r_eps) || !is_valid_sample(r_prev, r_eps) {
         return Vec3::ZERO;
@@ -135,27 +136,27 @@ pub fn wall_term(l_cur: Vec3, l_prev: Vec3, r_cur: f32, r_prev: f32, r_eps: f32)
     }
 }
 
-/// Everything a record needs from its sample set (§4.1), before the radius post-processing of §7.
+/// Everything a record needs from its sample set (§2.6), before the radius post-processing of §4.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RecordEstimate {
-    /// Irradiance `E` (RGB), §3.1.
+    /// Irradiance `E` (RGB), §2.5.
     pub e: Vec3,
-    /// Rotational gradient, one world-space tangent vector per channel (R, G, B), §6.1.
+    /// Rotational gradient, one world-space tangent vector per channel (R, G, B), §3.1.
     pub grad_r: [Vec3; 3],
-    /// Translational gradient (Křivánek improved form), per channel, world space, §6.2.
+    /// Translational gradient (Křivánek improved form), per channel, world space, §3.2.
     pub grad_t: [Vec3; 3],
-    /// Harmonic-mean hit distance over valid samples (`IC_FAR` if nothing was hit), §7.1.
+    /// Harmonic-mean hit distance over valid samples (`IC_FAR` if nothing was hit), §2.5.
     pub r_harmonic: f32,
-    /// Minimum valid hit distance (`IC_FAR` if none), §7.1.
+    /// Minimum valid hit distance (`IC_FAR` if none), §2.5.
     pub r_min: f32,
-    /// Minimum valid hit distance over rows entirely above 10° elevation (`IC_FAR` if none), §7.1.
+    /// Minimum valid hit distance over rows entirely above 10° elevation (`IC_FAR` if none), §2.5.
     pub r_min_restricted: f32,
     /// Number of valid samples (`r > r_eps`).
     pub valid_samples: u32,
 }
 
 impl RecordEstimate {
-    /// Characteristic distance before §7 post-processing: `max(R_harm, R_min_restricted)` (§19).
+    /// Characteristic distance before §4 post-processing: `max(R_harm, R_min_restricted)` (§2.5).
     pub fn radius(&self) -> f32 {
         self.r_harmonic.max(self.r_min_restricted)
     }
@@ -231,7 +232,7 @@ pub fn compute_record(
 }
 
 /// True when a computed irradiance is storable: every channel in `[0, 3·10³⁸)` (finite, not NaN,
-/// not negative) (§16.3: validate before insertion and count rejections).
+/// not negative) (§2.7: validate before insertion and count rejections).
 pub fn irradiance_is_valid(e: Vec3) -> bool {
     e.cmpge(Vec3::ZERO).all() && e.cmplt(Vec3::splat(3.0e38)).all()
 }

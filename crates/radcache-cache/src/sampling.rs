@@ -1,9 +1,9 @@
 //! Hemisphere sampling for one record: orthonormal basis, stratified cosine-weighted directions and a
-//! deterministic per-stratum jitter (spec §3.1, §3.2, §11.4, §16.3).
+//! deterministic per-stratum jitter (docs/irradiance-cache.md §2.1, §2.2, §2.3, §7.3).
 //!
 //! Stratum `(j, k)` of an `M × N` grid covers `sin²θ ∈ [j/M, (j+1)/M)` and `φ ∈ [2πk/N, 2π(k+1)/N)`;
 //! every stratum has projected solid angle `π/(MN)`, so one jittered direction per stratum is a
-//! stratified sample of the pdf `cos θ / π` (§3.1):
+//! stratified sample of the pdf `cos θ / π` (§2.1):
 //!
 //! ```text
 //! sin θ_j = sqrt((j + ξ)/M),  cos θ_j = sqrt(1 − (j + ξ)/M),  φ_k = 2π(k + ψ)/N
@@ -16,9 +16,9 @@
 use core::f32::consts::{PI, TAU};
 use glam::Vec3;
 
-/// Default strata for interactive quality, `M × N = 8 × 24` (§3.2 design values).
+/// Default strata for interactive quality, `M × N = 8 × 24` (§2.2).
 pub const STRATA_INTERACTIVE: (u32, u32) = (8, 24);
-/// Default strata for offline quality, `M × N = 16 × 48` (§3.2, §19).
+/// Default strata for offline quality, `M × N = 16 × 48` (§2.2, §8.1).
 pub const STRATA_DEFAULT: (u32, u32) = (16, 48);
 
 /// Index of stratum `(j, k)` in the `M × N` sample arrays: `j * N + k` (wrapping, like GLSL `uint`).
@@ -26,7 +26,7 @@ pub fn stratum_index(j: u32, k: u32, n: u32) -> u32 {
     j.wrapping_mul(n).wrapping_add(k)
 }
 
-/// Unit normal, or `+Z` when `n` is zero, tiny, huge or not finite (§16.3 degenerate-frame guard).
+/// Unit normal, or `+Z` when `n` is zero, tiny, huge or not finite (§2.1 degenerate-frame guard).
 pub fn normalize_or_z(n: Vec3) -> Vec3 {
     let len2 = n.dot(n);
     if len2 > 1.0e-30 && len2 < 1.0e30 {
@@ -72,29 +72,29 @@ pub fn azimuth_from_unit(u: f32) -> f32 {
     }
 }
 
-/// Centre azimuth of stratum column `k`: `φ_k = 2π(k + ½)/N`, wrapped to `[−π, π]` (§1).
+/// Centre azimuth of stratum column `k`: `φ_k = 2π(k + ½)/N`, wrapped to `[−π, π]` (§1.2).
 pub fn stratum_phi_centre(k: u32, n: u32) -> f32 {
     azimuth_from_unit((k as f32 + 0.5) / n.max(1) as f32)
 }
 
-/// Start azimuth of stratum column `k`: `φ_k⁻ = 2πk/N`, wrapped to `[−π, π]` (§1).
+/// Start azimuth of stratum column `k`: `φ_k⁻ = 2πk/N`, wrapped to `[−π, π]` (§1.2).
 pub fn stratum_phi_start(k: u32, n: u32) -> f32 {
     azimuth_from_unit(k as f32 / n.max(1) as f32)
 }
 
-/// Horizontal unit vector `u(φ) = (cos φ, sin φ, 0)` in the local frame (§1).
+/// Horizontal unit vector `u(φ) = (cos φ, sin φ, 0)` in the local frame (§1.2).
 pub fn horizontal_u(phi: f32) -> Vec3 {
     Vec3::new(phi.cos(), phi.sin(), 0.0)
 }
 
-/// Horizontal unit vector `v(φ) = u(φ + π/2) = (−sin φ, cos φ, 0)` in the local frame (§1).
+/// Horizontal unit vector `v(φ) = u(φ + π/2) = (−sin φ, cos φ, 0)` in the local frame (§1.2).
 pub fn horizontal_v(phi: f32) -> Vec3 {
     Vec3::new(-phi.sin(), phi.cos(), 0.0)
 }
 
 /// `tan θ_j` at the polar centre of row `j` (`sin²θ_j = (j + ½)/M`), i.e. `1/sqrt(M/(j+½) − 1)`:
-/// §6.1's (RADIANCE's, Mitsuba's) rotational-gradient weight, kept for comparison; the crate uses
-/// [`stratum_tan_mean`]. `j` is clamped to `M − 1`, so the result is always finite (§16.3).
+/// §3.1's (RADIANCE's, Mitsuba's) rotational-gradient weight, kept for comparison; the crate uses
+/// [`stratum_tan_mean`]. `j` is clamped to `M − 1`, so the result is always finite (§3.1).
 pub fn stratum_tan_centre(j: u32, m: u32) -> f32 {
     let m = m.max(1);
     let s2 = (j.min(m - 1) as f32 + 0.5) / m as f32;
@@ -122,7 +122,7 @@ pub fn stratum_tan_mean(j: u32, m: u32) -> f32 {
     (mf * (dtheta - (sb * cb - sa * ca))).max(0.0)
 }
 
-/// Local direction of stratum `(j, k)` with jitter `(ξ, ψ) ∈ [0, 1]²` (§3.1):
+/// Local direction of stratum `(j, k)` with jitter `(ξ, ψ) ∈ [0, 1]²` (§2.1):
 /// `(sinθ cosφ, sinθ sinφ, cosθ)`, `sin²θ = (j+ξ)/M`, `φ = 2π(k+ψ)/N`.
 /// Jitters are clamped to `[0, 1]`, `M, N` to `>= 1`, and `sin²θ` to `[0, 1]`.
 pub fn stratum_direction_local(j: u32, k: u32, m: u32, n: u32, xi: f32, psi: f32) -> Vec3 {
@@ -156,7 +156,7 @@ pub fn stratum_contains(w: Vec3, j: u32, k: u32, m: u32, n: u32, tol: f32) -> bo
     w.z >= -tol && in_theta && in_phi
 }
 
-/// Integer hash for the deterministic per-record jitter (§11.4). PCG-style output permutation of
+/// Integer hash for the deterministic per-record jitter (§2.3). PCG-style output permutation of
 /// one LCG step (Jarzynski & Olano, *Hash Functions for GPU Rendering*, JCGT 9(3), 2020); identical
 /// bit-for-bit in GLSL (`uint` arithmetic wraps).
 pub fn ircache_hash(v: u32) -> u32 {
@@ -172,14 +172,15 @@ pub fn unit_float_from_bits(h: u32) -> f32 {
 
 /// Jitter `(ξ, ψ)` of stratum `index` of the record with seed `seed` (e.g. the record id): the same
 /// record always reproduces the same directions, so a refreshed record with unchanged lighting gives
-/// the same value (§11.4 flicker control).
+/// the same value (§2.3; flicker control, docs/temporal.md §3.7).
 pub fn stratum_jitter(seed: u32, index: u32) -> (f32, f32) {
     let h1 = ircache_hash(index.wrapping_add(ircache_hash(seed)));
     let h2 = ircache_hash(h1);
     (unit_float_from_bits(h1), unit_float_from_bits(h2))
 }
 
-/// Solid-angle helper for tests and docs: the projected solid angle of one stratum, `π/(MN)` (§3.1).
+/// Solid-angle helper for tests and docs: the projected solid angle of one stratum, `π/(MN)`
+/// (§2.1).
 pub fn stratum_projected_solid_angle(m: u32, n: u32) -> f32 {
     PI / (m.max(1) as f32 * n.max(1) as f32)
 }

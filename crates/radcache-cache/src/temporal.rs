@@ -1,6 +1,6 @@
-//! Temporal radiance caching formulas (spec §11.2; the spec marks them as a reconstruction of
-//! Gautron et al. 2007, tagged "recall"). Pure formulas; record ageing and refresh scheduling live
-//! in the renderer.
+//! Temporal radiance caching formulas (docs/temporal.md §3.3; docs/references.md §2 marks them as a
+//! reconstruction of Gautron et al. 2007 [GBP07]). Pure formulas; record ageing and refresh
+//! scheduling live in the renderer.
 //!
 //! For a record evaluated at frame `t_i` and again (same sample directions) at `t_i + 1`:
 //! * temporal gradient (per channel, per frame): `∂E/∂t ≈ E(t_i+1) − E(t_i)`;
@@ -9,23 +9,24 @@
 //!   `Δt = a_t / |τ − 1|` frames, capped at `Δt_max`. Computed as `a_t·Y₀ / |Y₁ − Y₀|` so that no
 //!   ratio is formed: `Y₀ = Y₁` (including both 0) gives `Δt_max`, `Y₀ = 0 < Y₁` gives 0;
 //! * value within the lifespan: `E(t) = max(0, E(t_i) + (t − t_i)·∂E/∂t)`, then the spatial
-//!   extrapolation of §5.6 ([`crate::extrapolate_irradiance`] with this value as `E_i`).
+//!   extrapolation of docs/irradiance-cache.md §6.1 ([`crate::extrapolate_irradiance`] with this
+//!   value as `E_i`).
 //!
-//! [`moving_cover`] is this project's addition (not in the spec): the lifespan comes from one
-//! frame's change and misses what comes later (an object that approaches a record slowly at
-//! first), so a record also expires when the part of its hemisphere that moving objects' bounding
-//! spheres cover has changed by more than `a_t` since its last evaluation.
+//! [`moving_cover`] is this project's addition (docs/temporal.md §3.6; not from [GBP07]): the
+//! lifespan comes from one frame's change and misses what comes later (an object that approaches a
+//! record slowly at first), so a record also expires when the part of its hemisphere that moving
+//! objects' bounding spheres cover has changed by more than `a_t` since its last evaluation.
 
 use crate::luminance_rec709;
 use glam::{Vec3, Vec4};
 
-/// Temporal gradient per frame (§11.2 step 3): `E(t_i+1) − E(t_i)`.
+/// Temporal gradient per frame (docs/temporal.md §3.3): `E(t_i+1) − E(t_i)`.
 pub fn temporal_gradient(e_t0: Vec3, e_t1: Vec3) -> Vec3 {
     e_t1 - e_t0
 }
 
-/// Lifespan in frames (§11.2 step 4): `min(a_t / |τ − 1|, Δt_max)` with `τ = Y(E₁)/Y(E₀)`, in
-/// `[0, max(Δt_max, 0)]`. Negative luminances are treated as 0.
+/// Lifespan in frames (docs/temporal.md §3.3): `min(a_t / |τ − 1|, Δt_max)` with `τ = Y(E₁)/Y(E₀)`,
+/// in `[0, max(Δt_max, 0)]`. Negative luminances are treated as 0.
 pub fn temporal_lifespan(e_t0: Vec3, e_t1: Vec3, a_t: f32, max_age: f32) -> f32 {
     let max_age = max_age.max(0.0);
     let y0 = luminance_rec709(e_t0).max(0.0);
@@ -40,13 +41,14 @@ pub fn temporal_lifespan(e_t0: Vec3, e_t1: Vec3, a_t: f32, max_age: f32) -> f32 
     }
 }
 
-/// True while a record of age `age = t − t_i` frames is valid: `age <= lifespan` (§11.2 step 6).
+/// True while a record of age `age = t − t_i` frames is valid: `age <= lifespan`
+/// (docs/temporal.md §3.5).
 pub fn temporal_is_valid(age: f32, lifespan: f32) -> bool {
     age <= lifespan
 }
 
-/// Record value at age `age` frames (§11.2 step 5): `max(0, E(t_i) + age·∂E/∂t)` per channel,
-/// `age` clamped to `>= 0`.
+/// Record value at age `age` frames (docs/temporal.md §3.4): `max(0, E(t_i) + age·∂E/∂t)` per
+/// channel, `age` clamped to `>= 0`.
 pub fn temporal_extrapolate(e_t0: Vec3, de_dt: Vec3, age: f32) -> Vec3 {
     (e_t0 + de_dt * age.max(0.0)).max(Vec3::ZERO)
 }

@@ -1,28 +1,30 @@
-//! Record weights, validity tests and splat radius (spec §5.1, §5.3, §5.4, §5.5, §10.2, §16.1).
+//! Record weights, validity tests and splat radius (docs/irradiance-cache.md §5.1–§5.4,
+//! §5.6, §7.2).
 //!
 //! Common tests (a weight is 0 when any fails):
-//! * normal test (§5.5): `n·n_i > 0`; the normal error `sqrt(1 − n·n_i)` is evaluated as
-//!   `‖n − n_i‖/√2` (equal for unit normals, no cancellation, never NaN — §16.3's concern);
+//! * normal test (§5.4): `n·n_i > 0`; the normal error `sqrt(1 − n·n_i)` is evaluated as
+//!   `‖n − n_i‖/√2` (equal for unit normals, no cancellation, never NaN — §5.1);
 //! * in-front test (§5.4, RADIANCE ≥ 4.2 form): reject when `(p − p_i)·n_i < −tol`, with `tol` in
-//!   world units (the spec's design value is `0.5 · s(p)`, half a pixel footprint);
-//! * out-of-plane error (§5.4 design): `|(p − p_i)·n_i| / R_i` is added to the positional error, so
+//!   world units (by default `0.5 · s(p)`, half a pixel footprint);
+//! * out-of-plane error (§5.1): `|(p − p_i)·n_i| / R_i` is added to the positional error, so
 //!   points far above/below the record's tangent plane (thin walls, table over floor) lose weight.
 //!
 //! Weights (`Δ = p − p_i`, `e_pos = (‖Δ‖ + |Δ·n_i|) / R_i`, `e_nrm = sqrt(1 − n·n_i)`):
-//! * **Ward** (§5.1): `ε = e_pos + e_nrm`, valid iff `ε < a`, `w = 1 / max(ε, 10⁻³)` (cap 1000,
-//!   §16.1: RADIANCE's cap; with at most a few tens of records per pixel `Σ w·E` stays far from the
+//! * **Ward** (§5.2): `ε = e_pos + e_nrm`, valid iff `ε < a`, `w = 1 / max(ε, 10⁻³)` (cap 1000,
+//!   §7.2: RADIANCE's cap; with at most a few tens of records per pixel `Σ w·E` stays far from the
 //!   f32 range, and below the f16 range for `E < ~2`).
 //! * **Tabellion–Lamorlette** (§5.3): `w = 1 − κ · max(2·e_pos, e_nrm / sqrt(1 − cos 10°))`, valid iff
 //!   `w > 0`. Bounded by 1, so sums cannot overflow.
 //!
 //! **Default: Tabellion–Lamorlette** ([`WeightKind::default`]). Reasons: (1) the weight falls
 //! continuously to 0 at the zone boundary, so a record entering or leaving a pixel's set does not pop
-//! (Ward jumps from `1/a` to 0) — this matters for splat seams and for temporal stability (§11);
-//! (2) it is bounded, so additive splat blending needs no cap and half-float targets are safe;
-//! (3) its zone of influence is a hard ball `‖Δ‖ < R/(2κ)` with an explicit normal cone (10°/κ),
-//! which sizes splats exactly (§10.2); (4) it is Mitsuba's choice together with gradients and
-//! neighbour clamping, the combination this project follows (§5.7, §14.3). Ward stays selectable
-//! (its `a` is the classic accuracy knob; interpolation reproduces each record exactly).
+//! (Ward jumps from `1/a` to 0) — this matters for splat seams and for temporal stability
+//! (docs/temporal.md §3.7); (2) it is bounded, so additive splat blending needs no cap and
+//! half-float targets are safe; (3) its zone of influence is a hard ball `‖Δ‖ < R/(2κ)` with an
+//! explicit normal cone (10°/κ), which sizes splats exactly (§5.6); (4) it is Mitsuba's choice
+//! together with gradients and neighbour clamping, the combination this project follows (§5.5).
+//! Ward stays selectable (its `a` is the classic accuracy knob; interpolation reproduces each
+//! record exactly).
 //!
 //! Validity shapes (both kinds, `n = n_i`, point in the record's plane): Ward's zone is the disk
 //! `‖Δ‖ < a·R`, T&L's the disk `‖Δ‖ < R/(2κ)`; both shrink with normal deviation, Ward additively
@@ -38,7 +40,7 @@ pub use radcache_shared::consts::{WEIGHT_TL, WEIGHT_WARD};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[repr(u32)]
 pub enum WeightKind {
-    /// Ward's split-sphere weight `1/ε` (§5.1); parameter `a` (accuracy).
+    /// Ward's split-sphere weight `1/ε` (§5.2); parameter `a` (accuracy).
     Ward = WEIGHT_WARD,
     /// Tabellion–Lamorlette's bounded weight `1 − κ·max(ε_p, ε_n)` (§5.3); parameter `κ`.
     #[default]
@@ -56,7 +58,7 @@ impl WeightKind {
     }
 }
 
-/// Normal test (§5.5): the record faces the same side, `n·n_i > 0`.
+/// Normal test (§5.4): the record faces the same side, `n·n_i > 0`.
 pub fn normal_test(n: Vec3, n_i: Vec3) -> bool {
     n.dot(n_i) > 0.0
 }
@@ -68,18 +70,19 @@ pub fn in_front_test(p: Vec3, p_i: Vec3, n_i: Vec3, tol: f32) -> bool {
 
 /// Normal error `sqrt(1 − n·n_i)` (§5.1), evaluated as `‖n − n_i‖/√2` — the same value for unit
 /// normals (`‖n − n_i‖² = 2 − 2 n·n_i`), but without the cancellation of `1 − n·n_i` in f32 (a
-/// percent-level error below 0.1° of deviation) and never negative under the root (§16.3).
+/// percent-level error below 0.1° of deviation) and never negative under the root (§5.1).
 pub fn normal_error(n: Vec3, n_i: Vec3) -> f32 {
     (n - n_i).length() * core::f32::consts::FRAC_1_SQRT_2
 }
 
-/// Positional error `(‖Δ‖ + |Δ·n_i|) / max(R_i, R_FLOOR)`, `Δ = p − p_i` (§5.1 + §5.4 out-of-plane term).
+/// Positional error `(‖Δ‖ + |Δ·n_i|) / max(R_i, R_FLOOR)`, `Δ = p − p_i` (§5.1, with its
+/// out-of-plane term).
 pub fn position_error(p: Vec3, p_i: Vec3, n_i: Vec3, r_i: f32) -> f32 {
     let d = p - p_i;
     (d.length() + d.dot(n_i).abs()) / clamp_lo_hi(r_i, R_FLOOR, IC_FAR)
 }
 
-/// Ward's weight (§5.1) with the normal and in-front tests: `1/max(ε, 10⁻³)` if `ε < a`, else 0.
+/// Ward's weight (§5.2) with the normal and in-front tests: `1/max(ε, 10⁻³)` if `ε < a`, else 0.
 pub fn ward_weight(
     p: Vec3,
     n: Vec3,
@@ -143,7 +146,7 @@ pub fn record_weight(
     }
 }
 
-/// Ratio of the validity radius to `R` (§10.2): `a` (Ward) or `1/(2κ)` (T&L).
+/// Ratio of the validity radius to `R` (§5.6): `a` (Ward) or `1/(2κ)` (T&L).
 pub fn validity_scale(kind: WeightKind, param: f32) -> f32 {
     match kind {
         WeightKind::Ward => param.max(0.0),
@@ -151,7 +154,7 @@ pub fn validity_scale(kind: WeightKind, param: f32) -> f32 {
     }
 }
 
-/// World-space radius around `p_i` beyond which the weight is 0 or below `w_min` (§10.2): the
+/// World-space radius around `p_i` beyond which the weight is 0 or below `w_min` (§5.6): the
 /// radius of the sphere a splat quad must cover.
 /// * Ward: `w > max(1/a, w_min)` needs `‖Δ‖ < R / max(1/a, w_min)` (since `ε >= ‖Δ‖/R`).
 /// * T&L: `w > w_min` needs `‖Δ‖ < (1 − w_min) · R / (2κ)` (`w_min` clamped to `[0, 1]`).
@@ -174,7 +177,8 @@ pub fn weight_unit(kind: WeightKind, param: f32) -> f32 {
     }
 }
 
-/// Σw below which a pixel is a hole: `hole_threshold · weight_unit` (§9, §10.4).
+/// Σw below which a pixel is a hole: `hole_threshold · weight_unit` (§5.6;
+/// docs/cache-frame.md §3.3).
 pub fn coverage_threshold(kind: WeightKind, param: f32, hole_threshold: f32) -> f32 {
     hole_threshold.max(0.0) * weight_unit(kind, param)
 }

@@ -1,4 +1,5 @@
-//! Tests of the extrapolation (spec §5.6, §16.2) and the temporal formulas (§11.2).
+//! Tests of the extrapolation (docs/irradiance-cache.md §6.1, §6.2) and the temporal formulas
+//! (docs/temporal.md §3.3).
 
 mod common;
 

@@ -1,5 +1,6 @@
 //! Checks that `shaders/common/ircache_math.glsl` stays the twin of this crate
-//! (shared/docs/architecture.md, "Pair each GLSL function with a Rust reference"):
+//! (`docs/irradiance-cache.md`: every formula has a Rust reference in this crate and a GLSL twin of
+//! the same name):
 //! * every top-level `pub fn` of `src/` has a GLSL function of the same name and vice versa, with
 //!   the same arity once Rust's `[Vec3; 3]` arguments count as three `vec3` and tuple/struct
 //!   results as `out` parameters (value comparison on the GPU is the lead's `radcache-tests`);

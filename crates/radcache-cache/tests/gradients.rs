@@ -1,7 +1,8 @@
-//! Finite-difference checks of the gradients (spec §6.3) on analytic scenes (tests/common):
-//! samples come from ray casting the scene along each stratum direction; the reference is the
-//! central difference of the exact (Lambert) irradiance, `(E(x+δ) − E(x−δ))/2δ` for translations
-//! along `t`, `b` and `(E(R_{+δ} n) − E(R_{−δ} n))/2δ` for rotations of the normal about `t`, `b`.
+//! Finite-difference checks of the gradients (docs/irradiance-cache.md §3.3) on analytic scenes
+//! (tests/common): samples come from ray casting the scene along each stratum direction; the
+//! reference is the central difference of the exact (Lambert) irradiance, `(E(x+δ) − E(x−δ))/2δ`
+//! for translations along `t`, `b` and `(E(R_{+δ} n) − E(R_{−δ} n))/2δ` for rotations of the normal
+//! about `t`, `b`.
 //!
 //! **Tolerances, derived from the stratification.** Both estimators are first order in the
 //! stratum size: the translational one moves each radiance edge to the nearest stratum wall and

@@ -1,4 +1,5 @@
-//! Tests of `IcParams` and its presets (spec §3.2, §9, §19).
+//! Tests of `IcParams` and its presets (docs/irradiance-cache.md §2.2, §8.1;
+//! docs/cache-frame.md §3.2).
 
 use radcache_cache::weight::{splat_radius, WeightKind};
 use radcache_cache::{IcParams, Preset};
@@ -9,13 +10,13 @@ fn presets_are_valid_and_ordered() {
     for p in [d, n, h] {
         assert!(p.is_valid(), "{p:?}");
         assert_eq!(p.weight_kind, WeightKind::TabellionLamorlette);
-        assert!(p.strata_n >= 3 * p.strata_m, "N ≈ πM (§3.2)");
+        assert!(p.strata_n >= 3 * p.strata_m, "N ≈ πM (§2.2)");
     }
     assert_eq!(IcParams::preset(Preset::Default), n);
     assert_eq!(
         (n.strata_m, n.strata_n, n.accuracy, n.kappa),
         (16, 48, 0.15, 0.5),
-        "§19 starting values; κ measured (params.rs)"
+        "§8.1 values; κ measured (§8.2)"
     );
     assert_eq!(
         (
@@ -25,9 +26,9 @@ fn presets_are_valid_and_ordered() {
             n.max_age_frames
         ),
         (4.0, 20.0, 0.05, 30.0),
-        "R⁻ measured (params.rs), the rest §19"
+        "R⁻ measured (params.rs), the rest §8.1"
     );
-    assert_eq!((d.strata_m, d.strata_n), (8, 24), "§3.2 interactive");
+    assert_eq!((d.strata_m, d.strata_n), (8, 24), "§2.2 interactive");
     assert!(d.sample_count() < n.sample_count() && n.sample_count() < h.sample_count());
     assert!(d.accuracy > n.accuracy && n.accuracy > h.accuracy);
     assert!(
@@ -63,7 +64,7 @@ fn derived_quantities() {
     let c = p.for_creation();
     assert!(
         c.kappa > p.kappa && c.accuracy < p.accuracy,
-        "creation is stricter (§9)"
+        "creation is stricter (docs/cache-frame.md §3.2)"
     );
     assert!((c.kappa - p.kappa / 0.7).abs() < 1e-6);
     let ward = IcParams {

@@ -1,5 +1,5 @@
-//! Tests of the radius post-processing (spec §7.2–§7.7): gradient limit, footprint, clamp order,
-//! gradient attenuation, neighbour clamping and corners.
+//! Tests of the radius post-processing (docs/irradiance-cache.md §4.2–§4.7): gradient limit,
+//! footprint, clamp order, gradient attenuation, neighbour clamping and corners.
 
 use glam::Vec3;
 use radcache_cache::radius::*;
@@ -21,7 +21,7 @@ fn gradient_limit() {
         Vec3::new(0.0, 1.0, 0.0),
         Vec3::new(0.0, 0.0, 0.05),
     ];
-    // min(10, 1/0.1, 2/1, 0.5/0.05) = 2 (§7.2, per channel).
+    // min(10, 1/0.1, 2/1, 0.5/0.05) = 2 (§4.2, per channel).
     assert!((gradient_limit_radius(10.0, e, &g) - 2.0).abs() < 1e-6);
     assert_eq!(gradient_limit_radius(1.0, e, &g), 1.0);
     assert_eq!(gradient_limit_radius(f32::INFINITY, e, &NO_GRAD), IC_FAR);
@@ -56,7 +56,7 @@ fn pixel_footprint_forms() {
 
 #[test]
 fn radius_bounds_are_validity_radii_in_pixels() {
-    // §19: R⁻ = 2 px and R⁺ = 20 px are *validity* radii; the zone of a record clamped to R⁻
+    // §4.3: R⁻ = 2 px and R⁺ = 20 px are *validity* radii; the zone of a record clamped to R⁻
     // spans exactly 2 footprints for either weight.
     for (kind, param) in [
         (WeightKind::Ward, 0.15),
@@ -119,7 +119,7 @@ fn finalize_radius_follows_the_recommended_order() {
 
 #[test]
 fn neighbour_clamping() {
-    // §7.5: R_i <= R_j + d_ij both ways; records far apart are unaffected.
+    // §4.5: R_i <= R_j + d_ij both ways; records far apart are unaffected.
     let (a, b) = neighbour_clamp_pair(10.0, Vec3::ZERO, 1.0, Vec3::X * 2.0);
     assert_eq!((a, b), (3.0, 1.0));
     let (a, b) = neighbour_clamp_pair(10.0, Vec3::ZERO, 1.0, Vec3::X * 20.0);
@@ -164,7 +164,7 @@ fn neighbour_clamping() {
 
 #[test]
 fn corners_with_vanishing_radius() {
-    // §7.6: R → 0 (record in a corner) must give a positive used radius, a zero attenuation
+    // §4.6: R → 0 (record in a corner) must give a positive used radius, a zero attenuation
     // factor (huge corner gradients are not extrapolated) and no Inf/NaN.
     for r in [0.0f32, 1e-30, -1.0] {
         let g = [Vec3::X * 1e30, Vec3::Y * 1e30, Vec3::Z];

@@ -1,5 +1,6 @@
-//! Tests of the record sums (spec §3.1, §6, §7.1): constant radiance, the harmonic mean above a
-//! plane, the split sphere of §5.1 (exact gradients), invalid samples and the elevation restriction.
+//! Tests of the record sums (docs/irradiance-cache.md §2.5, §3): constant radiance, the harmonic
+//! mean above a plane, the split sphere of §3.3 (exact gradients), invalid samples and the
+//! elevation restriction.
 
 mod common;
 
@@ -54,7 +55,7 @@ fn constant_radiance_gives_pi_l_and_zero_gradients() {
 #[test]
 fn harmonic_mean_above_a_plane_is_three_halves_height() {
     // Record at height h facing an infinite plane: r = h/cosθ, and under the cosine pdf
-    // E[1/r] = E[cosθ]/h = 2/(3h), so R_harm = 3h/2 (§7.1). r_min → h (pole stratum).
+    // E[1/r] = E[cosθ]/h = 2/(3h), so R_harm = 3h/2 (§2.5). r_min → h (pole stratum).
     let h = 0.8;
     let plane = Scene {
         rects: vec![Rect::new(
@@ -83,7 +84,7 @@ fn harmonic_mean_above_a_plane_is_three_halves_height() {
     }
 }
 
-/// Split sphere (§5.1): record at the centre of a sphere of radius `rs`, radiance `l` on the half
+/// Split sphere (§3.3): record at the centre of a sphere of radius `rs`, radiance `l` on the half
 /// `x > 0`, black elsewhere. Exact: `E = πL/2`, `∇_t E = (2L/R) x̂`, `∇_r E = (πL/2) ŷ`, `R = rs`.
 fn split_sphere(m: u32, n: u32, rs: f32, l: Vec3) -> RecordEstimate {
     let mut ls = Vec::new();
@@ -168,7 +169,7 @@ fn invalid_samples_are_excluded_from_distances_and_walls() {
 fn restricted_minimum_ignores_grazing_hits() {
     // Hits at 4 everywhere but one very short grazing hit in the horizon row (elevation < 10°):
     // it collapses R_harm and R_min, not R_min_restricted, and radius() = max(R_harm,
-    // R_min_restricted) keeps 4 (§7.1, §19).
+    // R_min_restricted) keeps 4 (§2.5).
     let (m, n) = STRATA_DEFAULT;
     let mut r = vec![4.0f32; (m * n) as usize];
     r[stratum_index(m - 1, 3, n) as usize] = 1e-4;

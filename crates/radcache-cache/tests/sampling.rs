@@ -1,5 +1,5 @@
-//! Tests of the hemisphere sampling (spec §3.1, §3.2, §16.3): orthonormal basis, stratum
-//! directions, coverage of the hemisphere, cosine pdf, deterministic jitter, tan weights.
+//! Tests of the hemisphere sampling (docs/irradiance-cache.md §2.1, §2.2, §7.3): orthonormal basis,
+//! stratum directions, coverage of the hemisphere, cosine pdf, deterministic jitter, tan weights.
 
 use glam::Vec3;
 use radcache_cache::sampling::*;
@@ -190,7 +190,7 @@ fn tan_weights() {
                 "M={m} j={j}: {mean} vs {num}"
             );
             if j + 1 == m && m >= 16 {
-                // §6.1's centre value underestimates the horizon row by ≈ 1/√2 (the bias the
+                // §3.1's centre value underestimates the horizon row by ≈ 1/√2 (the bias the
                 // row mean removes, see record.rs).
                 let ratio = stratum_tan_centre(j, m) / mean;
                 assert!(

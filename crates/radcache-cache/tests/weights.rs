@@ -1,5 +1,6 @@
-//! Tests of the weights and splat radius (spec §5.1, §5.3–§5.5, §10.2, §16.1): monotonicity,
-//! symmetry, cap, in-front and normal tests, zone shapes of Ward vs Tabellion–Lamorlette.
+//! Tests of the weights and splat radius (docs/irradiance-cache.md §5.1–§5.4, §5.6, §7.2):
+//! monotonicity, symmetry, cap, in-front and normal tests, zone shapes of Ward vs
+//! Tabellion–Lamorlette.
 
 use glam::{Quat, Vec3};
 use radcache_cache::sampling::{ircache_hash, unit_float_from_bits};
@@ -75,7 +76,7 @@ fn weights_are_symmetric() {
 #[test]
 fn weight_cap_and_maximum() {
     let ward = ward_weight(Vec3::ZERO, Vec3::Z, Vec3::ZERO, Vec3::Z, R, 0.15, TOL);
-    assert_eq!(ward, 1.0 / WARD_MIN_ERROR, "1/ε capped at 1000 (§16.1)");
+    assert_eq!(ward, 1.0 / WARD_MIN_ERROR, "1/ε capped at 1000 (§7.2)");
     let near = ward_weight(
         Vec3::new(1e-6, 0.0, 0.0),
         Vec3::Z,
@@ -90,7 +91,7 @@ fn weight_cap_and_maximum() {
         tl_weight(Vec3::ZERO, Vec3::Z, Vec3::ZERO, Vec3::Z, R, 1.0, TOL),
         1.0
     );
-    // R = 0 (corner, §7.6): no Inf/NaN, the weight is the cap at p_i and 0 elsewhere.
+    // R = 0 (corner, §4.6): no Inf/NaN, the weight is the cap at p_i and 0 elsewhere.
     for (kind, param) in KINDS {
         let at = record_weight(
             kind,
@@ -165,7 +166,7 @@ fn in_front_and_normal_tests() {
     assert!((normal_error(small, Vec3::Z) - 7.071_067e-4).abs() < 1e-8);
     assert!(
         (normal_error(Vec3::Z * 1.01, Vec3::Z) - 0.01 / 2f32.sqrt()).abs() < 1e-6,
-        "non-unit: no NaN (§16.3)"
+        "non-unit: no NaN (§7.3)"
     );
     // The out-of-plane term lowers the weight of a point above the record's plane.
     for (kind, param) in KINDS {

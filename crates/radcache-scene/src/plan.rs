@@ -159,9 +159,9 @@ impl ScenePlan {
         )
     }
 
-    /// Whether kept records need temporal caching (IC reference §11.2): moving geometry or lights
-    /// change the irradiance, so records follow their instances, carry temporal gradients and
-    /// are refreshed in place when their lifespan ends.
+    /// Whether kept records need temporal caching (docs/temporal.md §1, §3): moving geometry or
+    /// lights change the irradiance, so records follow their instances, carry temporal gradients
+    /// and are refreshed in place when their lifespan ends.
     pub fn needs_lifespans(&self) -> bool {
         matches!(
             self.animation.kind,

@@ -124,7 +124,7 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// An irradiance record (§4.1 of the IC reference), 176 bytes. Gradients are world-space
+    /// An irradiance record (docs/irradiance-cache.md §2.6), 176 bytes. Gradients are world-space
     /// tangent vectors, one per colour channel.
     pub struct GpuRecord {
         /// Position `p_i` (xyz) and the radius used by the weight, `R_i = clamp(R_orig, R⁻, R⁺)` (w).
@@ -239,7 +239,7 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// A record's temporal state (temporal radiance caching, IC reference §11.2), 96 bytes, kept
+    /// A record's temporal state (temporal radiance caching, docs/temporal.md §3.1), 96 bytes, kept
     /// beside its `GpuRecord` (same index). The record lives on its mesh instance: its point and
     /// normals are stored in the instance's object space and moved with it every frame.
     pub struct GpuRecordTemporal {

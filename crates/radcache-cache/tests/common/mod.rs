@@ -1,5 +1,5 @@
-//! Analytic test scenes for the record/gradient tests (spec §6.3): uniformly emitting (or black)
-//! rectangles under a uniform sky, with
+//! Analytic test scenes for the record/gradient tests (docs/irradiance-cache.md §3.3): uniformly
+//! emitting (or black) rectangles under a uniform sky, with
 //! * CPU ray casting (ray–rectangle, f64) to produce the per-stratum samples `L_jk`, `r_jk`;
 //! * the exact irradiance `E(p, n)` by Lambert's polygon formula (projected solid angle of each
 //!   rectangle clipped to the hemisphere of `n`), used as the finite-difference reference.

@@ -1,9 +1,9 @@
-//! Neighbour clamping (`shaders/passes/neighbours.comp`, IC reference §7.5) of the batch of records
-//! just created, through a world-space hash grid kept on the GPU (`IcState::grid_heads`,
-//! `IcState::grid_next`): the batch is inserted, then each new record reads the 27 cells around
-//! it at its own level and the coarser ones, all with indirect dispatches (one workgroup per new
-//! record). The result equals the all-pairs clamp (see the shader), at a cost that grows with the
-//! number of nearby records instead of with all records.
+//! Neighbour clamping (`shaders/passes/neighbours.comp`, docs/irradiance-cache.md §4.5,
+//! docs/cache-frame.md §5) of the batch of records just created, through a world-space hash grid
+//! kept on the GPU (`IcState::grid_heads`, `IcState::grid_next`): the batch is inserted, then each
+//! new record reads the 27 cells around it at its own level and the coarser ones, all with indirect
+//! dispatches (one workgroup per new record). The result equals the all-pairs clamp (see the
+//! shader), at a cost that grows with the number of nearby records instead of with all records.
 
 use radcache_vk::{vk, Access, Context, Pipeline, Recorder, Resource, ShaderCompiler};
 

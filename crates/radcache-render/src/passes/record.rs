@@ -1,7 +1,8 @@
-//! Irradiance records (`shaders/passes/record.comp`, IC reference §3, §4, §6, §7, §16): one
-//! workgroup per requested pixel, dispatched indirectly from the counters (the host never learns
-//! the request count), M×N stratified gather rays each, the record formed as
-//! `radcache_cache::compute_record` + `finalize_radius` do (the shader's header has the details).
+//! Irradiance records (`shaders/passes/record.comp`, docs/cache-frame.md §4;
+//! docs/irradiance-cache.md §2, §2.6, §3, §4, §7): one workgroup per requested pixel, dispatched
+//! indirectly from the counters (the host never learns the request count), M×N stratified gather
+//! rays each, the record formed as `radcache_cache::compute_record` + `finalize_radius` do (the
+//! shader's header has the details).
 //!
 //! Bindings (`bindings::record`), after the scene's and the G-buffer's:
 //!
@@ -88,7 +89,8 @@ pub fn creation_seed(seed: u32, sub_frame: u32) -> u32 {
 
 /// Seed of the jitter of the record created at `pixel_index` with the pass seed `seed`: stratum
 /// `i` of that record is jittered by `radcache_cache::sampling::stratum_jitter(record_seed, i)`,
-/// so the same pixel and seed always reproduce the same gather directions (§11.4).
+/// so the same pixel and seed always reproduce the same gather directions
+/// (docs/irradiance-cache.md §2.3).
 pub fn record_seed(pixel_index: u32, seed: u32) -> u32 {
     ircache_hash(pixel_index ^ ircache_hash(seed))
 }
@@ -199,7 +201,7 @@ impl RecordPass {
         )
     }
 
-    /// Records refreshing records in place (temporal caching, IC reference §11.2 step 6): request
+    /// Records refreshing records in place (temporal caching, docs/temporal.md §3.5): request
     /// `i` of `requests` (`i < min(requested, request_capacity)`, dispatched from `counters`) is a record
     /// index; that record is computed again at its own point, normal and footprint, with its own
     /// pixel, level and sub-frame, and the pass seed [`creation_seed`]`(frame_seed, sub-frame)`,

@@ -1,4 +1,4 @@
-//! Temporal radiance caching (`shaders/passes/temporal.comp`; IC reference §11.2, §11.3): records
+//! Temporal radiance caching (`shaders/passes/temporal.comp`; docs/temporal.md §3, §1): records
 //! kept across the frames of an animation whose geometry or lights move.
 //!
 //! Every record lives on the mesh instance it was created on (object-space point and normals in
@@ -17,8 +17,8 @@
 //! instances' bounding spheres cover (`radcache_cache::temporal::moving_cover`, summed; the
 //! spheres at the scene's time are written by the host before the advance and the finish) has
 //! changed by more than `a_t` since its last evaluation. Linear extrapolation over
-//! the whole lifespan (§11.2) measured worse: a difference of two evaluations carries the noise of
-//! the paths that diverge between the two scenes.
+//! the whole lifespan (docs/temporal.md §3.4) measured worse: a difference of two evaluations
+//! carries the noise of the paths that diverge between the two scenes.
 //!
 //! [`crate::IcRenderer`] drives it: [`TemporalPass::record_advance`] at the start of a frame (it
 //! also re-clamps kept records' radii when the camera moved), the cache's hole filling, then
