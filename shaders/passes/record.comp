@@ -1,7 +1,7 @@
 // passes/record.comp — Rust: crates/radcache-render/src/passes/record.rs
 // Irradiance records (docs/cache-frame.md §4; docs/irradiance-cache.md §2, §2.6, §3, §4, §7; bare
 // §N below cite docs/irradiance-cache.md): one workgroup per requested pixel, dispatched indirectly
-// from IcCounters.dispatch (crates/radcache-render/src/records.rs).
+// from IcCounters.dispatch (crates/radcache-render/src/passes/record.rs).
 //
 // Request i (gl_WorkGroupID.x) exists when i < min(requested, request_capacity); it creates
 // record batch_first + i, or, past record_capacity, is dropped and counted in dropped_requests.

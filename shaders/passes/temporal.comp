@@ -1,5 +1,5 @@
 // passes/temporal.comp — Rust: crates/radcache-render/src/passes/temporal.rs
-// Temporal radiance caching (docs/temporal.md §3; crates/radcache-render/src/temporal.rs): records
+// Temporal radiance caching (docs/temporal.md §3; crates/radcache-render/src/passes/temporal.rs): records
 // live on their mesh instance, carry the change of their irradiance to the next frame and a
 // lifespan, and are evaluated again (at their own points, one frame ahead) when they expire.
 //
