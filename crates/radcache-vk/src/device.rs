@@ -109,7 +109,7 @@ pub(crate) fn query_caps(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Re
     // SAFETY: the chain only holds structs the device's API version / extensions define.
     unsafe { instance.get_physical_device_features2(pd, &mut core) };
     let c = core.features;
-    let flags: [(&'static str, u32); 13] = [
+    let flags: [(&'static str, u32); 14] = [
         ("bufferDeviceAddress", f12.buffer_device_address),
         ("scalarBlockLayout", f12.scalar_block_layout),
         ("runtimeDescriptorArray", f12.runtime_descriptor_array),
@@ -131,6 +131,7 @@ pub(crate) fn query_caps(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Re
         ("accelerationStructure", fas.acceleration_structure),
         ("rayQuery", frq.ray_query),
         ("fragmentStoresAndAtomics", c.fragment_stores_and_atomics),
+        ("drawIndirectFirstInstance", c.draw_indirect_first_instance),
         (
             "timestampComputeAndGraphics",
             props.limits.timestamp_compute_and_graphics,
@@ -236,7 +237,10 @@ pub(crate) fn create_device(
     let mut fas =
         vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
     let mut frq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
-    let core = vk::PhysicalDeviceFeatures::default().fragment_stores_and_atomics(true);
+    // drawIndirectFirstInstance: the splat pass's batch draw starts at a GPU-written instance.
+    let core = vk::PhysicalDeviceFeatures::default()
+        .fragment_stores_and_atomics(true)
+        .draw_indirect_first_instance(true);
     let mut f2 = vk::PhysicalDeviceFeatures2::default()
         .features(core)
         .push_next(&mut f12)

@@ -62,8 +62,9 @@ impl Recorder {
         self.check_indirect("dispatch_indirect", args, offset, DISPATCH_ARGS);
         args.used_by(self.index);
         // SAFETY: as for `dispatch`; `args` has INDIRECT_BUFFER usage and holds the arguments at
-        // an aligned offset (`check_indirect`). The group counts are written by radcache's own
-        // shaders, which keep them within the device limits (documented above).
+        // an aligned offset (`check_indirect`). The group counts are GPU data no host check can
+        // see: keeping them within the limits is the documented contract above, left to the
+        // shader that writes them (the one precondition here that is not checked).
         unsafe {
             self.shared
                 .device
@@ -220,8 +221,8 @@ impl Recorder {
 
     /// Draws with `draw_count` (0 or 1: multi-draw is not enabled) `VkDrawIndirectCommand`s read
     /// from `args` at `offset`, which must have `INDIRECT_BUFFER` usage and hold them at a
-    /// multiple of 4; the same pipeline checks as [`Self::draw`] apply. The commands are GPU
-    /// data: their `firstInstance` must be 0 (drawIndirectFirstInstance is not enabled).
+    /// multiple of 4; the same pipeline checks as [`Self::draw`] apply. Any `firstInstance` is
+    /// allowed (drawIndirectFirstInstance is enabled); the counts are the shader's to bound.
     pub fn draw_indirect(&mut self, args: &Buffer, offset: u64, draw_count: u32) {
         self.check_draw("draw_indirect");
         assert!(
@@ -238,8 +239,8 @@ impl Recorder {
         );
         args.used_by(self.index);
         // SAFETY: as for `draw`; `args` has INDIRECT_BUFFER usage and holds `draw_count` ≤ 1
-        // commands at an aligned offset (`check_indirect`). Their contents are written by
-        // radcache's own shaders, with `firstInstance` 0 (documented above).
+        // commands at an aligned offset (`check_indirect`). Every value of their fields is valid:
+        // drawIndirectFirstInstance is enabled, and vertex pulling reads no vertex buffers.
         unsafe {
             self.shared.device.cmd_draw_indirect(
                 self.cmd,

@@ -6,7 +6,8 @@
 //! interface lists every global variable it uses, so the used resources are the interface's
 //! variables that carry a `Binding` decoration; older modules fall back to every decorated
 //! variable. Only what the check needs is parsed: the variables, their pointer and base types,
-//! and the decorations `Binding`, `DescriptorSet`, `Block` and `BufferBlock`.
+//! the decorations `Binding`, `DescriptorSet`, `Block`, `BufferBlock` and `ArrayStride`, and the
+//! member offsets and matrix strides that give the byte span of a push-constant block.
 
 use std::collections::{HashMap, HashSet};
 
@@ -15,6 +16,10 @@ use crate::pipeline::{BindingKind, BindingLayout};
 
 // Opcodes, storage classes and decorations of the SPIR-V specification.
 const OP_ENTRY_POINT: u32 = 15;
+const OP_TYPE_INT: u32 = 21;
+const OP_TYPE_FLOAT: u32 = 22;
+const OP_TYPE_VECTOR: u32 = 23;
+const OP_TYPE_MATRIX: u32 = 24;
 const OP_TYPE_IMAGE: u32 = 25;
 const OP_TYPE_SAMPLER: u32 = 26;
 const OP_TYPE_SAMPLED_IMAGE: u32 = 27;
@@ -25,6 +30,7 @@ const OP_TYPE_POINTER: u32 = 32;
 const OP_CONSTANT: u32 = 43;
 const OP_VARIABLE: u32 = 59;
 const OP_DECORATE: u32 = 71;
+const OP_MEMBER_DECORATE: u32 = 72;
 const OP_TYPE_ACCELERATION_STRUCTURE: u32 = 5341;
 const SC_UNIFORM_CONSTANT: u32 = 0;
 const SC_UNIFORM: u32 = 2;
@@ -32,11 +38,14 @@ const SC_PUSH_CONSTANT: u32 = 9;
 const SC_STORAGE_BUFFER: u32 = 12;
 const DEC_BLOCK: u32 = 2;
 const DEC_BUFFER_BLOCK: u32 = 3;
+const DEC_ARRAY_STRIDE: u32 = 6;
+const DEC_MATRIX_STRIDE: u32 = 7;
+const DEC_OFFSET: u32 = 35;
 const DEC_BINDING: u32 = 33;
 const DEC_DESCRIPTOR_SET: u32 = 34;
 
 /// A type, as far as the check needs it.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 enum Type {
     /// `OpTypeImage` with its `Sampled` operand (1: sampled, 2: storage).
     Image(u32),
@@ -45,7 +54,13 @@ enum Type {
     /// Element type and the id of the length constant.
     Array(u32, u32),
     RuntimeArray(u32),
-    Struct,
+    /// Member types.
+    Struct(Vec<u32>),
+    /// A scalar of this many bytes.
+    Scalar(u64),
+    /// Component type and count (a vector's components, a matrix's columns).
+    Vector(u32, u32),
+    Matrix(u32, u32),
     AccelerationStructure,
     /// The pointee (the variable's storage class decides the kind).
     Pointer(u32),
@@ -58,10 +73,57 @@ type Used = Vec<(
     std::result::Result<(BindingKind, Option<u32>), String>,
 )>;
 
-/// What a module uses: its descriptor resources and whether it reads push constants.
+/// What a module uses: its descriptor resources and, when it reads push constants, the byte
+/// span of their block (`None` inside when it cannot be worked out).
 struct Uses {
     resources: Used,
-    push_constants: bool,
+    push_constants: Option<Option<u64>>,
+}
+
+/// The layout decorations that give a block's byte span.
+#[derive(Default)]
+struct Layout {
+    /// (struct, member) → byte offset / matrix stride.
+    offsets: HashMap<(u32, u32), u64>,
+    matrix_strides: HashMap<(u32, u32), u64>,
+    array_strides: HashMap<u32, u64>,
+}
+
+impl Layout {
+    /// The bytes from the start of a `ty` to the end of its last byte, if known; `matrix_stride`
+    /// is the stride of the member this type is (for matrices).
+    fn span(
+        &self,
+        types: &HashMap<u32, Type>,
+        constants: &HashMap<u32, u32>,
+        ty: u32,
+        matrix_stride: Option<u64>,
+        depth: u32,
+    ) -> Option<u64> {
+        if depth > 16 {
+            return None;
+        }
+        let span = |t, stride| self.span(types, constants, t, stride, depth + 1);
+        match types.get(&ty)? {
+            Type::Scalar(bytes) => Some(*bytes),
+            Type::Vector(c, n) => Some(span(*c, None)? * u64::from(*n)),
+            Type::Matrix(column, n) => {
+                let stride = matrix_stride?;
+                Some(stride * u64::from(n.checked_sub(1)?) + span(*column, None)?)
+            }
+            Type::Array(elem, len) => {
+                let len = u64::from(*constants.get(len)?);
+                let stride = *self.array_strides.get(&ty)?;
+                Some(stride * len.checked_sub(1)? + span(*elem, matrix_stride)?)
+            }
+            Type::Struct(members) => members.iter().enumerate().try_fold(0, |end, (i, m)| {
+                let key = (ty, i as u32);
+                let offset = *self.offsets.get(&key)?;
+                Some(end.max(offset + span(*m, self.matrix_strides.get(&key).copied())?))
+            }),
+            _ => None,
+        }
+    }
 }
 
 fn literal_string_words(words: &[u32]) -> usize {
@@ -85,6 +147,7 @@ fn parse(spirv: &[u32]) -> std::result::Result<Uses, String> {
     let mut blocks: HashSet<u32> = HashSet::new();
     let mut buffer_blocks: HashSet<u32> = HashSet::new();
     let mut interface: HashSet<u32> = HashSet::new();
+    let mut layout = Layout::default();
     let mut at = 5;
     while at < spirv.len() {
         let count = (spirv[at] >> 16) as usize;
@@ -111,8 +174,29 @@ fn parse(spirv: &[u32]) -> std::result::Result<Uses, String> {
                 (DEC_BUFFER_BLOCK, _) => {
                     buffer_blocks.insert(w[0]);
                 }
+                (DEC_ARRAY_STRIDE, Some(&stride)) => {
+                    layout.array_strides.insert(w[0], u64::from(stride));
+                }
                 _ => {}
             },
+            OP_MEMBER_DECORATE if w.len() >= 4 => match w[2] {
+                DEC_OFFSET => {
+                    layout.offsets.insert((w[0], w[1]), u64::from(w[3]));
+                }
+                DEC_MATRIX_STRIDE => {
+                    layout.matrix_strides.insert((w[0], w[1]), u64::from(w[3]));
+                }
+                _ => {}
+            },
+            OP_TYPE_INT | OP_TYPE_FLOAT if w.len() >= 2 => {
+                types.insert(w[0], Type::Scalar(u64::from(w[1] / 8)));
+            }
+            OP_TYPE_VECTOR if w.len() >= 3 => {
+                types.insert(w[0], Type::Vector(w[1], w[2]));
+            }
+            OP_TYPE_MATRIX if w.len() >= 3 => {
+                types.insert(w[0], Type::Matrix(w[1], w[2]));
+            }
             OP_TYPE_IMAGE if w.len() >= 7 => {
                 types.insert(w[0], Type::Image(w[6]));
             }
@@ -129,7 +213,7 @@ fn parse(spirv: &[u32]) -> std::result::Result<Uses, String> {
                 types.insert(w[0], Type::RuntimeArray(w[1]));
             }
             OP_TYPE_STRUCT if !w.is_empty() => {
-                types.insert(w[0], Type::Struct);
+                types.insert(w[0], Type::Struct(w[1..].to_vec()));
             }
             OP_TYPE_ACCELERATION_STRUCTURE if !w.is_empty() => {
                 types.insert(w[0], Type::AccelerationStructure);
@@ -148,7 +232,11 @@ fn parse(spirv: &[u32]) -> std::result::Result<Uses, String> {
     let used = |id: &u32| !interface_lists_all || interface.contains(id);
     let push_constants = variables
         .iter()
-        .any(|(id, _, class)| *class == SC_PUSH_CONSTANT && used(id));
+        .find(|(id, _, class)| *class == SC_PUSH_CONSTANT && used(id))
+        .map(|(_, pointer, _)| match types.get(pointer) {
+            Some(Type::Pointer(block)) => layout.span(&types, &constants, *block, None, 0),
+            _ => None,
+        });
     let mut resources = Vec::new();
     for (id, pointer, class) in &variables {
         let Some(&binding) = bindings.get(id) else {
@@ -209,10 +297,24 @@ pub(crate) fn check_layout(
     let invalid = |m: String| Error::Invalid(format!("pipeline {pipeline:?}: {m}"));
     for spirv in modules {
         let uses = parse(spirv).map_err(|m| invalid(format!("cannot read its SPIR-V: {m}")))?;
-        if uses.push_constants && push_constant_size == 0 {
-            return Err(invalid(
-                "the shader reads push constants, the pipeline declares none".into(),
-            ));
+        match uses.push_constants {
+            Some(_) if push_constant_size == 0 => {
+                return Err(invalid(
+                    "the shader reads push constants, the pipeline declares none".into(),
+                ))
+            }
+            Some(None) => {
+                return Err(invalid(
+                    "cannot work out the byte span of the shader's push-constant block".into(),
+                ))
+            }
+            Some(Some(span)) if span > u64::from(push_constant_size) => {
+                return Err(invalid(format!(
+                    "the shader's push-constant block spans {span} bytes, the pipeline declares \
+                     {push_constant_size}"
+                )))
+            }
+            _ => {}
         }
         for (set, binding, used) in uses.resources {
             let (kind, length) = used.map_err(|m| invalid(format!("binding {binding}: {m}")))?;

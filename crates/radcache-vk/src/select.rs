@@ -28,6 +28,7 @@ pub const REQUIRED_FEATURES: &[&str] = &[
     "accelerationStructure",
     "rayQuery",
     "fragmentStoresAndAtomics",
+    "drawIndirectFirstInstance",
     "timestampComputeAndGraphics",
 ];
 

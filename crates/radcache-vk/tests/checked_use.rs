@@ -219,6 +219,13 @@ fn pipelines_declare_every_resource_their_shader_uses() {
     let err =
         Pipeline::compute(&ctx, "test.fill", &spirv, &[storage(0), storage(1)], 0).unwrap_err();
     assert!(err.to_string().contains("reads push constants"), "{err}");
+    let err =
+        Pipeline::compute(&ctx, "test.fill", &spirv, &[storage(0), storage(1)], 4).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("push-constant block spans 8 bytes, the pipeline declares 4"),
+        "{err}"
+    );
     let err = Pipeline::compute(&ctx, "test.fill", &[1, 2, 3, 4, 5, 6], &[], 0).unwrap_err();
     assert!(err.to_string().contains("not a SPIR-V module"), "{err}");
     // A table that declares more than the shader uses is fine.
