@@ -249,11 +249,15 @@ gpu_struct! {
         pub object_normal: [f32; 4] => "vec4",
         /// Object-space geometric normal (xyz); unused (w).
         pub object_geometric: [f32; 4] => "vec4",
-        /// Irradiance at birth `E_i(t_i)` (rgb); unused (w).
+        /// The newest known irradiance `E_k` (rgb, exact at frame `t_k`); the share of the
+        /// record's cosine-weighted hemisphere that the other moving instances covered then (w,
+        /// the motion-aware expiry's reference, docs/temporal.md §3).
         pub birth_irradiance: [f32; 4] => "vec4",
-        /// Temporal gradient `∂E_i/∂t` per frame (rgb); luminance ratio `τ_i` (w).
+        /// Rate `∂E_i/∂t` per frame over the span between the last two evaluations (rgb); that
+        /// span in frames (w).
         pub gradient: [f32; 4] => "vec4",
-        /// Instance (x), birth frame `t_i` (y), flags (z: bit 0 = adopted), unused (w).
+        /// Instance (x), frame `t_k` of the newest known value (y), flags (z: bit 0 = adopted,
+        /// `TEMPORAL_FLAG_ADOPTED`), unused (w).
         pub info: [u32; 4] => "uvec4",
     }
 }
