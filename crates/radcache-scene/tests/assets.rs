@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use common::{close, close3, load, temp_dir};
 use glam::Vec3;
-use radcache_scene::assets::{write_bundled_assets, CORNELL_YFOV};
+use radcache_scene::assets::{write_bundled_assets, CORNELL_YFOV, COURTYARD_DURATION};
 use radcache_scene::{AnimationKind, Environment, EnvironmentKind, LightKind, Scene};
 
 fn bundled() -> Vec<PathBuf> {
@@ -274,7 +274,7 @@ fn repository_assets_are_up_to_date() {
     let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets");
     let fresh = temp_dir("fresh");
     write_bundled_assets(&fresh).unwrap();
-    for name in ["cornell", "furnace", "animated"] {
+    for name in ["cornell", "furnace", "animated", "courtyard"] {
         for ext in ["gltf", "bin"] {
             let rel = format!("{name}/{name}.{ext}");
             let committed = std::fs::read(repo.join(&rel)).unwrap_or_else(|e| {
@@ -287,4 +287,39 @@ fn repository_assets_are_up_to_date() {
             );
         }
     }
+}
+
+/// The Sponza-class courtyard: over 100k triangles in many meshes and materials, fine foliage,
+/// a directional sun, a constant sky, and a 5 s camera path over static geometry.
+#[test]
+fn courtyard_is_sponza_class() {
+    let (s, warnings) = load(&bundled()[3]);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let triangles = s.triangle_count();
+    assert!((100_000..200_000).contains(&triangles), "{triangles} triangles");
+    assert!(s.meshes.len() >= 50, "{} meshes", s.meshes.len());
+    assert!(s.materials.len() >= 8, "{} materials", s.materials.len());
+    let bushes = s
+        .meshes
+        .iter()
+        .filter(|m| m.name.as_deref().is_some_and(|n| n.starts_with("bush_")))
+        .count();
+    assert_eq!(bushes, 20);
+    assert_eq!(s.lights.len(), 1);
+    assert!(matches!(s.lights[0].kind, LightKind::Directional));
+    match &s.environment {
+        Environment::Constant(c) => assert!(c.min_element() > 0.0, "{c}"),
+        other => panic!("expected a constant sky, got {other:?}"),
+    }
+    let plan = s.plan();
+    assert!(!plan.has_emissive() && plan.has_punctual_lights());
+    // The camera moves over 5 s (120 frames at 24 fps); nothing else does.
+    let (a, b) = (s.camera_at(0.0), s.camera_at(COURTYARD_DURATION));
+    assert!((a.position - b.position).length() > 10.0, "{a:?} {b:?}");
+    // Only the camera node moves: no mesh instance and no light is dynamic.
+    let moving: Vec<&str> = (0..s.nodes.len())
+        .filter(|&n| s.dynamic[n])
+        .filter_map(|n| s.nodes[n].name.as_deref())
+        .collect();
+    assert_eq!(moving, ["camera"]);
 }

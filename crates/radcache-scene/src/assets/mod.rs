@@ -4,12 +4,15 @@
 //! - `furnace/furnace.gltf`: a closed box, camera inside, every face of albedo ρ emitting Le
 //!   (defaults ρ = 0.5, Le = 1 → the converged radiance everywhere is Le / (1 − ρ) = 2);
 //! - `animated/animated.gltf`: a 5 s Cornell-like room with a camera fly-through, a box moving
-//!   and turning (LINEAR), a cube bouncing (CUBICSPLINE translation, STEP scale) and a point light.
+//!   and turning (LINEAR), a cube bouncing (CUBICSPLINE translation, STEP scale) and a point light;
+//! - `courtyard/courtyard.gltf`: a Sponza-class courtyard (about 125,000 triangles in 54 meshes,
+//!   9 materials, foliage, a sun and a sky, a 5 s camera fly-through; see `courtyard.rs`).
 //!
 //! All are written with [`GltfBuilder`] (`.gltf` + `.bin`), so they are reproducible.
 
 mod animated;
 mod cornell;
+mod courtyard;
 pub mod stiff;
 
 use std::path::{Path, PathBuf};
@@ -21,6 +24,7 @@ use crate::writer::{BufferLayout, GltfBuilder, MaterialDesc, NodeDesc, Primitive
 
 pub use animated::{animated_builder, write_animated, ANIMATED_DURATION};
 pub use cornell::{cornell_builder, cornell_scaled_builder, write_cornell, CORNELL_YFOV};
+pub use courtyard::{courtyard_builder, write_courtyard, COURTYARD_DURATION};
 
 /// Default furnace albedo.
 pub const FURNACE_ALBEDO: f32 = 0.5;
@@ -137,12 +141,13 @@ pub fn write_furnace(dir: &Path, albedo: f32, emission: f32) -> Result<PathBuf> 
     write_named(&furnace_builder(albedo, emission), dir, "furnace")
 }
 
-/// Writes the three bundled assets under `dir` and returns their `.gltf` paths
-/// (cornell, furnace, animated).
+/// Writes the bundled assets under `dir` and returns their `.gltf` paths
+/// (cornell, furnace, animated, courtyard).
 pub fn write_bundled_assets(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(vec![
         write_cornell(dir)?,
         write_furnace(dir, FURNACE_ALBEDO, FURNACE_EMISSION)?,
         write_animated(dir)?,
+        write_courtyard(dir)?,
     ])
 }
