@@ -266,6 +266,10 @@ pub fn stats_entry(r: &Rendered, frame: u32, time: f32) -> Value {
         entry["rejected_records"] = json!(ic.rejected_records);
         entry["phases_wall_s"] = json!(ic.phases_s);
     }
+    if let Some((from, to)) = r.created {
+        // Creating the cache's renderer: shaders, pipelines and pass buffers (first frame only).
+        entry["pipelines_s"] = json!(to.duration_since(from).as_secs_f64());
+    }
     entry
 }
 

@@ -20,7 +20,7 @@
 //! another device — so that the driver only ever sees data it wrote itself.
 
 use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The first bytes of a radcache pipeline cache file.
 pub(crate) const MAGIC: [u8; 8] = *b"RCPIPEC\0";
@@ -237,26 +237,23 @@ pub(crate) fn check_vulkan_header(id: &Identity, data: &[u8]) -> Result<(), Reje
     Ok(())
 }
 
-/// Writes `bytes` to a temporary file beside `path` and renames it over `path`, so that a reader
-/// (another radcache process) sees the old file or the new one, never a part.
+/// Writes `bytes` to a hidden temporary file beside `path` (a `tempfile`, private to the user),
+/// fsynced, then renamed over `path`: another radcache process reading the file sees the old one
+/// or the new one, never a part; concurrent writers each rename a whole file (the last one wins).
 pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     use std::io::Write;
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(format!(".tmp-{}", std::process::id()));
-    let tmp = PathBuf::from(tmp);
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    let dir = path.parent().unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir)?;
+    let mut prefix = std::ffi::OsString::from(".");
+    prefix.push(path.file_name().unwrap_or_default());
+    prefix.push(".");
+    let mut temp = tempfile::Builder::new()
+        .prefix(&prefix)
+        .suffix(".tmp")
+        .tempfile_in(dir)?;
+    temp.write_all(bytes)?;
+    temp.as_file().sync_all()?;
+    temp.persist(path).map(drop).map_err(|e| e.error)
 }
 
 #[cfg(test)]
