@@ -45,6 +45,10 @@ pub fn context() -> Context {
     init_log();
     let mut opts = ContextOptions::from_env();
     opts.validation = !validation_disabled_by_user();
+    // Tests leave the user's pipeline cache alone unless `RADCACHE_PIPELINE_CACHE` names one.
+    if std::env::var_os(radcache_vk::PIPELINE_CACHE_ENV).is_none() {
+        opts.pipeline_cache_dir = None;
+    }
     let ctx =
         Context::with_options(&opts).unwrap_or_else(|e| panic!("creating the Vulkan context: {e}"));
     if opts.validation {

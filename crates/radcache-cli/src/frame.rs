@@ -266,5 +266,33 @@ pub fn stats_entry(r: &Rendered, frame: u32, time: f32) -> Value {
         entry["rejected_records"] = json!(ic.rejected_records);
         entry["phases_wall_s"] = json!(ic.phases_s);
     }
+    if let Some((from, to)) = r.created {
+        // Creating the cache's renderer: shaders, pipelines and pass buffers (first frame only).
+        entry["pipelines_s"] = json!(to.duration_since(from).as_secs_f64());
+    }
     entry
+}
+
+/// The stats file's `pipelines` entry: pipelines created so far, how many the driver compiled
+/// from scratch (not found in the persistent pipeline cache; on a driver whose cache keeps
+/// nothing, `driver_cache_bytes` 32, every one), how many radcache's index knew from an earlier
+/// run, the seconds their creation took; and the GLSL modules compiled to SPIR-V (by shaderc, or
+/// read from the on-disk SPIR-V cache).
+pub fn pipelines_entry(setup: &FrameSetup<'_>) -> Value {
+    let p = setup.ctx.pipeline_stats();
+    let s = setup.shaders.stats();
+    json!({
+        "created": p.created,
+        "compiled_from_scratch": p.compiled_from_scratch,
+        "cache_hits": p.cache_hits,
+        "indexed": p.indexed,
+        "creation_s": p.creation_s,
+        "driver_cache_bytes": p.driver_cache_bytes,
+        "cache_file": setup.ctx.pipeline_cache_file(),
+        "shaders": {
+            "compiled": s.compiled,
+            "from_disk": s.from_disk,
+            "compile_s": s.compile_s,
+        },
+    })
 }

@@ -67,7 +67,9 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     };
 
     let ctx = Context::new()?;
-    let shaders = ShaderCompiler::new(shader_root())?;
+    // Compiled shaders are kept beside the pipeline cache (README "Design notes / pipeline cache").
+    let spirv_dir = radcache_vk::pipeline_cache_dir_from_env();
+    let shaders = ShaderCompiler::new(shader_root())?.with_disk_cache(spirv_dir.as_deref());
     let t_upload = Instant::now();
     let mut gpu = GpuScene::new(&ctx, &scene, env_map.as_ref())?;
     let upload_s = t_upload.elapsed().as_secs_f64();
@@ -230,6 +232,7 @@ fn write_stats(
         "time_step_s": setup.time_step_s,
         // Host seconds outside the frames; "write" sums the frames' `write_s`.
         "cpu_s": {"scene_load": load_s, "upload": upload_s, "write": write_s},
+        "pipelines": frame::pipelines_entry(setup),
         "frames": frames,
     });
     crate::output::write_text(path, &serde_json::to_string_pretty(&value)?, "stats")

@@ -17,6 +17,7 @@ use crate::device::{self, DeviceInfo};
 use crate::error::{Error, Result, VkResultExt};
 use crate::instance::{self, InstanceParts};
 use crate::options::ContextOptions;
+use crate::pcache::PipelineCache;
 use crate::select;
 
 /// A GPU object waiting for the GPU to be done with it.
@@ -57,6 +58,7 @@ pub(crate) struct DeviceShared {
     pub allocator: Mutex<Option<Allocator>>,
     pub tracking: Mutex<Tracking>,
     pub last_pass: Mutex<Option<String>>,
+    pub pipeline_cache: PipelineCache,
     pub inst: InstanceParts,
 }
 
@@ -252,6 +254,8 @@ impl Drop for DeviceShared {
             alloc.report_memory_leaks(log::Level::Error);
             drop(alloc);
         }
+        self.pipeline_cache.save(&self.device);
+        self.pipeline_cache.destroy(&self.device);
         let pool = *self.lock_command_pool();
         // SAFETY: the device is idle and every child object has been destroyed above; the
         // messenger is destroyed before its state box and the instance.
@@ -362,26 +366,30 @@ impl Context {
                 });
             }
         };
-        let allocator = Allocator::new(&AllocatorCreateDesc {
+        let dir = opts.pipeline_cache_dir.as_deref();
+        let parts = Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
             physical_device: pd,
             debug_settings: Default::default(),
             buffer_device_address: true,
             allocation_sizes: Default::default(),
-        });
-        let allocator = match allocator {
-            Ok(a) => a,
+        })
+        .map_err(|e| Error::Alloc {
+            name: "allocator".into(),
+            source: e,
+        })
+        .and_then(|a| Ok((a, PipelineCache::open(&device, dir, (&info).into())?)));
+        let (allocator, pipeline_cache) = match parts {
+            Ok(p) => p,
             Err(e) => {
-                // SAFETY: only the command pool was created from the device.
+                // SAFETY: only the command pool was created from the device (an allocator made
+                // before the pipeline cache failed was dropped, holding no memory).
                 unsafe {
                     device.destroy_command_pool(command_pool, None);
                     device.destroy_device(None);
                 }
-                return Err(Error::Alloc {
-                    name: "allocator".into(),
-                    source: e,
-                });
+                return Err(e);
             }
         };
         let inst = guard.0.take().expect("guard holds the instance");
@@ -402,6 +410,7 @@ impl Context {
             allocator: Mutex::new(Some(allocator)),
             tracking: Mutex::new(Tracking::default()),
             last_pass: Mutex::new(None),
+            pipeline_cache,
             inst,
         };
         Ok(Context {
@@ -478,6 +487,7 @@ impl Context {
             t.submitted.clear();
         }
         self.shared.collect();
+        self.shared.pipeline_cache.save(&self.shared.device);
         let state = &self.shared.inst.messenger_state;
         ShutdownReport {
             validation_errors: state.errors.load(Ordering::SeqCst),

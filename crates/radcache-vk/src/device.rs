@@ -45,6 +45,14 @@ pub struct DeviceInfo {
     pub subgroup_size: u32,
     /// Whether the validation layer is active.
     pub validation: bool,
+    /// `vendorID`.
+    pub vendor_id: u32,
+    /// `deviceID`.
+    pub device_id: u32,
+    /// `driverVersion` (encoding vendor-specific).
+    pub driver_version: u32,
+    /// `pipelineCacheUUID`: pipeline cache data is exchangeable between devices with equal ids.
+    pub pipeline_cache_uuid: [u8; 16],
 }
 
 fn kind_of(t: vk::PhysicalDeviceType) -> DeviceKind {
@@ -200,6 +208,10 @@ pub(crate) fn device_info(
         min_scratch_alignment: as_props.min_acceleration_structure_scratch_offset_alignment,
         subgroup_size: sub.subgroup_size,
         validation,
+        vendor_id: p.vendor_id,
+        device_id: p.device_id,
+        driver_version: p.driver_version,
+        pipeline_cache_uuid: p.pipeline_cache_uuid,
     }
 }
 

@@ -10,6 +10,7 @@ use ash::vk;
 
 use crate::context::{Context, DeviceShared, Garbage};
 use crate::error::{Error, Result, VkResultExt};
+use crate::pcache::PipelineKey;
 use crate::reflect;
 
 /// The kind of resource at a binding.
@@ -244,16 +245,30 @@ impl Pipeline {
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)
             .name(c"main");
+        let mut feedback = vk::PipelineCreationFeedback::default();
+        let mut stage_feedback = [vk::PipelineCreationFeedback::default()];
+        let mut feedback_info = vk::PipelineCreationFeedbackCreateInfo::default()
+            .pipeline_creation_feedback(&mut feedback)
+            .pipeline_stage_creation_feedbacks(&mut stage_feedback);
         let info = [vk::ComputePipelineCreateInfo::default()
             .stage(stage)
-            .layout(layouts.pipeline)];
-        // SAFETY: module and layout are live; the layout declares every resource and the push
-        // constants the shader uses (`reflect::check_layout` above); `info` outlives the call.
+            .layout(layouts.pipeline)
+            .push_next(&mut feedback_info)];
+        let cache = &shared.pipeline_cache;
+        let driver_bytes = cache.driver_bytes(&shared.device);
+        let started = std::time::Instant::now();
+        // SAFETY: module, layout and cache are live; the layout declares every resource and the
+        // push constants the shader uses (`reflect::check_layout` above); `info` and the feedback
+        // structs it points to (one per stage, as the count says) outlive the call.
         let created = unsafe {
             shared
                 .device
-                .create_compute_pipelines(vk::PipelineCache::null(), &info, None)
+                .create_compute_pipelines(cache.raw(), &info, None)
         };
+        if created.is_ok() {
+            let key = PipelineKey::compute(spirv, bindings, push_constant_size);
+            cache.record(key, &feedback, started, driver_bytes);
+        }
         // SAFETY: the module is no longer needed once the pipeline call returned.
         unsafe { shared.device.destroy_shader_module(module, None) };
         pipeline.raw = created.map_err(|(_, e)| Error::Vk {
@@ -347,6 +362,11 @@ impl Pipeline {
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let mut feedback = vk::PipelineCreationFeedback::default();
+        let mut stage_feedback = [vk::PipelineCreationFeedback::default(); 2];
+        let mut feedback_info = vk::PipelineCreationFeedbackCreateInfo::default()
+            .pipeline_creation_feedback(&mut feedback)
+            .pipeline_stage_creation_feedbacks(&mut stage_feedback);
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
             .color_attachment_formats(desc.color_formats)
             .depth_attachment_format(desc.depth.map_or(vk::Format::UNDEFINED, |d| d.format));
@@ -361,15 +381,23 @@ impl Pipeline {
             .color_blend_state(&blend)
             .dynamic_state(&dynamic)
             .layout(layouts.pipeline)
-            .push_next(&mut rendering)];
-        // SAFETY: every state struct lives until the call returns; modules and layout are live;
-        // the layout declares every resource and the push constants the shaders use
-        // (`reflect::check_layout` above).
+            .push_next(&mut rendering)
+            .push_next(&mut feedback_info)];
+        let cache = &shared.pipeline_cache;
+        let driver_bytes = cache.driver_bytes(&shared.device);
+        let started = std::time::Instant::now();
+        // SAFETY: every state struct, and the feedback structs (one per stage, as the count says),
+        // lives until the call returns; modules, layout and cache are live; the layout declares
+        // every resource and the push constants the shaders use (`reflect::check_layout` above).
         let created = unsafe {
             shared
                 .device
-                .create_graphics_pipelines(vk::PipelineCache::null(), &info, None)
+                .create_graphics_pipelines(cache.raw(), &info, None)
         };
+        if created.is_ok() {
+            let key = PipelineKey::graphics(desc);
+            cache.record(key, &feedback, started, driver_bytes);
+        }
         // SAFETY: the modules are no longer needed once the pipeline call returned.
         unsafe {
             shared.device.destroy_shader_module(vs, None);

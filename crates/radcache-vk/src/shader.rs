@@ -3,18 +3,18 @@
 //! Shaders live under one root folder (the repository's `shaders/`). `#include "x.glsl"` resolves
 //! relative to the including file first, then to the root. Defines are passed per compile. The
 //! target is Vulkan 1.3 / SPIR-V 1.6 (ray queries need SPIR-V 1.4+). Errors carry `file:line`
-//! relative to the root. Results are cached in memory by (path, defines); a cached entry is reused
-//! only while the contents of every file it read are unchanged, so edits are picked up on the next
-//! compile (hot reload without a watcher).
+//! relative to the root. Results are cached in memory by (path, defines), and on disk as well with
+//! [`ShaderCompiler::with_disk_cache`] (`crate::spirv_cache`, keyed by path, defines and compiler
+//! options); a cached entry is reused only while the contents of every file it read are
+//! unchanged, so edits are picked up on the next compile (hot reload without a watcher).
 
 use std::cell::RefCell;
-use std::collections::hash_map::DefaultHasher;
 use std::collections::HashMap;
-use std::hash::{Hash, Hasher};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use crate::error::{Error, Result};
+use crate::spirv_cache::{self, hash_source as hash_text, Compiled, DiskCache};
 
 /// Shader stage, from the file extension (`.comp`, `.vert`, `.frag`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -55,6 +55,19 @@ struct Entry {
     spirv: Arc<Vec<u32>>,
 }
 
+/// What a [`ShaderCompiler`] did since it was created.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ShaderStats {
+    /// Modules compiled by shaderc.
+    pub compiled: u32,
+    /// Modules returned from the in-memory cache.
+    pub reused: u32,
+    /// Modules read from the on-disk cache.
+    pub from_disk: u32,
+    /// Seconds spent compiling (shaderc, reading the sources included).
+    pub compile_s: f64,
+}
+
 /// The shader compiler: one shaderc instance (the first compile in a process is slow), a root
 /// folder and the in-memory cache.
 pub struct ShaderCompiler {
@@ -62,6 +75,8 @@ pub struct ShaderCompiler {
     root: PathBuf,
     debug_info: bool,
     cache: Mutex<HashMap<Key, Entry>>,
+    disk: Option<DiskCache>,
+    stats: Mutex<ShaderStats>,
 }
 
 impl std::fmt::Debug for ShaderCompiler {
@@ -70,12 +85,6 @@ impl std::fmt::Debug for ShaderCompiler {
             .field("root", &self.root)
             .finish()
     }
-}
-
-fn hash_text(s: &str) -> u64 {
-    let mut h = DefaultHasher::new();
-    s.hash(&mut h);
-    h.finish()
 }
 
 impl ShaderCompiler {
@@ -90,7 +99,32 @@ impl ShaderCompiler {
             root: root.into(),
             debug_info: cfg!(debug_assertions),
             cache: Mutex::new(HashMap::new()),
+            disk: None,
+            stats: Mutex::new(ShaderStats::default()),
         })
+    }
+
+    /// Keeps compiled modules on disk as well, under `dir/spirv/` (`dir` is the pipeline cache's
+    /// folder, e.g. [`crate::pipeline_cache_dir_from_env`]; `None` keeps them in memory only).
+    pub fn with_disk_cache(mut self, dir: Option<&Path>) -> Self {
+        self.disk = dir.map(DiskCache::new);
+        self
+    }
+
+    fn lock_stats(&self) -> std::sync::MutexGuard<'_, ShaderStats> {
+        self.stats.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn options_text(&self) -> String {
+        format!(
+            "vulkan1.3 spirv1.6 glsl performance debug={}",
+            self.debug_info
+        )
+    }
+
+    /// How many modules were compiled, reused and read from disk, and the seconds compiling took.
+    pub fn stats(&self) -> ShaderStats {
+        *self.stats.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     /// The shader root folder.
@@ -123,8 +157,18 @@ impl ShaderCompiler {
         defs.sort();
         let key = (path.to_string(), defs);
         if let Some(spirv) = self.cached(&key) {
+            self.lock_stats().reused += 1;
             return Ok(spirv);
         }
+        let disk_key = spirv_cache::key(path, &key.1, &self.options_text());
+        let fresh = |rel: &str, h: u64| self.read(rel).is_ok_and(|t| hash_text(&t) == h);
+        if let Some(c) = self.disk.as_ref().and_then(|d| d.load(disk_key, fresh)) {
+            let spirv = Arc::new(c.spirv);
+            self.remember(key, c.files, spirv.clone());
+            self.lock_stats().from_disk += 1;
+            return Ok(spirv);
+        }
+        let started = std::time::Instant::now();
         let source = self.read(path).map_err(shader_err)?;
         let read_files = RefCell::new(vec![(path.to_string(), hash_text(&source))]);
         let mut options = shaderc::CompileOptions::new().map_err(|e| shader_err(e.to_string()))?;
@@ -181,15 +225,26 @@ impl ShaderCompiler {
         }
         let spirv = Arc::new(artifact.as_binary().to_vec());
         drop(options);
+        {
+            let mut stats = self.lock_stats();
+            stats.compiled += 1;
+            stats.compile_s += started.elapsed().as_secs_f64();
+        }
         let files = read_files.into_inner();
-        self.cache.lock().unwrap_or_else(|p| p.into_inner()).insert(
-            key,
-            Entry {
-                files,
-                spirv: spirv.clone(),
-            },
-        );
+        if let Some(disk) = &self.disk {
+            let compiled = Compiled {
+                files: files.clone(),
+                spirv: spirv.to_vec(),
+            };
+            disk.store(disk_key, &compiled);
+        }
+        self.remember(key, files, spirv.clone());
         Ok(spirv)
+    }
+
+    fn remember(&self, key: Key, files: Vec<(String, u64)>, spirv: Arc<Vec<u32>>) {
+        let mut cache = self.cache.lock().unwrap_or_else(|p| p.into_inner());
+        cache.insert(key, Entry { files, spirv });
     }
 
     fn cached(&self, key: &Key) -> Option<Arc<Vec<u32>>> {

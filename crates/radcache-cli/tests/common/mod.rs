@@ -4,9 +4,14 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// The `radcache` binary under test.
+/// The `radcache` binary under test. It leaves the user's pipeline cache alone (the cache is
+/// off) unless `RADCACHE_PIPELINE_CACHE` is set for the test run or by the test.
 pub fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_radcache"))
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_radcache"));
+    if std::env::var_os("RADCACHE_PIPELINE_CACHE").is_none() {
+        cmd.env("RADCACHE_PIPELINE_CACHE", "off");
+    }
+    cmd
 }
 
 /// Runs `radcache` with `args` and waits for it.

@@ -25,6 +25,10 @@ pub fn context() -> Context {
         Ok("0") | Ok("false") | Ok("off") | Ok("no")
     );
     opts.validation = !off;
+    // Tests leave the user's pipeline cache alone unless `RADCACHE_PIPELINE_CACHE` names one.
+    if std::env::var_os(radcache_vk::PIPELINE_CACHE_ENV).is_none() {
+        opts.pipeline_cache_dir = None;
+    }
     let ctx = Context::with_options(&opts).unwrap_or_else(|e| panic!("creating the context: {e}"));
     if opts.validation {
         assert!(
