@@ -126,6 +126,15 @@ pub struct RenderArgs {
     /// Scene time of the first frame (default: the animation's first key, else 0).
     #[arg(long)]
     pub(crate) start_time: Option<f32>,
+    /// The frame shown at the start time (default: the first of `--frames`): a part of a longer
+    /// sequence (a farm chunk) passes the sequence's first frame to get its frames' times.
+    #[arg(long, value_name = "N")]
+    pub(crate) start_frame: Option<u32>,
+    /// Before each frame to write, render the K frames before it without writing them (down to
+    /// `--start-frame`), so the records kept across frames have the lifespans and values of one
+    /// run from the start (a farm chunk, a resumed run).
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    pub(crate) warm_up: u32,
     /// Render frames again that are already on disk (a sequence skips them otherwise, so an
     /// interrupted run resumes where it stopped).
     #[arg(long)]

@@ -4,7 +4,7 @@
 //!
 //! | layer | modules |
 //! |---|---|
-//! | commands | `render`, `info`, `compare`, `flicker`, `convergence` (with its `ladder`, `model`, `plot`, `report`) |
+//! | commands | `render`, `info`, `compare`, `flicker`, `convergence` (with its `ladder`, `model`, `plot`, `report`), `farm` (with its `script`, `summary`) |
 //! | a frame of `render` | `frame` |
 //! | helpers | `sequence` (frames, contact sheet, per-frame lines), `profile` (trace, pass table) |
 //! | leaves | `args` (clap types of `render`, `args::ic` the cache's), `progress` (bars), `output` (stdout, files) |
@@ -15,6 +15,7 @@
 mod args;
 mod compare;
 mod convergence;
+mod farm;
 mod flicker;
 mod frame;
 mod info;
@@ -52,6 +53,9 @@ enum Command {
     /// Error against run time of the cache and the path tracer on one frame: CSV, log–log plot,
     /// Markdown summary with the Pareto front and the speed-ups.
     Convergence(convergence::ConvergenceArgs),
+    /// Render a sequence on a Slurm cluster: an array job of chunks, a prepass where asked and a
+    /// final job (contact sheet, flicker, summary); `--dry-run` prints the job scripts.
+    Farm(Box<farm::FarmArgs>),
 }
 
 /// The error's chain as one line, `outer: cause: cause`, each cause once: a cause whose message
@@ -80,6 +84,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare::run(&args),
         Command::Flicker(args) => flicker::run(&args),
         Command::Convergence(args) => convergence::run(&args),
+        Command::Farm(args) => farm::run(&args),
     };
     match result {
         Ok(code) => code,

@@ -150,6 +150,37 @@ impl SequenceBar {
     }
 }
 
+/// Warm-up frames rendered since the last written frame, reported in one line before it:
+/// `warm-up: frames 9..12 (4) in 3.10 s` (a farm's summary reads these).
+#[derive(Debug, Default)]
+pub struct WarmUp {
+    frames: Option<(u32, u32)>,
+    seconds: f64,
+}
+
+impl WarmUp {
+    /// A warm-up frame took `seconds`.
+    pub fn add(&mut self, frame: u32, seconds: f64) {
+        let first = self.frames.map_or(frame, |(a, _)| a);
+        self.frames = Some((first, frame));
+        self.seconds += seconds;
+    }
+
+    /// Prints the line (unless `quiet`) for the frames added since the last report.
+    pub fn report(&mut self, quiet: bool) {
+        if let Some((a, b)) = self.frames.take() {
+            if !quiet {
+                line(&format!(
+                    "warm-up: frames {a}..{b} ({}) in {:.2} s, not written",
+                    b - a + 1,
+                    self.seconds
+                ));
+            }
+            self.seconds = 0.0;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use std::sync::{Arc, Mutex};

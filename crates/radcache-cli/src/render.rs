@@ -14,11 +14,12 @@ use radcache_scene::{Environment, LoadOptions, Scene};
 use radcache_vk::{Context, ShaderCompiler};
 use serde_json::json;
 
-use crate::args::{parse_resolution, shader_root, RenderArgs};
+use crate::args::{parse_resolution, shader_root, Method, RenderArgs};
 use crate::frame::{self, FrameSetup};
 use crate::profile::Profile;
 use crate::progress;
-use crate::sequence::{ContactSheet, FrameArgs, Sequence, SequenceProgress};
+use crate::progress::WarmUp;
+use crate::sequence::{Action, ContactSheet, FrameArgs, Sequence, SequenceProgress};
 
 pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let budget = match (args.spp, args.time_budget) {
@@ -53,6 +54,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
             start_time: args.start_time,
             fps: args.fps,
             pattern,
+            start_frame: args.start_frame,
         },
         plan.animation.time_range,
     )?;
@@ -82,7 +84,29 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     // Records are kept across frames; where geometry or lights move they carry lifespans
     // (temporal caching, a time step of one frame).
     let temporal = !args.no_temporal;
-    let time_step_s = if temporal && sequence.frames.len() > 1 && plan.needs_lifespans() {
+    let output_of = |number| -> Result<std::path::PathBuf> {
+        Ok(if pattern {
+            radcache_image::frame_path(&args.output, number)?
+        } else {
+            args.output.clone()
+        })
+    };
+    let mut on_disk = std::collections::BTreeSet::new();
+    if pattern && !args.overwrite {
+        for &(number, _) in &sequence.frames {
+            if output_of(number)?.exists() {
+                on_disk.insert(number);
+            }
+        }
+    }
+    let warm_up = if temporal && args.method == Method::Ic {
+        args.warm_up
+    } else {
+        0
+    };
+    let steps = sequence.steps(warm_up, |f| on_disk.contains(&f));
+    let multi_frame = sequence.frames.len() > 1 || steps.iter().any(|s| s.action == Action::WarmUp);
+    let time_step_s = if temporal && multi_frame && plan.needs_lifespans() {
         1.0 / args.fps
     } else {
         0.0
@@ -95,33 +119,41 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         size,
         budget,
         temporal,
-        sequence: sequence.frames.len() > 1,
+        sequence: multi_frame,
         time_step_s,
     };
     let stop = interrupt_flag(sequence.frames.len() > 1);
     let mut progress = SequenceProgress::new(sequence.frames.len(), args.quiet);
-    let mut ic = None;
+    let mut ic: Option<radcache_render::IcRenderer> = None;
     let mut entries = Vec::new();
     let mut write_s = 0.0;
     let mut stopped = false;
     let mut sheet = ContactSheet::new(args.contact_sheet.clone());
-    for &(number, time) in &sequence.frames {
+    let mut warm = WarmUp::default();
+    for step in &steps {
+        let (number, time) = (step.frame, step.time);
         if stop.load(Ordering::SeqCst) {
             stopped = true;
             break;
         }
-        let output = if pattern {
-            radcache_image::frame_path(&args.output, number)?
-        } else {
-            args.output.clone()
-        };
-        if pattern && !args.overwrite && output.exists() {
+        let output = output_of(number)?;
+        if step.action == Action::Skip {
             progress.skipped(number, &output);
             sheet.add_file(&output)?;
             continue;
         }
+        if step.after_gap {
+            if let Some(renderer) = ic.as_mut() {
+                renderer.forget();
+            }
+        }
         let t_frame = Instant::now();
         let rendered = frame::render(&setup, &mut gpu, &mut ic, number, time)?;
+        if step.action == Action::WarmUp {
+            warm.add(number, t_frame.elapsed().as_secs_f64());
+            continue;
+        }
+        warm.report(args.quiet);
         if rendered.out.nonfinite_pixels > 0 {
             log::warn!(
                 "frame {number}: {} pixels were non-finite and written as black",

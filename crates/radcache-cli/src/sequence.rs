@@ -87,6 +87,32 @@ impl ContactSheet {
 pub struct Sequence {
     /// (frame number, scene time in seconds), in order.
     pub frames: Vec<(u32, f32)>,
+    /// The frame shown at `start` and the frames per second (`time_of`).
+    origin: u32,
+    start: f32,
+    fps: f32,
+}
+
+/// What a run does with one frame (see [`Sequence::steps`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    /// Render and write it.
+    Write,
+    /// Render it for the cache's sake only (a warm-up frame): not written.
+    WarmUp,
+    /// Leave it: it is on disk and no frame to write follows closely.
+    Skip,
+}
+
+/// One frame of a run's plan.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Step {
+    pub frame: u32,
+    pub time: f32,
+    pub action: Action,
+    /// The frame before it was not rendered in this run (the first rendered frame, or one after
+    /// skipped frames): a kept cache has no history for it and starts afresh.
+    pub after_gap: bool,
 }
 
 /// Parses an inclusive frame range `A..B` (or a single frame `N`).
@@ -127,6 +153,8 @@ pub struct FrameArgs<'a> {
     pub fps: f32,
     /// The output path contains a `#` run.
     pub pattern: bool,
+    /// `--start-frame N`: the frame shown at the start time (default: the first of `--frames`).
+    pub start_frame: Option<u32>,
 }
 
 impl Sequence {
@@ -147,7 +175,7 @@ impl Sequence {
             (Some(_), Some(_)) => bail!("--frames and --frame exclude each other"),
             (Some(text), None) => {
                 let (a, b) = parse_frames(text)?;
-                (a, b, a)
+                (a, b, args.start_frame.unwrap_or(a))
             }
             (None, Some(n)) => (n, n, 1.min(n)),
             (None, None) => match range {
@@ -158,6 +186,9 @@ impl Sequence {
                 _ => (1, 1, 1),
             },
         };
+        if args.start_frame.is_some() && args.frames.is_none() {
+            bail!("--start-frame applies to a sequence given with --frames");
+        }
         if first != last && !args.pattern {
             bail!("a sequence needs a run of '#' in the output path for the frame number");
         }
@@ -167,12 +198,66 @@ impl Sequence {
             }
             return Ok(Sequence {
                 frames: vec![(first, t)],
+                origin: first,
+                start: t,
+                fps: args.fps,
             });
         }
-        let frames = (first..=last)
-            .map(|f| (f, start + (f - origin) as f32 / args.fps))
+        let mut sequence = Sequence {
+            frames: Vec::new(),
+            origin,
+            start,
+            fps: args.fps,
+        };
+        sequence.frames = (first..=last).map(|f| (f, sequence.time_of(f))).collect();
+        Ok(sequence)
+    }
+
+    /// The scene time of frame `f` (also of frames before the first, for warm-up).
+    pub fn time_of(&self, f: u32) -> f32 {
+        self.start + (i64::from(f) - i64::from(self.origin)) as f32 / self.fps
+    }
+
+    /// The run's plan: every frame not `on_disk` is rendered and written; with `warm_up` K > 0,
+    /// the K frames before each of those (down to the frame shown at the start time, even
+    /// before the sequence's first frame) are rendered too, without being written, so that the
+    /// cache kept across frames has the history it would have in one run from the start (a
+    /// chunk of a farm render, or a resumed run). Every other frame on disk is skipped.
+    pub fn steps(&self, warm_up: u32, on_disk: impl Fn(u32) -> bool) -> Vec<Step> {
+        let missing: Vec<u32> = self
+            .frames
+            .iter()
+            .map(|&(f, _)| f)
+            .filter(|&f| !on_disk(f))
             .collect();
-        Ok(Sequence { frames })
+        let Some(&(first, _)) = self.frames.first() else {
+            return Vec::new();
+        };
+        let last = self.frames.last().map_or(first, |&(f, _)| f);
+        let lowest = first.saturating_sub(warm_up).max(self.origin.min(first));
+        let mut steps: Vec<Step> = Vec::new();
+        for f in lowest..=last {
+            let in_range = f >= first;
+            let action = if in_range && missing.binary_search(&f).is_ok() {
+                Action::Write
+            } else if missing.iter().any(|&m| m > f && m - f <= warm_up) {
+                Action::WarmUp
+            } else if in_range {
+                Action::Skip
+            } else {
+                continue;
+            };
+            let after_gap = steps
+                .last()
+                .is_none_or(|p| p.action == Action::Skip || p.frame + 1 != f);
+            steps.push(Step {
+                frame: f,
+                time: self.time_of(f),
+                action,
+                after_gap,
+            });
+        }
+        steps
     }
 }
 
@@ -335,5 +420,78 @@ mod tests {
         a = args(Some("1..3"), None);
         a.fps = 0.0;
         assert!(Sequence::new(&a, None).is_err());
+    }
+
+    fn plan(steps: &[Step]) -> Vec<(u32, char, bool)> {
+        let letter = |a| match a {
+            Action::Write => 'w',
+            Action::WarmUp => 'u',
+            Action::Skip => 's',
+        };
+        steps
+            .iter()
+            .map(|s| (s.frame, letter(s.action), s.after_gap))
+            .collect()
+    }
+
+    #[test]
+    fn warm_up_frames_precede_each_frame_to_write() {
+        // A chunk 13..16 of a sequence from frame 1: two warm-up frames before it, with the
+        // times of the long run.
+        let mut a = args(Some("13..16"), None);
+        a.start_frame = Some(1);
+        let s = Sequence::new(&a, Some((0.0, 5.0))).unwrap();
+        assert_eq!(s.frames[0], (13, 12.0 / 24.0));
+        let steps = s.steps(2, |_| false);
+        assert_eq!(steps[0].time, 10.0 / 24.0);
+        assert_eq!(
+            plan(&steps),
+            [
+                (11, 'u', true),
+                (12, 'u', false),
+                (13, 'w', false),
+                (14, 'w', false),
+                (15, 'w', false),
+                (16, 'w', false)
+            ]
+        );
+        // Frames on disk: warm-up frames before each missing one (on disk or not), skips
+        // elsewhere; a frame after skipped ones starts afresh.
+        let on_disk = |f| f != 14 && f != 20;
+        let s = Sequence::new(&args(Some("11..20"), None), None).unwrap();
+        assert_eq!(
+            plan(&s.steps(2, on_disk)),
+            [
+                (11, 's', true),
+                (12, 'u', true),
+                (13, 'u', false),
+                (14, 'w', false),
+                (15, 's', false),
+                (16, 's', true),
+                (17, 's', true),
+                (18, 'u', true),
+                (19, 'u', false),
+                (20, 'w', false)
+            ]
+        );
+        // Warm-up never goes before the frame shown at the start time; without warm-up frames
+        // on disk are skipped as before.
+        let s = Sequence::new(&args(Some("1..3"), None), None).unwrap();
+        assert_eq!(plan(&s.steps(8, |_| false))[0], (1, 'w', true));
+        let on_disk = |f| f == 2;
+        assert_eq!(
+            plan(&s.steps(0, on_disk)),
+            [(1, 'w', true), (2, 's', false), (3, 'w', true)]
+        );
+        let mut a = args(Some("3..4"), None);
+        a.start_frame = Some(2);
+        let s = Sequence::new(&a, None).unwrap();
+        assert_eq!(plan(&s.steps(8, |_| false))[0], (2, 'u', true));
+        a.frames = None;
+        a.frame = Some(3);
+        assert!(
+            Sequence::new(&a, None).is_err(),
+            "--start-frame needs --frames"
+        );
     }
 }
