@@ -4,15 +4,17 @@
 //!
 //! | layer | modules |
 //! |---|---|
-//! | commands | `render`, `info`, `compare`, `flicker`, `convergence` (with its `ladder`, `model`, `plot`, `report`) |
+//! | commands | `render`, `info`, `compare`, `flicker`, `convergence` (with its `ladder`, `model`, `plot`, `report`), `cache` |
 //! | a frame of `render` | `frame` |
-//! | helpers | `sequence` (frames, contact sheet, per-frame lines), `profile` (trace, pass table) |
+//! | helpers | `sequence` (frames, contact sheet, per-frame lines), `profile` (trace, pass table), `cache_io` (`render --cache-in/--cache-out`) |
 //! | leaves | `args` (clap types of `render`, `args::ic` the cache's), `progress` (bars), `output` (stdout, files) |
 //!
 //! This root only parses the command line, sets up the logger and prints a failed command's
 //! error, each cause once.
 
 mod args;
+mod cache;
+mod cache_io;
 mod compare;
 mod convergence;
 mod flicker;
@@ -52,6 +54,9 @@ enum Command {
     /// Error against run time of the cache and the path tracer on one frame: CSV, log–log plot,
     /// Markdown summary with the Pareto front and the speed-ups.
     Convergence(convergence::ConvergenceArgs),
+    /// Cache files: `info FILE` prints the header; `build SCENE` computes the records over a
+    /// static scene's camera path (prepass) for `render --cache-in`.
+    Cache(cache::CacheArgs),
 }
 
 /// The error's chain as one line, `outer: cause: cause`, each cause once: a cause whose message
@@ -80,6 +85,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare::run(&args),
         Command::Flicker(args) => flicker::run(&args),
         Command::Convergence(args) => convergence::run(&args),
+        Command::Cache(args) => cache::run(&args),
     };
     match result {
         Ok(code) => code,

@@ -4,7 +4,9 @@
 //! - `furnace/furnace.gltf`: a closed box, camera inside, every face of albedo ρ emitting Le
 //!   (defaults ρ = 0.5, Le = 1 → the converged radiance everywhere is Le / (1 − ρ) = 2);
 //! - `animated/animated.gltf`: a 5 s Cornell-like room with a camera fly-through, a box moving
-//!   and turning (LINEAR), a cube bouncing (CUBICSPLINE translation, STEP scale) and a point light.
+//!   and turning (LINEAR), a cube bouncing (CUBICSPLINE translation, STEP scale) and a point light;
+//! - `cornell_fly/cornell_fly.gltf`: the Cornell box with a 2 s camera path and nothing else
+//!   moving (the static fly-through of `radcache cache build`).
 //!
 //! All are written with [`GltfBuilder`] (`.gltf` + `.bin`), so they are reproducible.
 
@@ -20,7 +22,10 @@ use crate::error::{Error, Result};
 use crate::writer::{BufferLayout, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
 
 pub use animated::{animated_builder, write_animated, ANIMATED_DURATION};
-pub use cornell::{cornell_builder, cornell_scaled_builder, write_cornell, CORNELL_YFOV};
+pub use cornell::{
+    cornell_builder, cornell_fly_builder, cornell_scaled_builder, write_cornell, write_cornell_fly,
+    CORNELL_FLY_DURATION, CORNELL_YFOV,
+};
 
 /// Default furnace albedo.
 pub const FURNACE_ALBEDO: f32 = 0.5;
@@ -137,12 +142,13 @@ pub fn write_furnace(dir: &Path, albedo: f32, emission: f32) -> Result<PathBuf> 
     write_named(&furnace_builder(albedo, emission), dir, "furnace")
 }
 
-/// Writes the three bundled assets under `dir` and returns their `.gltf` paths
-/// (cornell, furnace, animated).
+/// Writes the four bundled assets under `dir` and returns their `.gltf` paths
+/// (cornell, furnace, animated, cornell_fly).
 pub fn write_bundled_assets(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(vec![
         write_cornell(dir)?,
         write_furnace(dir, FURNACE_ALBEDO, FURNACE_EMISSION)?,
         write_animated(dir)?,
+        write_cornell_fly(dir)?,
     ])
 }
