@@ -1,7 +1,8 @@
 //! `cargo xtask assets [--check]`: writes the bundled glTF scenes (Cornell box, furnace, animated
-//! room) into `<repo>/assets` with `radcache_scene::assets::write_bundled_assets`, or with
-//! `--check` regenerates them into a temporary directory and fails if any generated file is
-//! missing from `assets/` or differs from it byte for byte (the generators are deterministic).
+//! room, static Cornell fly-through, Sponza-class courtyard) into `<repo>/assets` with
+//! `radcache_scene::assets::write_bundled_assets`, or with `--check` regenerates them into a
+//! temporary directory and fails if any generated file is missing from `assets/` or differs from
+//! it byte for byte (the generators are deterministic).
 
 use std::path::{Path, PathBuf};
 

@@ -13,6 +13,7 @@
 //! | [`extrapolate`] | gradient extrapolation with the negative/exploding guards | §6.1, §6.2 |
 //! | [`temporal`] | temporal gradient, lifespan, temporal extrapolation | `docs/temporal.md` §3.3 |
 //! | [`params`] | [`IcParams`] and its `draft`/`default`/`high` presets | §2.2, §8.1 |
+//! | [`cache_file`] | the cache file: header, records, validation (no formula, no GLSL twin) | — |
 //!
 //! **GLSL twin.** `shaders/common/ircache_math.glsl` implements the same functions under the same
 //! (snake_case) names, argument order and guards, in f32. Every public function here takes plain
@@ -36,6 +37,7 @@
 //!   normals or zero radii (checked by the randomized sweep in `tests/sweep.rs`). NaN *inputs* are not
 //!   supported on the GPU side (Vulkan does not guarantee NaN semantics).
 
+pub mod cache_file;
 pub mod extrapolate;
 pub mod params;
 pub mod radius;

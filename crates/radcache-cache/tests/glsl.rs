@@ -50,8 +50,14 @@ fn rust_arity(args: &str, ret: &str) -> usize {
 
 fn rust_functions() -> BTreeMap<String, usize> {
     let mut out = BTreeMap::new();
+    // The formula modules are the files of `src/`; its folder `cache_file/` (the cache file
+    // format) holds no formula.
     for entry in std::fs::read_dir(crate_dir().join("src")).unwrap() {
-        let text = std::fs::read_to_string(entry.unwrap().path()).unwrap();
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            continue;
+        }
+        let text = std::fs::read_to_string(path).unwrap();
         for (pos, _) in text.match_indices("\npub fn ") {
             let sig = &text[pos + 8..];
             let sig = &sig[..sig.find('{').unwrap()];

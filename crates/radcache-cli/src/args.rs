@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
-use radcache_scene::EnvOverride;
+use radcache_scene::{CameraView, EnvOverride};
 
 use ic::IcArgs;
 
@@ -146,6 +146,13 @@ pub struct RenderArgs {
     /// Use the camera with this name instead of the scene's first.
     #[arg(long)]
     pub(crate) camera: Option<String>,
+    /// Start from the records of this cache file (`--cache-out`, `radcache cache build`): made
+    /// for this scene, cache parameters and resolution, it is refused otherwise.
+    #[arg(long, value_name = "FILE.rcache")]
+    pub(crate) cache_in: Option<PathBuf>,
+    /// Write the cache's records after the last frame rendered to this file (atomically).
+    #[arg(long, value_name = "FILE.rcache")]
+    pub(crate) cache_out: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) env: EnvArgs,
     /// Write the run's timeline (GPU passes, host work) in the Chrome trace event format, for
@@ -181,6 +188,17 @@ pub struct RenderArgs {
     /// No progress bars, per-frame lines or pass table (warnings and errors stay).
     #[arg(long, short)]
     pub(crate) quiet: bool,
+}
+
+/// `--resolution WxH`, else 512 pixels high at the camera's aspect ratio.
+pub fn image_size(resolution: Option<&str>, view: &CameraView) -> Result<(u32, u32)> {
+    match resolution {
+        Some(r) => parse_resolution(r),
+        None => {
+            let aspect = view.perspective.aspect_or(1.0);
+            Ok((((512.0 * aspect).round() as u32).max(1), 512))
+        }
+    }
 }
 
 /// Parses `--resolution WxH` (each side in 1..=16384).

@@ -275,7 +275,24 @@ pub fn run(args: &FarmArgs) -> Result<ExitCode> {
             layout.scene.display(),
             plan.animation.kind
         ),
-        Some(n) => Some(n),
+        Some(n) => {
+            // The prepass job runs `radcache cache build` with the same options as the chunks:
+            // refuse now what it would refuse on the cluster.
+            let mut line = vec![
+                layout.scene.display().to_string(),
+                "-o".into(),
+                layout.cache_file().display().to_string(),
+                "--every".into(),
+                n.to_string(),
+            ];
+            line.extend(args.render.iter().cloned());
+            crate::cache::check_build_line(&line).with_context(|| {
+                "--prepass-every: the render arguments after `--` are not all valid \
+                 `radcache cache build` options (the prepass job takes the same options)"
+                    .to_string()
+            })?;
+            Some(n)
+        }
     };
     let missing = layout.missing()?;
     let mut chunks: Vec<u32> = missing.iter().map(|&f| layout.chunk_of(f)).collect();

@@ -17,6 +17,7 @@ use radcache_scene::Scene;
 use radcache_vk::{Context, ShaderCompiler};
 use serde_json::{json, Value};
 
+use crate::args::ic::IcArgs;
 use crate::args::{Method, RenderArgs};
 use crate::progress::FrameBar;
 
@@ -98,31 +99,38 @@ pub fn render(
             })
         }
         Method::Ic => {
-            let defaults = IcSettings::default();
             let settings = IcSettings {
-                width,
-                height,
-                params: args.ic.params()?,
-                sub_frames: args.ic.sub_frames.unwrap_or(defaults.sub_frames).max(1),
-                direct_samples: args
-                    .ic
-                    .direct_samples
-                    .unwrap_or(defaults.direct_samples)
-                    .max(1),
-                seed: args.seed,
                 frame,
                 time,
                 debug_aovs: args.debug_aov,
                 settle_records: setup.temporal && setup.sequence,
                 time_step_s: setup.time_step_s,
-                ..defaults
+                ..ic_settings(&args.ic, setup.size, args.seed)?
             };
             let mut created = None;
             let renderer = match ic {
                 Some(r) => r,
                 None => {
                     let start = Instant::now();
-                    let r = IcRenderer::new(setup.ctx, setup.shaders, gpu, &settings)?;
+                    let mut r = IcRenderer::new(setup.ctx, setup.shaders, gpu, &settings)?;
+                    if let Some(path) = &args.cache_in {
+                        let (ctx, shaders) = (setup.ctx, setup.shaders);
+                        let n = crate::cache_io::import(
+                            path,
+                            &mut r,
+                            ctx,
+                            shaders,
+                            setup.scene,
+                            gpu,
+                            &settings,
+                        )?;
+                        if !args.quiet {
+                            crate::progress::line(&format!(
+                                "loaded {n} records from {}",
+                                path.display()
+                            ));
+                        }
+                    }
                     created = Some((start, Instant::now()));
                     ic.insert(r)
                 }
@@ -148,6 +156,21 @@ pub fn render(
             })
         }
     }
+}
+
+/// The cache's settings of `--method ic` at `size` with `seed` (frame 1 at time 0, one frame
+/// without temporal caching: the caller sets those).
+pub fn ic_settings(ic: &IcArgs, size: (u32, u32), seed: u32) -> Result<IcSettings> {
+    let defaults = IcSettings::default();
+    Ok(IcSettings {
+        width: size.0,
+        height: size.1,
+        params: ic.params()?,
+        sub_frames: ic.sub_frames.unwrap_or(defaults.sub_frames).max(1),
+        direct_samples: ic.direct_samples.unwrap_or(defaults.direct_samples).max(1),
+        seed,
+        ..defaults
+    })
 }
 
 /// The frame's image with its AOV and debug layers.

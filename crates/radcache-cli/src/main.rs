@@ -4,15 +4,17 @@
 //!
 //! | layer | modules |
 //! |---|---|
-//! | commands | `render`, `info`, `compare`, `flicker`, `convergence` (with its `ladder`, `model`, `plot`, `report`), `farm` (with its `script`, `summary`) |
+//! | commands | `render`, `info`, `compare`, `flicker`, `convergence` (with its `ladder`, `model`, `plot`, `report`), `farm` (with its `script`, `summary`), `cache` |
 //! | a frame of `render` | `frame` |
-//! | helpers | `sequence` (frames, contact sheet, per-frame lines), `profile` (trace, pass table) |
+//! | helpers | `sequence` (frames, contact sheet, per-frame lines), `profile` (trace, pass table), `cache_io` (`render --cache-in/--cache-out`) |
 //! | leaves | `args` (clap types of `render`, `args::ic` the cache's), `progress` (bars), `output` (stdout, files) |
 //!
 //! This root only parses the command line, sets up the logger and prints a failed command's
 //! error, each cause once.
 
 mod args;
+mod cache;
+mod cache_io;
 mod compare;
 mod convergence;
 mod farm;
@@ -56,6 +58,9 @@ enum Command {
     /// Render a sequence on a Slurm cluster: an array job of chunks, a prepass where asked and a
     /// final job (contact sheet, flicker, summary); `--dry-run` prints the job scripts.
     Farm(Box<farm::FarmArgs>),
+    /// Cache files: `info FILE` prints the header; `build SCENE` computes the records over a
+    /// static scene's camera path (prepass) for `render --cache-in`.
+    Cache(cache::CacheArgs),
 }
 
 /// The error's chain as one line, `outer: cause: cause`, each cause once: a cause whose message
@@ -85,6 +90,7 @@ fn main() -> ExitCode {
         Command::Flicker(args) => flicker::run(&args),
         Command::Convergence(args) => convergence::run(&args),
         Command::Farm(args) => farm::run(&args),
+        Command::Cache(args) => cache::run(&args),
     };
     match result {
         Ok(code) => code,

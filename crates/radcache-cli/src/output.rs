@@ -26,10 +26,16 @@ pub fn make_parent(path: &Path, what: &str) -> Result<()> {
 /// Writes `text` to `path` atomically, creating its folder; errors name `what` (and the writer's
 /// name the path).
 pub fn write_text(path: &Path, text: &str, what: &str) -> Result<()> {
+    write_bytes(path, text.as_bytes(), what)
+}
+
+/// Writes `bytes` to `path` atomically, creating its folder; errors name `what` (and the writer's
+/// name the path).
+pub fn write_bytes(path: &Path, bytes: &[u8], what: &str) -> Result<()> {
     make_parent(path, what)?;
     radcache_image::write_atomic(path, |w| {
         use std::io::Write;
-        w.write_all(text.as_bytes())
+        w.write_all(bytes)
             .map_err(|source| radcache_image::Error::Io {
                 op: "cannot write",
                 path: path.to_path_buf(),

@@ -14,7 +14,7 @@ use radcache_scene::{Environment, LoadOptions, Scene};
 use radcache_vk::{Context, ShaderCompiler};
 use serde_json::json;
 
-use crate::args::{parse_resolution, shader_root, Method, RenderArgs};
+use crate::args::{image_size, shader_root, Method, RenderArgs};
 use crate::frame::{self, FrameSetup};
 use crate::profile::Profile;
 use crate::progress;
@@ -29,6 +29,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         (Some(n), None) => Budget::Samples(n),
         (None, None) => Budget::Samples(64),
     };
+    crate::cache_io::check_render_args(args)?;
     let pattern = args.output.to_string_lossy().contains('#');
     let mut profile = Profile::new();
 
@@ -60,13 +61,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     )?;
 
     let view = scene.camera_at(sequence.frames[0].1);
-    let size = match &args.resolution {
-        Some(r) => parse_resolution(r)?,
-        None => {
-            let aspect = view.perspective.aspect_or(1.0);
-            (((512.0 * aspect).round() as u32).max(1), 512)
-        }
-    };
+    let size = image_size(args.resolution.as_deref(), &view)?;
 
     let ctx = Context::new()?;
     // Compiled shaders are kept beside the pipeline cache (README "Design notes / pipeline cache").
@@ -199,6 +194,13 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         progress.rendered(number, t_frame.elapsed().as_secs_f64());
     }
     progress.finish(stopped);
+    if let Some(path) = &args.cache_out {
+        let settings = radcache_render::IcSettings {
+            time_step_s,
+            ..frame::ic_settings(&args.ic, size, args.seed)?
+        };
+        crate::cache_io::export(path, ic.as_ref(), &ctx, &scene, &settings, args.quiet)?;
+    }
     sheet.write(&frame::png_options(args))?;
     if let Some(path) = &args.profile {
         profile.write(path)?;

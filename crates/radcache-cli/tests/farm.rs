@@ -353,5 +353,19 @@ fn a_dry_run_prints_the_jobs_and_bad_requests_are_refused() {
     );
     refused(&["--dry-run", "--", "--qualty", "x"], "--qualty");
     refused(&["--chunk", "0", "--dry-run"], "--chunk");
+    // The prepass job takes the chunks' options: one `cache build` does not accept is refused
+    // before anything is written or submitted.
+    let out = bin()
+        .args(["farm", &cornell, "-o", &pattern, "--frames", "1..8"])
+        .args(["--prepass-every", "4", "--dry-run", "--", "--png"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success()
+            && stderr.contains("radcache cache build")
+            && stderr.contains("--png"),
+        "{stderr}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -3,12 +3,12 @@
 //! bookkeeping pass ([`crate::passes::ic_counters`]) keeps consistent on the GPU, so the host never
 //! reads a count to size a dispatch or a draw.
 
-use radcache_shared::gpu::{DrawArgs, GpuRecord, GpuRecordTemporal, IcCounters};
+use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, GpuRecordTemporal, IcCounters};
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Recorder, ShaderCompiler,
 };
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::passes::ic_counters::{CounterStep, IcCountersPass};
 
 pub use radcache_shared::consts::{GRID_LEVELS, GRID_SLOTS};
@@ -214,6 +214,102 @@ impl IcState {
         ctx.submit(rec)?.wait()?;
         drop(staging);
         Ok(dropped)
+    }
+
+    /// The first `count` records with their temporal states and last-use marks (after the last
+    /// submission's fence).
+    pub fn download(
+        &self,
+        ctx: &Context,
+    ) -> Result<(Vec<GpuRecord>, Vec<GpuRecordTemporal>, Vec<u32>)> {
+        let count = self.read_counters()?.record_count.min(self.record_capacity) as usize;
+        if count == 0 {
+            return Ok(Default::default());
+        }
+        Ok((
+            ctx.read_buffer(&self.records, count)?,
+            ctx.read_buffer(&self.temporal, count)?,
+            ctx.read_buffer(&self.last_used, count)?,
+        ))
+    }
+
+    /// Replaces every record by `records` with their temporal states and last-use marks (equal
+    /// lengths, at most the capacity); the slots after them start as never used, the counters
+    /// say `records.len()` records and no batch. The caller must rebuild the neighbour grid
+    /// before the records are looked up.
+    pub fn upload(
+        &self,
+        ctx: &Context,
+        records: &[GpuRecord],
+        temporal: &[GpuRecordTemporal],
+        last_used: &[u32],
+    ) -> Result<()> {
+        let n = records.len();
+        if temporal.len() != n || last_used.len() != n {
+            return Err(Error::Invalid(format!(
+                "{n} records with {} temporal states and {} marks",
+                temporal.len(),
+                last_used.len()
+            )));
+        }
+        if n > self.record_capacity as usize {
+            return Err(Error::Invalid(format!(
+                "{n} records do not fit in the cache's capacity of {}",
+                self.record_capacity
+            )));
+        }
+        let n = n as u32;
+        let mut rec = ctx.begin("ic.upload")?;
+        rec.barrier(Access::ALL, Access::TRANSFER_WRITE);
+        rec.fill_buffer(&self.last_used, 0, vk::WHOLE_SIZE, 0);
+        let mut staging = Vec::new();
+        if n > 0 {
+            let src = vk::BufferUsageFlags::TRANSFER_SRC;
+            let r = ctx.create_buffer_init("ic.upload.records", src, records)?;
+            let t = ctx.create_buffer_init("ic.upload.temporal", src, temporal)?;
+            let u = ctx.create_buffer_init("ic.upload.last_used", src, last_used)?;
+            rec.copy_buffer(
+                &r,
+                0,
+                &self.records,
+                0,
+                std::mem::size_of_val(records) as u64,
+            );
+            rec.copy_buffer(
+                &t,
+                0,
+                &self.temporal,
+                0,
+                std::mem::size_of_val(temporal) as u64,
+            );
+            // The fill above and this copy both write `last_used`.
+            rec.barrier(Access::TRANSFER_WRITE, Access::TRANSFER_WRITE);
+            rec.copy_buffer(&u, 0, &self.last_used, 0, u64::from(n) * 4);
+            staging.extend([r, t, u]);
+        }
+        let counters = IcCounters {
+            record_count: n,
+            requested: 0,
+            batch_first: n,
+            holes: 0,
+            dispatch: DispatchArgs {
+                x: 0,
+                y: 1,
+                z: 1,
+                pad: 0,
+            },
+            draw: DrawArgs::quads(n, 0),
+            record_capacity: self.record_capacity,
+            request_capacity: self.request_capacity,
+            dropped_requests: 0,
+            rejected_records: 0,
+            batch_draw: DrawArgs::quads(0, 0),
+        };
+        rec.update_buffer(&self.counters, 0, std::slice::from_ref(&counters));
+        rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
+        ctx.submit(rec)?.wait()?;
+        drop(staging);
+        Ok(())
     }
 
     /// The counters after the last submission's fence.

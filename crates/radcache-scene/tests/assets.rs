@@ -268,13 +268,57 @@ fn animated_scene() {
     );
 }
 
+#[test]
+fn cornell_fly_through_moves_only_the_camera() {
+    let paths = bundled();
+    let (s, warnings) = load(&paths[3]);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let (cornell, _) = load(&paths[0]);
+    assert_eq!(s.triangle_count(), cornell.triangle_count());
+    assert_eq!(s.time_range(), Some((0.0, 2.0)));
+    close3(
+        s.camera_at(0.0).position,
+        Vec3::new(0.278, 0.273, -0.8),
+        1e-6,
+    );
+    close3(s.camera_at(2.0).position, Vec3::new(0.2, 0.26, -0.35), 1e-6);
+    let plan = s.plan();
+    assert_eq!(plan.animation.kind, AnimationKind::CameraOnly);
+    assert!(plan.keeps_records());
+    // The same room under another camera: the same content (a cache file of one serves the
+    // other); the animated room is other content.
+    assert_eq!(s.content_hash(), cornell.content_hash());
+    let (animated, _) = load(&paths[2]);
+    assert_ne!(s.content_hash(), animated.content_hash());
+    assert_eq!(s.content_hash(), load(&paths[3]).0.content_hash());
+}
+
+#[test]
+fn the_content_hash_follows_materials_geometry_and_lights() {
+    let (base, _) = load(&bundled()[0]);
+    let hash = base.content_hash();
+    let mut s = base.clone();
+    s.materials[1].base_color.x += 1e-3;
+    assert_ne!(s.content_hash(), hash, "a material's colour");
+    let mut s = base.clone();
+    s.meshes[0].positions[0].y += 1e-4;
+    assert_ne!(s.content_hash(), hash, "a vertex");
+    let mut s = base.clone();
+    s.environment = Environment::Constant(Vec3::splat(0.1));
+    assert_ne!(s.content_hash(), hash, "the environment");
+    let mut s = base.clone();
+    s.path = PathBuf::from("elsewhere/copy.gltf");
+    s.meshes[0].name = Some("renamed".into());
+    assert_eq!(s.content_hash(), hash, "names and the path are not content");
+}
+
 /// Generate-and-check: the committed `assets/` must match the generators' output.
 #[test]
 fn repository_assets_are_up_to_date() {
     let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets");
     let fresh = temp_dir("fresh");
     write_bundled_assets(&fresh).unwrap();
-    for name in ["cornell", "furnace", "animated", "courtyard"] {
+    for name in ["cornell", "furnace", "animated", "cornell_fly", "courtyard"] {
         for ext in ["gltf", "bin"] {
             let rel = format!("{name}/{name}.{ext}");
             let committed = std::fs::read(repo.join(&rel)).unwrap_or_else(|e| {
@@ -293,10 +337,13 @@ fn repository_assets_are_up_to_date() {
 /// a directional sun, a constant sky, and a 5 s camera path over static geometry.
 #[test]
 fn courtyard_is_sponza_class() {
-    let (s, warnings) = load(&bundled()[3]);
+    let (s, warnings) = load(&bundled()[4]);
     assert!(warnings.is_empty(), "{warnings:?}");
     let triangles = s.triangle_count();
-    assert!((100_000..200_000).contains(&triangles), "{triangles} triangles");
+    assert!(
+        (100_000..200_000).contains(&triangles),
+        "{triangles} triangles"
+    );
     assert!(s.meshes.len() >= 50, "{} meshes", s.meshes.len());
     assert!(s.materials.len() >= 8, "{} materials", s.materials.len());
     let bushes = s

@@ -1,7 +1,8 @@
 //! The irradiance cache's frame: [`IcRenderer`] owns the passes, the G-buffer and the cache
 //! state, so a sequence creates its pipelines once and can keep its records from frame to frame.
 //! [`IcRenderer::render`] is the list of the frame's phases (their bodies in `ic/phases.rs`, the
-//! temporal steps in `ic/temporal.rs`); the flow is described in [`crate::frame`].
+//! temporal steps in `ic/temporal.rs`, cache files in `ic/cache.rs`); the flow is described in
+//! [`crate::frame`].
 
 use std::time::Instant;
 
@@ -25,6 +26,7 @@ use crate::passes::temporal::TemporalPass;
 use crate::scene::GpuScene;
 use crate::state::IcState;
 
+mod cache;
 mod phases;
 mod temporal;
 
@@ -49,6 +51,9 @@ pub struct IcRenderer {
     temporal: Option<TemporalPass>,
     /// The previous frame's `clip_from_world` (kept records are re-clamped when it changes).
     last_view: Option<[[f32; 4]; 4]>,
+    /// Re-clamp the kept records at the next frame whatever its view (imported records, made
+    /// for an unknown view: `import_cache`).
+    reclamp_next: bool,
     /// False until a frame has left records to keep.
     has_records: bool,
     /// Frames rendered (the last-use marks of `IcState::last_used`).
@@ -106,6 +111,7 @@ impl IcRenderer {
                 None
             },
             last_view: None,
+            reclamp_next: false,
             has_records: false,
             frames: 0,
         })

@@ -20,8 +20,9 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 
 use super::{write_named, yaw, QuadSoup};
+use crate::animation::{Interpolation, Property};
 use crate::error::Result;
-use crate::writer::{GltfBuilder, MaterialDesc, NodeDesc};
+use crate::writer::{ChannelDesc, GltfBuilder, MaterialDesc, NodeDesc};
 
 /// Vertical field of view of the published camera: 2·atan(0.0125 / 0.035).
 pub const CORNELL_YFOV: f32 = 0.686_047_9;
@@ -283,4 +284,44 @@ pub fn cornell_scaled_builder(scale: f32) -> GltfBuilder {
 /// Writes `dir/cornell/cornell.gltf` (+ `.bin`).
 pub fn write_cornell(dir: &Path) -> Result<PathBuf> {
     write_named(&cornell_builder(), dir, "cornell")
+}
+
+/// Duration of the Cornell box fly-through in seconds.
+pub const CORNELL_FLY_DURATION: f32 = 2.0;
+
+/// The Cornell box with a camera path and nothing else moving (the prepass of `radcache cache
+/// build`): from the published viewpoint the camera moves in to the left, turning right, then
+/// to the right, turning left (LINEAR translation and rotation; keys at 0, 1, 2 s).
+pub fn cornell_fly_builder() -> GltfBuilder {
+    let mut b = GltfBuilder::new();
+    let m = add_materials(&mut b);
+    let mut roots = add_room(&mut b, m);
+    let short = add_block(&mut b, "short_block", &SHORT_BLOCK, m.white);
+    roots.push(node(&mut b, "short_block", short));
+    let camera = add_camera(&mut b, "camera");
+    roots.push(camera);
+    let keys = [0.0, 1.0, CORNELL_FLY_DURATION];
+    let translation = [CAMERA_POSITION, [0.36, 0.30, -0.50], [0.20, 0.26, -0.35]];
+    let rotation = [yaw(180.0), yaw(172.0), yaw(190.0)];
+    let channel = |property, values: Vec<f32>| ChannelDesc {
+        node: camera,
+        property,
+        interpolation: Interpolation::Linear,
+        times: keys.to_vec(),
+        values,
+    };
+    b.add_animation(
+        "fly_through",
+        &[
+            channel(Property::Translation, translation.concat()),
+            channel(Property::Rotation, rotation.concat()),
+        ],
+    );
+    b.add_scene("cornell_fly", &roots, None);
+    b
+}
+
+/// Writes `dir/cornell_fly/cornell_fly.gltf` (+ `.bin`).
+pub fn write_cornell_fly(dir: &Path) -> Result<PathBuf> {
+    write_named(&cornell_fly_builder(), dir, "cornell_fly")
 }

@@ -207,8 +207,16 @@ fn add_building(b: &mut GltfBuilder, m: &Materials, side: f32, nodes: &mut Vec<u
         for c in 0..=COLUMNS {
             let x = -HALF_X + c as f32 * pitch;
             columns.cylinder(x, z, COLUMN_R, y0 + 0.3, spring - 0.25, 16);
-            caps.cuboid(Vec3::new(x, y0 + 0.15, z), Vec3::new(0.38, 0.15, 0.38), false);
-            caps.cuboid(Vec3::new(x, spring - 0.12, z), Vec3::new(0.4, 0.13, 0.4), false);
+            caps.cuboid(
+                Vec3::new(x, y0 + 0.15, z),
+                Vec3::new(0.38, 0.15, 0.38),
+                false,
+            );
+            caps.cuboid(
+                Vec3::new(x, spring - 0.12, z),
+                Vec3::new(0.4, 0.13, 0.4),
+                false,
+            );
         }
         let mut arches = Mesh::default();
         for c in 0..COLUMNS {
@@ -298,7 +306,8 @@ fn bush(c: Vec3, radius: f32, leaves: usize, rng: &mut Rng) -> Mesh {
             continue;
         }
         let p = c + d * Vec3::new(radius, radius * 0.8, radius);
-        let n = (d + 0.3 * Vec3::new(rng.signed(), rng.signed(), rng.signed())).normalize_or(Vec3::Y);
+        let n =
+            (d + 0.3 * Vec3::new(rng.signed(), rng.signed(), rng.signed())).normalize_or(Vec3::Y);
         let t = n.any_orthonormal_vector();
         let s = n.cross(t);
         let size = 0.05 + 0.05 * rng.next();
@@ -320,14 +329,22 @@ fn add_court(b: &mut GltfBuilder, m: &Materials, nodes: &mut Vec<usize>) {
         for j in 0..tiles {
             let x = -HALF_X + i as f32 * 2.0 * HALF_X / strips as f32;
             let z = -HALF_Z - DEPTH + j as f32 * 2.0 * (HALF_Z + DEPTH) / tiles as f32;
-            let (dx, dz) = (2.0 * HALF_X / strips as f32, 2.0 * (HALF_Z + DEPTH) / tiles as f32);
+            let (dx, dz) = (
+                2.0 * HALF_X / strips as f32,
+                2.0 * (HALF_Z + DEPTH) / tiles as f32,
+            );
             let q = [
                 Vec3::new(x, 0.0, z),
                 Vec3::new(x + dx, 0.0, z),
                 Vec3::new(x + dx, 0.0, z + dz),
                 Vec3::new(x, 0.0, z + dz),
             ];
-            if (i + j) % 2 == 0 { &mut light } else { &mut dark }.quad(q, Vec3::Y);
+            if (i + j) % 2 == 0 {
+                &mut light
+            } else {
+                &mut dark
+            }
+            .quad(q, Vec3::Y);
         }
     }
     let mut walls = QuadSoup::default();

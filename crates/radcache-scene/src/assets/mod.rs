@@ -7,6 +7,8 @@
 //!   and turning (LINEAR), a cube bouncing (CUBICSPLINE translation, STEP scale) and a point light;
 //! - `courtyard/courtyard.gltf`: a Sponza-class courtyard (about 125,000 triangles in 54 meshes,
 //!   9 materials, foliage, a sun and a sky, a 5 s camera fly-through; see `courtyard.rs`).
+//! - `cornell_fly/cornell_fly.gltf`: the Cornell box with a 2 s camera path and nothing else
+//!   moving (the static fly-through of `radcache cache build`).
 //!
 //! All are written with [`GltfBuilder`] (`.gltf` + `.bin`), so they are reproducible.
 
@@ -23,7 +25,10 @@ use crate::error::{Error, Result};
 use crate::writer::{BufferLayout, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
 
 pub use animated::{animated_builder, write_animated, ANIMATED_DURATION};
-pub use cornell::{cornell_builder, cornell_scaled_builder, write_cornell, CORNELL_YFOV};
+pub use cornell::{
+    cornell_builder, cornell_fly_builder, cornell_scaled_builder, write_cornell, write_cornell_fly,
+    CORNELL_FLY_DURATION, CORNELL_YFOV,
+};
 pub use courtyard::{courtyard_builder, write_courtyard, COURTYARD_DURATION};
 
 /// Default furnace albedo.
@@ -142,12 +147,13 @@ pub fn write_furnace(dir: &Path, albedo: f32, emission: f32) -> Result<PathBuf> 
 }
 
 /// Writes the bundled assets under `dir` and returns their `.gltf` paths
-/// (cornell, furnace, animated, courtyard).
+/// (cornell, furnace, animated, cornell_fly, courtyard).
 pub fn write_bundled_assets(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(vec![
         write_cornell(dir)?,
         write_furnace(dir, FURNACE_ALBEDO, FURNACE_EMISSION)?,
         write_animated(dir)?,
+        write_cornell_fly(dir)?,
         write_courtyard(dir)?,
     ])
 }

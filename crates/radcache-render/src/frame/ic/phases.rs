@@ -113,8 +113,9 @@ impl IcRenderer {
         }
         // Kept records take the radius clamp of the new view when the camera moved.
         let clip = gpu.constants().clip_from_world;
-        let view_changed = self.last_view.is_some_and(|v| v != clip);
+        let view_changed = self.reclamp_next || self.last_view.is_some_and(|v| v != clip);
         self.last_view = Some(clip);
+        self.reclamp_next = false;
         if let Some(t) = self.temporal.as_mut() {
             if !self.has_records {
                 t.forget();

@@ -1,0 +1,242 @@
+//! Cache files: a round trip keeps every record bit for bit, and each refusal class (not a cache
+//! file, another version, truncated, corrupted, another scene, other parameters or settings, too
+//! many records) gives its own error naming the file, never a panic.
+
+use std::path::{Path, PathBuf};
+
+use radcache_cache::cache_file::{
+    CacheFile, CacheFileError, CacheIdentity, CacheRecords, CacheSettings, Refusal, HEADER_LEN,
+};
+use radcache_cache::IcParams;
+use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
+
+fn identity() -> CacheIdentity {
+    CacheIdentity {
+        scene_hash: 0x1234_5678_9abc_def0,
+        settings: CacheSettings {
+            width: 64,
+            height: 48,
+            time_step_s: 0.0,
+        },
+        params: IcParams::draft(),
+    }
+}
+
+/// `n` records whose every word differs (including NaN bit patterns, kept as bits).
+fn records(n: usize) -> CacheRecords {
+    let word =
+        |i: usize, k: usize| (i * 1000 + k) as u32 ^ (0x7fc0_0000 * k.is_multiple_of(7) as u32);
+    let mut records = Vec::new();
+    let mut temporal = Vec::new();
+    for i in 0..n {
+        let mut r: GpuRecord = bytemuck::Zeroable::zeroed();
+        let w: &mut [u32] = bytemuck::cast_slice_mut(std::slice::from_mut(&mut r));
+        w.iter_mut().enumerate().for_each(|(k, w)| *w = word(i, k));
+        records.push(r);
+        let mut t: GpuRecordTemporal = bytemuck::Zeroable::zeroed();
+        let w: &mut [u32] = bytemuck::cast_slice_mut(std::slice::from_mut(&mut t));
+        w.iter_mut()
+            .enumerate()
+            .for_each(|(k, w)| *w = word(i, k + 100));
+        temporal.push(t);
+    }
+    CacheRecords {
+        records,
+        temporal,
+        last_used: (0..n as u32).map(|i| i % 5).collect(),
+        frames: 7,
+        lifespans: false,
+    }
+}
+
+fn dir() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("radcache-cache-file-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn write(name: &str, bytes: &[u8]) -> PathBuf {
+    let path = dir().join(name);
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
+
+fn bytes(n: usize) -> Vec<u8> {
+    CacheFile::new(identity(), records(n)).encode()
+}
+
+/// Loads `path` for `identity()` with room for 100 records; the error must name the file.
+fn refusal(path: &Path, id: &CacheIdentity) -> (Refusal, String) {
+    let err = CacheFile::load(path, id, 100).unwrap_err();
+    let text = err.to_string();
+    assert!(text.contains(&path.display().to_string()), "{text}");
+    match err {
+        CacheFileError::Refused { refusal, .. } => (refusal, text),
+        other => panic!("not a refusal: {other}"),
+    }
+}
+
+#[test]
+fn a_round_trip_keeps_every_record_bit_for_bit() {
+    let original = records(9);
+    let path = write("round.rcache", &bytes(9));
+    let file = CacheFile::load(&path, &identity(), 9).unwrap();
+    assert_eq!(file.header.record_count, 9);
+    assert_eq!(file.header.identity, identity());
+    let same = |a: &[u8], b: &[u8]| a == b;
+    assert!(same(
+        bytemuck::cast_slice(&file.records.records),
+        bytemuck::cast_slice(&original.records)
+    ));
+    assert!(same(
+        bytemuck::cast_slice(&file.records.temporal),
+        bytemuck::cast_slice(&original.temporal)
+    ));
+    assert_eq!(file.records.last_used, original.last_used);
+    assert_eq!((file.records.frames, file.records.lifespans), (7, false));
+    // An empty cache is a valid file too.
+    let empty = CacheFile::decode(&bytes(0)).unwrap();
+    assert_eq!(empty.header.record_count, 0);
+    assert_eq!(bytes(0).len(), HEADER_LEN);
+    let text = file.header.describe();
+    assert!(
+        text.contains("records: 9") && text.contains("strata_m: 8"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_file_that_is_not_a_cache_file_is_refused() {
+    let path = write("not.rcache", b"glTF this is something else entirely");
+    let (r, text) = refusal(&path, &identity());
+    assert!(matches!(r, Refusal::NotACacheFile), "{text}");
+    assert!(text.contains("not a radcache cache file"), "{text}");
+}
+
+#[test]
+fn another_format_version_is_refused() {
+    let mut b = bytes(3);
+    b[8..12].copy_from_slice(&2u32.to_le_bytes());
+    let (r, text) = refusal(&write("version.rcache", &b), &identity());
+    assert!(
+        matches!(
+            r,
+            Refusal::Version {
+                found: 2,
+                supported: 1
+            }
+        ),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_truncated_file_is_refused_wherever_it_was_cut() {
+    let b = bytes(3);
+    for cut in [0, 5, 10, HEADER_LEN - 1, HEADER_LEN, b.len() - 1] {
+        let path = write(&format!("cut{cut}.rcache"), &b[..cut]);
+        let (r, text) = refusal(&path, &identity());
+        assert!(
+            matches!(r, Refusal::Truncated { .. }),
+            "cut at {cut}: {text}"
+        );
+        assert!(text.contains("truncated"), "{text}");
+    }
+}
+
+#[test]
+fn a_corrupted_file_is_refused() {
+    let b = bytes(3);
+    // A flipped bit anywhere after the version: in the header (its checksum), in a record, in a
+    // temporal state, in a mark; and bytes appended after the records.
+    for at in [
+        13,
+        40,
+        90,
+        HEADER_LEN + 5,
+        HEADER_LEN + 3 * 176 + 20,
+        b.len() - 2,
+    ] {
+        let mut c = b.clone();
+        c[at] ^= 0x10;
+        let (r, text) = refusal(&write(&format!("flip{at}.rcache"), &c), &identity());
+        assert!(matches!(r, Refusal::Corrupt(_)), "bit at {at}: {text}");
+        assert!(text.contains("corrupted"), "{text}");
+    }
+    let mut c = b.clone();
+    c.extend_from_slice(&[0; 4]);
+    let (r, text) = refusal(&write("long.rcache", &c), &identity());
+    assert!(matches!(r, Refusal::Corrupt(_)), "{text}");
+}
+
+#[test]
+fn a_file_of_another_scene_is_refused() {
+    let path = write("scene.rcache", &bytes(3));
+    let other = CacheIdentity {
+        scene_hash: 42,
+        ..identity()
+    };
+    let (r, text) = refusal(&path, &other);
+    assert!(matches!(r, Refusal::OtherScene { scene: 42, .. }), "{text}");
+    assert!(text.contains("another scene"), "{text}");
+}
+
+#[test]
+fn other_cache_parameters_are_refused_by_name() {
+    let path = write("params.rcache", &bytes(3));
+    let mut other = identity();
+    other.params.accuracy = 0.2;
+    other.params.strata_n = 30;
+    let (r, text) = refusal(&path, &other);
+    assert!(matches!(r, Refusal::OtherParams(_)), "{text}");
+    assert!(
+        text.contains("accuracy 0.3 (this render: 0.2)") && text.contains("strata_n 24"),
+        "{text}"
+    );
+    let mut preset = identity();
+    preset.params = IcParams::default();
+    assert!(matches!(refusal(&path, &preset).0, Refusal::OtherParams(_)));
+}
+
+#[test]
+fn other_settings_are_refused() {
+    let path = write("settings.rcache", &bytes(3));
+    let mut other = identity();
+    other.settings.width = 128;
+    let (r, text) = refusal(&path, &other);
+    assert!(matches!(r, Refusal::OtherSettings(_)), "{text}");
+    assert!(
+        text.contains("made at 64x48, this render is 128x48"),
+        "{text}"
+    );
+    let mut other = identity();
+    other.settings.time_step_s = 1.0 / 24.0;
+    assert!(matches!(
+        refusal(&path, &other).0,
+        Refusal::OtherSettings(_)
+    ));
+}
+
+#[test]
+fn more_records_than_the_capacity_are_refused() {
+    let path = write("many.rcache", &bytes(101));
+    let (r, text) = refusal(&path, &identity());
+    assert!(
+        matches!(
+            r,
+            Refusal::TooManyRecords {
+                count: 101,
+                capacity: 100
+            }
+        ),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_missing_file_is_an_io_error_naming_it() {
+    let path = dir().join("absent.rcache");
+    let err = CacheFile::read(&path).unwrap_err();
+    assert!(matches!(err, CacheFileError::Io { .. }));
+    assert!(err.to_string().contains("absent.rcache"), "{err}");
+}
