@@ -260,11 +260,6 @@ pub fn run(args: &FarmArgs) -> Result<ExitCode> {
     let plan = scene.plan();
     let keeps_cache = render.method == Method::Ic && !render.no_temporal;
     let moving = plan.animation.kind != AnimationKind::None;
-    let warm_up = match args.warm_up {
-        Some(k) => k,
-        None if moving && keeps_cache => DEFAULT_WARM_UP,
-        None => 0,
-    };
     let prepass = match args.prepass_every {
         None => None,
         Some(0) => bail!("--prepass-every must be at least 1"),
@@ -293,6 +288,13 @@ pub fn run(args: &FarmArgs) -> Result<ExitCode> {
             })?;
             Some(n)
         }
+    };
+    // With a prepass every chunk starts from the same records (the scene's geometry is static),
+    // so a warm-up would only repeat work.
+    let warm_up = match args.warm_up {
+        Some(k) => k,
+        None if moving && keeps_cache && prepass.is_none() => DEFAULT_WARM_UP,
+        None => 0,
     };
     let missing = layout.missing()?;
     let mut chunks: Vec<u32> = missing.iter().map(|&f| layout.chunk_of(f)).collect();

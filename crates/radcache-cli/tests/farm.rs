@@ -337,6 +337,30 @@ fn a_dry_run_prints_the_jobs_and_bad_requests_are_refused() {
     }
     assert!(!dir.join(".farm").exists(), "a dry run writes nothing");
 
+    // A camera path over static geometry warms up each chunk, unless a prepass gives every
+    // chunk the same records.
+    let fly = text(&repo().join("assets/cornell_fly/cornell_fly.gltf"));
+    let dry = |extra: &[&str]| {
+        let out = bin()
+            .args([
+                "farm", &fly, "-o", &pattern, "--frames", "1..12", "--chunk", "6",
+            ])
+            .args(extra)
+            .args(["--dry-run", "--", "--resolution", "32x32"])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).to_string()
+    };
+    assert!(dry(&[]).contains("warm-up 24 frames per chunk (plan: CameraOnly)"));
+    assert!(
+        dry(&["--prepass-every", "4"]).contains("warm-up 0 frames per chunk (plan: CameraOnly)")
+    );
+
     let refused = |extra: &[&str], cause: &str| {
         let out = bin()
             .args(["farm", &animated(), "-o", &pattern, "--frames", "1..4"])
