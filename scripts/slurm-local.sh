@@ -9,8 +9,11 @@
 #   scripts/slurm-local.sh stop     stop the daemons (nothing is left running)
 #
 # Needs root. Idempotent: `start` on a running cluster with an unchanged configuration only
-# checks it; a changed configuration restarts it. Facts it relies on: ../shared/docs/slurm.md
-# of the project's notes (Debian 12, Slurm 22.05).
+# checks it; a changed configuration restarts it. Facts it relies on (Debian 12, Slurm 22.05,
+# measured): without systemd /run/munge must be created and munged started as the munge user;
+# slurmctld and slurmd daemonize themselves and write their pid files; exited daemons can linger
+# as zombies, so a pid is trusted only after /proc/PID/stat and /proc/PID/comm are checked;
+# cgroup plugins may not work in containers (proctrack/linuxproc, task/none).
 set -euo pipefail
 
 CONF=/etc/slurm/slurm.conf
