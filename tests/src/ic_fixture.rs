@@ -248,3 +248,32 @@ pub fn faces_scene() -> Scene {
     b.add_scene("faces", &roots, None);
     write_and_load(&b, &temp_dir("ic-passes-faces"), "faces")
 }
+
+/// Records clearing `g` and writing `count` surface points from `texels` into its position,
+/// normal and geometric images with the `shaders/tests/gbuffer_fill.comp` pipeline `fill`
+/// (bindings 0–2 the images, 3 the texels; push constant: the count).
+pub fn fill_gbuffer_points(
+    rec: &mut radcache_vk::Recorder,
+    fill: &radcache_vk::Pipeline,
+    g: &radcache_render::GBuffer,
+    texels: &radcache_vk::Buffer,
+    count: u32,
+) {
+    use radcache_vk::{ImageUse, Resource};
+    for image in g.images() {
+        rec.use_image(image, ImageUse::TransferDst);
+        rec.clear_color(image, [0.0; 4]);
+    }
+    for image in [&g.position, &g.normal, &g.geometric] {
+        rec.use_image(image, ImageUse::ComputeStorage);
+    }
+    rec.bind_pipeline(fill);
+    rec.push_bindings(&[
+        (0, Resource::StorageImage(&g.position)),
+        (1, Resource::StorageImage(&g.normal)),
+        (2, Resource::StorageImage(&g.geometric)),
+        (3, Resource::Buffer(texels)),
+    ]);
+    rec.push_constants(&count);
+    rec.dispatch(1, 1, 1).unwrap();
+}

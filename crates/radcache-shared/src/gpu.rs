@@ -238,6 +238,26 @@ gpu_struct! {
     }
 }
 
+impl IcCounters {
+    /// The counters after a reset (`CounterStep::Reset` in `shaders/passes/ic_counters.comp`): no
+    /// records, no requests, nothing dropped, empty draws.
+    pub const fn reset(record_capacity: u32, request_capacity: u32) -> IcCounters {
+        IcCounters {
+            record_count: 0,
+            requested: 0,
+            batch_first: 0,
+            holes: 0,
+            dispatch: DispatchArgs::groups(0),
+            draw: DrawArgs::quads(0, 0),
+            record_capacity,
+            request_capacity,
+            dropped_requests: 0,
+            rejected_records: 0,
+            batch_draw: DrawArgs::quads(0, 0),
+        }
+    }
+}
+
 gpu_struct! {
     /// A record's temporal state (temporal radiance caching, docs/temporal.md §3.1), 96 bytes, kept
     /// beside its `GpuRecord` (same index). The record lives on its mesh instance: its point and
