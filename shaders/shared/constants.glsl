@@ -56,4 +56,16 @@ const uint TWIN_RADIUS = 3u;
 const uint TWIN_RECORD = 4u;
 const uint TWIN_TEMPORAL = 5u;
 
+const float ALPHA_MIN = 0.001;
+const float COS_MIN = 1e-6;
+const float SMITH_LAMBDA_MASKED = 3.4028235e38;
+const float SCHLICK_MEAN_C0 = 8.2245e-5;
+const float SCHLICK_MEAN_C1 = 0.00201882;
+const float SCHLICK_MEAN_C2 = 0.00931768;
+const float SCHLICK_MEAN_C3 = 0.00777722;
+const float SCHLICK_MEAN_C4 = 0.00896681;
+
+const uint BRDF_TWIN_TERMS = 0u;
+const uint BRDF_TWIN_BRDF = 1u;
+
 #endif

@@ -1,12 +1,42 @@
-//! The harness of the GLSL twin test (`tests/tests/ircache_glsl.rs`): rows of inputs, their
-//! expected outputs and how each lane is compared, run through `shaders/tests/ircache_twin.comp`.
+//! The harness of the GLSL twin tests (`tests/tests/ircache_glsl.rs`, `tests/tests/brdf_glsl.rs`):
+//! rows of inputs, their expected outputs and how each lane is compared, run through a twin shader
+//! (`shaders/tests/ircache_twin.comp`, `shaders/tests/brdf_twin.comp`).
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use radcache_vk::{vk, Access, Context, Pipeline, Resource};
 
 use crate::Rng;
-pub use radcache_shared::consts::TwinMode;
+pub use radcache_shared::consts::{BrdfTwinMode, TwinMode};
+
+/// A twin shader's mode (its push constant `mode`).
+pub trait ShaderMode: Copy {
+    /// The value of the push constant.
+    fn bits(self) -> u32;
+}
+
+impl ShaderMode for TwinMode {
+    fn bits(self) -> u32 {
+        self as u32
+    }
+}
+
+impl ShaderMode for BrdfTwinMode {
+    fn bits(self) -> u32 {
+        self as u32
+    }
+}
+
+/// The largest differences seen in one output lane of a family (compared lanes only).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LaneDiff {
+    /// Largest `|gpu − cpu|`.
+    pub abs: f32,
+    /// Largest `|gpu − cpu| / |cpu|` over the values with `|cpu| >= 1e-6`.
+    pub rel: f32,
+    /// Largest fraction of the tolerance used: `|gpu − cpu| / (1e-5 · max(|cpu|, scale) + 1e-6)`.
+    pub of_tolerance: f32,
+}
 
 /// 16 vec4 of inputs or outputs (uints as float bits, booleans as 0/1).
 pub type Row = [[f32; 4]; 16];
@@ -118,8 +148,25 @@ pub fn vec(rng: &mut Rng, s: f32) -> Vec3 {
 }
 
 /// Runs one family through the twin shader in `mode` and compares every expected lane.
-pub fn check(ctx: &Context, pl: &Pipeline, mode: TwinMode, cases: &[Case], samples: &[[f32; 4]]) {
-    let mode = mode as u32;
+pub fn check(
+    ctx: &Context,
+    pl: &Pipeline,
+    mode: impl ShaderMode,
+    cases: &[Case],
+    samples: &[[f32; 4]],
+) {
+    check_diffs(ctx, pl, mode, cases, samples);
+}
+
+/// [`check`], returning the largest differences per output lane (`[slot][lane]`).
+pub fn check_diffs(
+    ctx: &Context,
+    pl: &Pipeline,
+    mode: impl ShaderMode,
+    cases: &[Case],
+    samples: &[[f32; 4]],
+) -> [[LaneDiff; 4]; 16] {
+    let mode = mode.bits();
     let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
     let rows: Vec<Row> = cases.iter().map(|c| c.0).collect();
     let inputs = ctx.create_buffer_init("twin.in", storage, &rows).unwrap();
@@ -128,7 +175,7 @@ pub fn check(ctx: &Context, pl: &Pipeline, mode: TwinMode, cases: &[Case], sampl
     let outputs = ctx.create_buffer_init("twin.out", storage, &rows).unwrap();
     let count = rows.len() as u32;
     let mut rec = ctx.begin("twin").unwrap();
-    rec.pass("ircache_twin", |rec| {
+    rec.pass("twin", |rec| {
         rec.bind_pipeline(pl);
         rec.push_bindings(&[
             (0, Resource::Buffer(&inputs)),
@@ -143,6 +190,7 @@ pub fn check(ctx: &Context, pl: &Pipeline, mode: TwinMode, cases: &[Case], sampl
     ctx.submit(rec).unwrap().wait().unwrap();
     let out: Vec<Row> = ctx.read_buffer(&outputs, rows.len()).unwrap();
     let (mut failures, mut compared, mut ties) = (Vec::new(), 0usize, 0usize);
+    let mut diffs = [[LaneDiff::default(); 4]; 16];
     for (r, ((_, e), o)) in cases.iter().zip(&out).enumerate() {
         for (slot, lane) in (0..16).flat_map(|s| (0..4).map(move |l| (s, l))) {
             let (gpu, cpu) = (o[slot][lane], e.v[slot][lane]);
@@ -156,6 +204,17 @@ pub fn check(ctx: &Context, pl: &Pipeline, mode: TwinMode, cases: &[Case], sampl
                 How::Near(s) => gpu == cpu || (gpu - cpu).abs() <= 1e-5 * cpu.abs().max(s) + 1e-6,
             };
             compared += 1;
+            let d = &mut diffs[slot][lane];
+            d.abs = d.abs.max((gpu - cpu).abs());
+            if let How::Near(scale) = e.how[slot][lane] {
+                let diff = (gpu - cpu).abs();
+                if cpu.abs() >= 1e-6 {
+                    d.rel = d.rel.max(diff / cpu.abs());
+                }
+                d.of_tolerance = d
+                    .of_tolerance
+                    .max(diff / (1e-5 * cpu.abs().max(scale) + 1e-6));
+            }
             if !ok {
                 let (how, at) = (e.how[slot][lane], format!("row {r} out[{slot}][{lane}]"));
                 failures.push(format!("{at}: GPU {gpu:e}, CPU {cpu:e} ({how:?})"));
@@ -166,4 +225,5 @@ pub fn check(ctx: &Context, pl: &Pipeline, mode: TwinMode, cases: &[Case], sampl
     assert!(compared > 0 && ties * 50 <= compared, "{ties} ties");
     let shown = failures[..failures.len().min(25)].join("\n");
     assert!(failures.is_empty(), "mode {mode}:\n{shown}");
+    diffs
 }

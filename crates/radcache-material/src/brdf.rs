@@ -7,8 +7,11 @@ use crate::ggx::{alpha_from_roughness, ggx_d, smith_v_correlated};
 
 /// Cosines to the normal below this value count as "at or below the horizon": the BRDF, its pdf
 /// and the sample weights are 0 there. It bounds `V ≤ 0.5/(2·COS_MIN·α)` and so keeps every
-/// value finite in f32 (§4.3).
-pub const COS_MIN: f32 = 1.0e-6;
+/// value finite in f32 (§4.3). Declared in `radcache_shared::consts` (generated for GLSL).
+pub use radcache_shared::consts::COS_MIN;
+use radcache_shared::consts::{
+    SCHLICK_MEAN_C0, SCHLICK_MEAN_C1, SCHLICK_MEAN_C2, SCHLICK_MEAN_C3, SCHLICK_MEAN_C4,
+};
 
 /// One material's parameters at a shading point: the glTF metallic-roughness factors (after
 /// textures), `KHR_materials_ior`'s `ior` and `KHR_materials_specular`'s `specular` /
@@ -112,7 +115,14 @@ pub fn brdf_eval(m: &Material, v: Vec3, l: Vec3) -> Vec3 {
 
 /// Coefficients of [`schlick_hemispherical_mean`] in `t = 1 − n·v`, lowest power first
 /// (least-squares fit, maximum error 8·10⁻⁶ over `n·v ∈ [0, 1]`; §6).
-const SCHLICK_MEAN_COEFFS: [f32; 5] = [8.2245e-5, 2.01882e-3, 9.31768e-3, 7.77722e-3, 8.96681e-3];
+/// `SCHLICK_MEAN_C0..C4` are declared in `radcache_shared::consts` (generated for GLSL).
+const SCHLICK_MEAN_COEFFS: [f32; 5] = [
+    SCHLICK_MEAN_C0,
+    SCHLICK_MEAN_C1,
+    SCHLICK_MEAN_C2,
+    SCHLICK_MEAN_C3,
+    SCHLICK_MEAN_C4,
+];
 
 /// `W(n·v) = ∫ (1 − v·h)^5 (n·l)/π dl` over the upper hemisphere, `h = normalize(v + l)`: the
 /// cosine-weighted mean of Schlick's weight over all light directions, by the degree-4 fit

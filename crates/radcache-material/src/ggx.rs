@@ -5,7 +5,9 @@ use glam::Vec3;
 
 /// Smallest α used: glTF roughness 0 (a perfect mirror) is clamped to this value so that D,
 /// the pdf and the sample weights stay finite (the peak of D is `1/(π α²) ≈ 3.2·10⁵`).
-pub const ALPHA_MIN: f32 = 1.0e-3;
+/// Declared in `radcache_shared::consts` (generated for GLSL).
+pub use radcache_shared::consts::ALPHA_MIN;
+use radcache_shared::consts::SMITH_LAMBDA_MASKED;
 
 /// `α = roughness²` (glTF Appendix B), with roughness clamped to `[0, 1]` and α to
 /// [`ALPHA_MIN`] from below.
@@ -38,10 +40,11 @@ fn smith_root(alpha: f32, cos_theta: f32) -> f32 {
 }
 
 /// Smith's Λ for GGX: `Λ(ω) = (−1 + sqrt(1 + α² tan²θ))/2 = (sqrt(α² + (1 − α²)c²)/c − 1)/2`,
-/// `c = cosθ > 0` (Heitz 2014, GGX case). Returns `f32::MAX` for `c <= 0` (fully masked).
+/// `c = cosθ > 0` (Heitz 2014, GGX case). Returns `SMITH_LAMBDA_MASKED = f32::MAX` for `c <= 0`
+/// (fully masked).
 pub fn smith_lambda(alpha: f32, cos_theta: f32) -> f32 {
     if cos_theta <= 0.0 {
-        return f32::MAX;
+        return SMITH_LAMBDA_MASKED;
     }
     0.5 * (smith_root(alpha, cos_theta) / cos_theta - 1.0)
 }

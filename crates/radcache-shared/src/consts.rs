@@ -179,6 +179,30 @@ const _: () = assert!(GRID_SLOTS == GRID_LEVELS + 1);
 const _: () = assert!(RECORD_FLAG_FOLDED <= RECORD_FLAGS_MASK);
 const _: () = assert!(RECORD_FLAGS_MASK == (1 << RECORD_INSTANCE_SHIFT) - 1);
 
+gpu_consts! {
+    /// The BRDF constants' GLSL (`radcache-material` and `shaders/common/brdf.glsl` use the same).
+    fn material_glsl;
+    /// Smallest GGX α used: glTF roughness 0 (a perfect mirror) is clamped to this value so that
+    /// D, the pdf and the sample weights stay finite (the peak of D is `1/(π α²) ≈ 3.2·10⁵`).
+    pub const ALPHA_MIN: f32 = 1.0e-3;
+    /// Cosines to the normal below this value count as "at or below the horizon": the BRDF, its
+    /// pdf and the sample weights are 0 there (it bounds `V ≤ 0.5/(2·COS_MIN·α)`).
+    pub const COS_MIN: f32 = 1.0e-6;
+    /// Smith's Λ of a fully masked direction (`cos θ <= 0`): the largest finite f32.
+    pub const SMITH_LAMBDA_MASKED: f32 = f32::MAX;
+    /// Coefficients of the fit of Schlick's hemispherical mean `W(n·v)` in `t = 1 − n·v`,
+    /// lowest power first (least-squares fit, maximum error 8·10⁻⁶; docs/materials.md §6).
+    pub const SCHLICK_MEAN_C0: f32 = 8.2245e-5;
+    /// See [`SCHLICK_MEAN_C0`].
+    pub const SCHLICK_MEAN_C1: f32 = 2.01882e-3;
+    /// See [`SCHLICK_MEAN_C0`].
+    pub const SCHLICK_MEAN_C2: f32 = 9.31768e-3;
+    /// See [`SCHLICK_MEAN_C0`].
+    pub const SCHLICK_MEAN_C3: f32 = 7.77722e-3;
+    /// See [`SCHLICK_MEAN_C0`].
+    pub const SCHLICK_MEAN_C4: f32 = 8.96681e-3;
+}
+
 gpu_enum! {
     /// The steps of the cache's counter bookkeeping (`shaders/passes/ic_counters.comp`).
     pub enum CounterStep("COUNTERS") {
@@ -236,6 +260,16 @@ gpu_enum! {
 }
 
 gpu_enum! {
+    /// The function families of the BRDF's GLSL twin test (`shaders/tests/brdf_twin.comp`).
+    pub enum BrdfTwinMode("BRDF_TWIN") {
+        /// Fresnel, GGX and Smith terms.
+        Terms = 0,
+        /// Evaluation, diffuse share, sampling and pdfs of a material.
+        Brdf = 1,
+    }
+}
+
+gpu_enum! {
     /// The formula families of the GLSL twin test (`shaders/tests/ircache_twin.comp`).
     pub enum TwinMode("TWIN") {
         /// Stratified hemisphere sampling and hashing.
@@ -267,6 +301,8 @@ pub fn generated_glsl() -> String {
         TemporalStep::glsl(),
         RecordSource::glsl(),
         TwinMode::glsl(),
+        material_glsl(),
+        BrdfTwinMode::glsl(),
     ] {
         s.push_str(&part);
         s.push('\n');

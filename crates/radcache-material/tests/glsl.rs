@@ -1,0 +1,186 @@
+//! Checks that `shaders/common/brdf.glsl` stays the twin of this crate (`docs/materials.md`: a
+//! GLSL twin mirrors the crate function by function, same names, argument order and guards):
+//! * every top-level function of `src/` has a GLSL function of the same name and the same number
+//!   of arguments, and vice versa (the exceptions are listed with their reasons); the values are
+//!   compared on the GPU by `tests/tests/brdf_glsl.rs`;
+//! * the constants come from the generated `shaders/shared/constants.glsl`, none is hand-copied;
+//! * the file compiles with `glslangValidator` (Vulkan 1.2 target; `scripts/setup.sh` installs
+//!   it with `glslang-tools`), included twice (its guard): a machine without the tool fails.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// Rust functions whose GLSL twin has another name, and why.
+const RENAMED: [(&str, &str, &str); 1] = [(
+    "reflect",
+    "brdf_reflect",
+    "GLSL's built-in reflect(I, N) = I − 2(N·I)N is the negative of the Rust one",
+)];
+
+/// GLSL helpers with no function of their own in the crate, and what they mirror.
+const GLSL_ONLY: [(&str, &str); 1] = [("brdf_normalize_or_z", "glam's `normalize_or(Vec3::Z)`")];
+
+fn crate_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn glsl_path() -> PathBuf {
+    crate_dir().join("../../shaders/common/brdf.glsl")
+}
+
+fn arity(args: &str) -> usize {
+    args.split(',').filter(|a| !a.trim().is_empty()).count()
+}
+
+/// Top-level functions (public or not) of `src/*.rs` and their argument counts.
+fn rust_functions() -> BTreeMap<String, usize> {
+    let mut out = BTreeMap::new();
+    for entry in std::fs::read_dir(crate_dir().join("src")).unwrap() {
+        let text = std::fs::read_to_string(entry.unwrap().path()).unwrap();
+        for prefix in ["\npub fn ", "\nfn "] {
+            for (pos, _) in text.match_indices(prefix) {
+                let sig = &text[pos + prefix.len()..];
+                let open = sig.find('(').unwrap();
+                let close = open + sig[open..].find(')').unwrap();
+                out.insert(sig[..open].to_string(), arity(&sig[open + 1..close]));
+            }
+        }
+    }
+    out
+}
+
+/// Functions defined at the top level of the GLSL file and their argument counts.
+fn glsl_functions(text: &str) -> BTreeMap<String, usize> {
+    let mut out = BTreeMap::new();
+    for ty in [
+        "float",
+        "vec3",
+        "vec4",
+        "uint",
+        "bool",
+        "void",
+        "BrdfLobes",
+        "BrdfSample",
+    ] {
+        for (pos, _) in text.match_indices(&format!("\n{ty} ")) {
+            let rest = &text[pos + ty.len() + 2..];
+            let Some(paren) = rest.find('(') else {
+                continue;
+            };
+            let name = &rest[..paren];
+            if name.contains(' ') || name.contains('=') || name.contains('\n') {
+                continue; // a declaration, not a function
+            }
+            let close = paren + rest[paren..].find(')').unwrap();
+            out.insert(name.to_string(), arity(&rest[paren + 1..close]));
+        }
+    }
+    out
+}
+
+#[test]
+fn every_rust_function_has_a_glsl_twin() {
+    let text = std::fs::read_to_string(glsl_path()).expect("shaders/common/brdf.glsl");
+    assert!(
+        text.starts_with("// common/brdf.glsl — Rust: crates/radcache-material/src/*.rs"),
+        "brdf.glsl must name its CPU twin on its first line"
+    );
+    let glsl = glsl_functions(&text);
+    let rust = rust_functions();
+    assert!(
+        rust.len() >= 20 && glsl.len() >= 20,
+        "parsers found too little: {} / {}",
+        rust.len(),
+        glsl.len()
+    );
+    for (name, arity) in &rust {
+        let twin = RENAMED
+            .iter()
+            .find(|(r, _, _)| r == name)
+            .map_or(name.as_str(), |(_, g, _)| g);
+        let g = glsl
+            .get(twin)
+            .unwrap_or_else(|| panic!("no GLSL twin `{twin}` for `{name}`"));
+        assert_eq!(g, arity, "`{name}`: GLSL takes {g} arguments, Rust {arity}");
+    }
+    for name in glsl.keys() {
+        let known = rust.contains_key(name)
+            || RENAMED.iter().any(|(_, g, _)| g == name)
+            || GLSL_ONLY.iter().any(|(g, _)| g == name);
+        assert!(known, "GLSL `{name}` has no Rust reference");
+    }
+    for (rust_name, glsl_name, _) in RENAMED {
+        assert!(rust.contains_key(rust_name) && !glsl.contains_key(rust_name));
+        assert!(glsl.contains_key(glsl_name));
+    }
+}
+
+/// The constants are generated into `shaders/shared/constants.glsl` from
+/// `radcache_shared::consts` (which this crate re-exports): the twin includes that file and
+/// hand-copies none of them.
+#[test]
+fn constants_are_generated_not_copied() {
+    let text = std::fs::read_to_string(glsl_path()).unwrap();
+    assert!(
+        text.contains("#include \"../shared/constants.glsl\""),
+        "brdf.glsl must include the generated constants"
+    );
+    let generated = radcache_shared::consts::generated_glsl();
+    for name in [
+        "ALPHA_MIN",
+        "COS_MIN",
+        "SMITH_LAMBDA_MASKED",
+        "SCHLICK_MEAN_C0",
+        "SCHLICK_MEAN_C1",
+        "SCHLICK_MEAN_C2",
+        "SCHLICK_MEAN_C3",
+        "SCHLICK_MEAN_C4",
+    ] {
+        let key = format!(" {name} = ");
+        assert!(!text.contains(&key), "brdf.glsl hand-copies {name}");
+        assert!(generated.contains(&key), "constants.glsl lacks {name}");
+        assert!(text.contains(name), "brdf.glsl does not use {name}");
+    }
+    assert_eq!(radcache_material::ggx::ALPHA_MIN, 1.0e-3);
+    assert_eq!(radcache_material::brdf::COS_MIN, 1.0e-6);
+}
+
+#[test]
+fn glsl_compiles() {
+    let out = std::process::Command::new("glslangValidator")
+        .arg("--version")
+        .output()
+        .unwrap_or_else(|e| {
+            panic!("glslangValidator not found ({e}): install glslang-tools (run scripts/setup.sh)")
+        });
+    assert!(
+        out.status.success(),
+        "glslangValidator --version failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let dir = std::env::temp_dir().join(format!("radcache-material-glsl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let wrapper = dir.join("wrap.comp");
+    std::fs::write(
+        &wrapper,
+        "#version 460\n#extension GL_GOOGLE_include_directive : require\n#include \"brdf.glsl\"\n\
+         #include \"brdf.glsl\"\nlayout(local_size_x = 1) in;\n\
+         layout(std430, binding = 0) buffer Out { vec4 v[]; } o;\n\
+         void main() { Material m = Material(vec3(1.0), 1.0, 0.5, 1.5, 1.0, vec3(1.0));\n\
+         BrdfSample s = brdf_sample(m, vec3(0.0, 0.6, 0.8), vec3(0.3, 0.7, 0.1));\n\
+         o.v[0] = vec4(s.weight, s.pdf); }\n",
+    )
+    .unwrap();
+    let include = format!("-I{}", glsl_path().parent().unwrap().display());
+    let spv = dir.join("wrap.spv");
+    let res = std::process::Command::new("glslangValidator")
+        .args(["-V", "--target-env", "vulkan1.2", &include, "-o"])
+        .arg(&spv)
+        .arg(&wrapper)
+        .output()
+        .unwrap();
+    let log =
+        String::from_utf8_lossy(&res.stdout).to_string() + &String::from_utf8_lossy(&res.stderr);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(res.status.success(), "glslangValidator failed:\n{log}");
+}
