@@ -277,3 +277,19 @@ pub fn fill_gbuffer_points(
     rec.push_constants(&count);
     rec.dispatch(1, 1, 1).unwrap();
 }
+
+/// The settings of a small sequence frame that keeps its records (`size`², draft, 4 sub-frames
+/// of 4 direct samples, records settled so a static frame creates none) at `time`, frame `frame`.
+pub fn sequence_settings(size: u32, time: f32, frame: u32) -> radcache_render::IcSettings {
+    radcache_render::IcSettings {
+        width: size,
+        height: size,
+        params: radcache_cache::IcParams::draft(),
+        sub_frames: 4,
+        direct_samples: 4,
+        time,
+        frame,
+        settle_records: true,
+        ..radcache_render::IcSettings::default()
+    }
+}

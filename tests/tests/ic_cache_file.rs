@@ -10,6 +10,7 @@ use radcache_cache::cache_file::{CacheFile, CacheIdentity, CacheRecords, CacheSe
 use radcache_cache::IcParams;
 use radcache_render::{GpuScene, IcRenderer, IcSettings, IcStats};
 use radcache_scene::{AnimationKind, Scene};
+use radcache_tests::ic_fixture::sequence_settings;
 use radcache_tests::scenes::{load, temp_dir};
 use radcache_tests::{context, finish, shaders};
 use radcache_vk::Context;
@@ -24,17 +25,7 @@ fn fly_through() -> Scene {
 }
 
 fn settings(time: f32, frame: u32) -> IcSettings {
-    IcSettings {
-        width: SIZE,
-        height: SIZE,
-        params: IcParams::draft(),
-        sub_frames: 4,
-        direct_samples: 4,
-        time,
-        frame,
-        settle_records: true,
-        ..IcSettings::default()
-    }
+    sequence_settings(SIZE, time, frame)
 }
 
 fn frame(

@@ -10,6 +10,7 @@ use radcache_render::{GpuScene, IcRenderer, IcSettings, IcStats};
 use radcache_scene::writer::{ChannelDesc, GltfBuilder, MaterialDesc, NodeDesc};
 use radcache_scene::{AnimationKind, Interpolation, Property, Scene};
 use radcache_shared::gpu::GpuRecord;
+use radcache_tests::ic_fixture::sequence_settings;
 use radcache_tests::scenes::{camera_node, cube, load, plane_y, temp_dir, write_and_load};
 use radcache_tests::{context, finish, shaders};
 use radcache_vk::Context;
@@ -75,17 +76,7 @@ fn camera_only_scene() -> Scene {
 }
 
 fn settings(time: f32, frame: u32) -> IcSettings {
-    IcSettings {
-        width: SIZE,
-        height: SIZE,
-        params: IcParams::draft(),
-        sub_frames: 4,
-        direct_samples: 4,
-        time,
-        frame,
-        settle_records: true,
-        ..IcSettings::default()
-    }
+    sequence_settings(SIZE, time, frame)
 }
 
 fn frame(

@@ -11,6 +11,10 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+use radcache_shared::glsl_twin::{
+    assert_compiles_with_glslang, assert_constants_generated, glsl_functions,
+};
+
 /// Rust functions with no GLSL twin (slices / test helpers) and their reason.
 const RUST_ONLY: [(&str, &str); 2] = [
     (
@@ -85,32 +89,10 @@ fn rust_functions() -> BTreeMap<String, usize> {
     out
 }
 
-fn glsl_functions(text: &str) -> BTreeMap<String, usize> {
-    let mut out = BTreeMap::new();
-    for ty in ["float", "vec3", "vec4", "uint", "bool", "void"] {
-        for (pos, _) in text.match_indices(&format!("\n{ty} ")) {
-            let rest = &text[pos + ty.len() + 2..];
-            let Some(paren) = rest.find('(') else {
-                continue;
-            };
-            let name = &rest[..paren];
-            if name.contains(' ') || name.contains('=') {
-                continue; // a declaration, not a function
-            }
-            let args = &rest[paren + 1..paren + rest[paren..].find(')').unwrap()];
-            out.insert(
-                name.to_string(),
-                args.split(',').filter(|a| !a.trim().is_empty()).count(),
-            );
-        }
-    }
-    out
-}
-
 #[test]
 fn every_rust_function_has_a_glsl_twin() {
     let text = std::fs::read_to_string(glsl_path()).expect("shaders/common/ircache_math.glsl");
-    let glsl = glsl_functions(&text);
+    let glsl = glsl_functions(&text, &["float", "vec3", "vec4", "uint", "bool", "void"]);
     let rust = rust_functions();
     assert!(
         rust.len() > 50 && glsl.len() > 50,
@@ -145,12 +127,7 @@ fn every_rust_function_has_a_glsl_twin() {
 #[test]
 fn constants_are_generated_not_copied() {
     let text = std::fs::read_to_string(glsl_path()).unwrap();
-    assert!(
-        text.contains("#include \"../shared/constants.glsl\""),
-        "ircache_math.glsl must include the generated constants"
-    );
-    let generated = radcache_shared::consts::generated_glsl();
-    for name in [
+    let names = [
         "IC_FAR",
         "R_FLOOR",
         "WARD_MIN_ERROR",
@@ -160,11 +137,8 @@ fn constants_are_generated_not_copied() {
         "EXTRAPOLATION_MAX_FACTOR",
         "WEIGHT_WARD",
         "WEIGHT_TL",
-    ] {
-        let key = format!(" {name} = ");
-        assert!(!text.contains(&key), "ircache_math.glsl hand-copies {name}");
-        assert!(generated.contains(&key), "constants.glsl lacks {name}");
-    }
+    ];
+    assert_constants_generated("ircache_math.glsl", &text, &names);
     // Derived constants hold what their names say.
     assert!(
         (radcache_cache::TL_NORMAL_SCALE - (1.0 - 10f32.to_radians().cos()).sqrt()).abs() < 1e-6
@@ -178,38 +152,10 @@ fn constants_are_generated_not_copied() {
 
 #[test]
 fn glsl_compiles() {
-    let out = std::process::Command::new("glslangValidator")
-        .arg("--version")
-        .output()
-        .unwrap_or_else(|e| {
-            panic!("glslangValidator not found ({e}): install glslang-tools (run scripts/setup.sh)")
-        });
-    assert!(
-        out.status.success(),
-        "glslangValidator --version failed: {}",
-        String::from_utf8_lossy(&out.stderr)
+    assert_compiles_with_glslang(
+        glsl_path().parent().unwrap(),
+        "ircache_math.glsl",
+        "vec3 t, b; basis_from_normal(vec3(0.0, 0.0, -1.0), t, b); \
+         o.v[0] = vec4(t, stratum_tan_mean(3u, 16u));",
     );
-    let dir = std::env::temp_dir().join(format!("radcache-cache-glsl-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let wrapper = dir.join("wrap.comp");
-    std::fs::write(
-        &wrapper,
-        "#version 460\n#extension GL_GOOGLE_include_directive : require\n#include \"ircache_math.glsl\"\n\
-         #include \"ircache_math.glsl\"\nlayout(local_size_x = 1) in;\n\
-         layout(std430, binding = 0) buffer Out { vec4 v[]; } o;\n\
-         void main() { vec3 t, b; basis_from_normal(vec3(0.0, 0.0, -1.0), t, b); o.v[0] = vec4(t, stratum_tan_mean(3u, 16u)); }\n",
-    )
-    .unwrap();
-    let include = format!("-I{}", glsl_path().parent().unwrap().display());
-    let spv = dir.join("wrap.spv");
-    let res = std::process::Command::new("glslangValidator")
-        .args(["-V", "--target-env", "vulkan1.2", &include, "-o"])
-        .arg(&spv)
-        .arg(&wrapper)
-        .output()
-        .unwrap();
-    let log =
-        String::from_utf8_lossy(&res.stdout).to_string() + &String::from_utf8_lossy(&res.stderr);
-    let _ = std::fs::remove_dir_all(&dir);
-    assert!(res.status.success(), "glslangValidator failed:\n{log}");
 }

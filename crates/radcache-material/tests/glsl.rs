@@ -10,6 +10,10 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+use radcache_shared::glsl_twin::{
+    assert_compiles_with_glslang, assert_constants_generated, glsl_functions,
+};
+
 /// Rust functions whose GLSL twin has another name, and why.
 const RENAMED: [(&str, &str, &str); 1] = [(
     "reflect",
@@ -49,10 +53,14 @@ fn rust_functions() -> BTreeMap<String, usize> {
     out
 }
 
-/// Functions defined at the top level of the GLSL file and their argument counts.
-fn glsl_functions(text: &str) -> BTreeMap<String, usize> {
-    let mut out = BTreeMap::new();
-    for ty in [
+#[test]
+fn every_rust_function_has_a_glsl_twin() {
+    let text = std::fs::read_to_string(glsl_path()).expect("shaders/common/brdf.glsl");
+    assert!(
+        text.starts_with("// common/brdf.glsl — Rust: crates/radcache-material/src/*.rs"),
+        "brdf.glsl must name its CPU twin on its first line"
+    );
+    let types = [
         "float",
         "vec3",
         "vec4",
@@ -61,31 +69,8 @@ fn glsl_functions(text: &str) -> BTreeMap<String, usize> {
         "void",
         "BrdfLobes",
         "BrdfSample",
-    ] {
-        for (pos, _) in text.match_indices(&format!("\n{ty} ")) {
-            let rest = &text[pos + ty.len() + 2..];
-            let Some(paren) = rest.find('(') else {
-                continue;
-            };
-            let name = &rest[..paren];
-            if name.contains(' ') || name.contains('=') || name.contains('\n') {
-                continue; // a declaration, not a function
-            }
-            let close = paren + rest[paren..].find(')').unwrap();
-            out.insert(name.to_string(), arity(&rest[paren + 1..close]));
-        }
-    }
-    out
-}
-
-#[test]
-fn every_rust_function_has_a_glsl_twin() {
-    let text = std::fs::read_to_string(glsl_path()).expect("shaders/common/brdf.glsl");
-    assert!(
-        text.starts_with("// common/brdf.glsl — Rust: crates/radcache-material/src/*.rs"),
-        "brdf.glsl must name its CPU twin on its first line"
-    );
-    let glsl = glsl_functions(&text);
+    ];
+    let glsl = glsl_functions(&text, &types);
     let rust = rust_functions();
     assert!(
         rust.len() >= 20 && glsl.len() >= 20,
@@ -121,12 +106,7 @@ fn every_rust_function_has_a_glsl_twin() {
 #[test]
 fn constants_are_generated_not_copied() {
     let text = std::fs::read_to_string(glsl_path()).unwrap();
-    assert!(
-        text.contains("#include \"../shared/constants.glsl\""),
-        "brdf.glsl must include the generated constants"
-    );
-    let generated = radcache_shared::consts::generated_glsl();
-    for name in [
+    let names = [
         "ALPHA_MIN",
         "COS_MIN",
         "SMITH_LAMBDA_MASKED",
@@ -135,10 +115,9 @@ fn constants_are_generated_not_copied() {
         "SCHLICK_MEAN_C2",
         "SCHLICK_MEAN_C3",
         "SCHLICK_MEAN_C4",
-    ] {
-        let key = format!(" {name} = ");
-        assert!(!text.contains(&key), "brdf.glsl hand-copies {name}");
-        assert!(generated.contains(&key), "constants.glsl lacks {name}");
+    ];
+    assert_constants_generated("brdf.glsl", &text, &names);
+    for name in names {
         assert!(text.contains(name), "brdf.glsl does not use {name}");
     }
     assert_eq!(radcache_material::ggx::ALPHA_MIN, 1.0e-3);
@@ -147,40 +126,11 @@ fn constants_are_generated_not_copied() {
 
 #[test]
 fn glsl_compiles() {
-    let out = std::process::Command::new("glslangValidator")
-        .arg("--version")
-        .output()
-        .unwrap_or_else(|e| {
-            panic!("glslangValidator not found ({e}): install glslang-tools (run scripts/setup.sh)")
-        });
-    assert!(
-        out.status.success(),
-        "glslangValidator --version failed: {}",
-        String::from_utf8_lossy(&out.stderr)
+    assert_compiles_with_glslang(
+        glsl_path().parent().unwrap(),
+        "brdf.glsl",
+        "Material m = Material(vec3(1.0), 1.0, 0.5, 1.5, 1.0, vec3(1.0)); \
+         BrdfSample s = brdf_sample(m, vec3(0.0, 0.6, 0.8), vec3(0.3, 0.7, 0.1)); \
+         o.v[0] = vec4(s.weight, s.pdf);",
     );
-    let dir = std::env::temp_dir().join(format!("radcache-material-glsl-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let wrapper = dir.join("wrap.comp");
-    std::fs::write(
-        &wrapper,
-        "#version 460\n#extension GL_GOOGLE_include_directive : require\n#include \"brdf.glsl\"\n\
-         #include \"brdf.glsl\"\nlayout(local_size_x = 1) in;\n\
-         layout(std430, binding = 0) buffer Out { vec4 v[]; } o;\n\
-         void main() { Material m = Material(vec3(1.0), 1.0, 0.5, 1.5, 1.0, vec3(1.0));\n\
-         BrdfSample s = brdf_sample(m, vec3(0.0, 0.6, 0.8), vec3(0.3, 0.7, 0.1));\n\
-         o.v[0] = vec4(s.weight, s.pdf); }\n",
-    )
-    .unwrap();
-    let include = format!("-I{}", glsl_path().parent().unwrap().display());
-    let spv = dir.join("wrap.spv");
-    let res = std::process::Command::new("glslangValidator")
-        .args(["-V", "--target-env", "vulkan1.2", &include, "-o"])
-        .arg(&spv)
-        .arg(&wrapper)
-        .output()
-        .unwrap();
-    let log =
-        String::from_utf8_lossy(&res.stdout).to_string() + &String::from_utf8_lossy(&res.stderr);
-    let _ = std::fs::remove_dir_all(&dir);
-    assert!(res.status.success(), "glslangValidator failed:\n{log}");
 }
