@@ -27,16 +27,24 @@ float env_texel_solid_angle(uint y, uint w, uint h) {
     return (2.0 * PI / float(w)) * max(c0 - c1, 0.0);
 }
 
-// Radiance arriving from direction d (world, unit) out of the environment.
-vec3 environment_radiance(vec3 d) {
-    vec3 l = vec3(0.0);
-#ifdef HAS_ENV_CONSTANT
-    l += frame.environment.rgb;
-#endif
+// Radiance arriving from direction d (world, unit) out of the environment map alone (0 without
+// one).
+vec3 environment_map_radiance(vec3 d) {
 #ifdef HAS_ENV_MAP
     uint w = frame.counts.w;
     uint h = uint(frame.totals.y);
-    l += env_texels[env_texel_index(d, w, h)].rgb * frame.environment.w;
+    return env_texels[env_texel_index(d, w, h)].rgb * frame.environment.w;
+#else
+    return vec3(0.0);
+#endif
+}
+
+// Radiance arriving from direction d (world, unit) out of the environment: its constant part
+// plus its map.
+vec3 environment_radiance(vec3 d) {
+    vec3 l = environment_map_radiance(d);
+#ifdef HAS_ENV_CONSTANT
+    l += frame.environment.rgb;
 #endif
     return l;
 }

@@ -37,6 +37,22 @@ vec2 kronecker2(uint g, vec2 shift) {
     return min(fract(shift + float(g) * alpha), vec2(ONE_MINUS_EPS));
 }
 
+// The sky in the records (IC_SKY_IN_RECORDS, docs/cache-frame.md §2.1): a constant environment's
+// light then reaches the frame through the records' gathers, which count it on a first-segment
+// miss, and this pass leaves it out (it samples only emitters, the map and punctual lights).
+#if defined(HAS_ENV_CONSTANT) && !defined(IC_SKY_IN_RECORDS)
+#define DIRECT_ENV_CONSTANT
+#endif
+
+// The environment light this pass accounts for along direction d.
+vec3 direct_environment(vec3 d) {
+#ifdef IC_SKY_IN_RECORDS
+    return environment_map_radiance(d);
+#else
+    return environment_radiance(d);
+#endif
+}
+
 // One-sample MIS (Veach 1997, §9.2.4, balance heuristic): each sample picks ONE technique (a
 // point on an emitter, a direction of the environment map, or a cosine-distributed BSDF
 // direction) with probability c_t and casts one ray; its contribution f(x) / Σ_t c_t·p_t(x)
@@ -54,13 +70,13 @@ const float W_ENV = 1.0;
 #else
 const float W_ENV = 0.0;
 #endif
-#ifdef HAS_ENV_CONSTANT
+#ifdef DIRECT_ENV_CONSTANT
 const float W_BSDF = 1.0;
 #else
 const float W_BSDF = 0.25;
 #endif
 // Without emitters or an environment there is nothing to sample (punctual lights only).
-#if defined(HAS_EMITTERS) || defined(HAS_ENV_MAP) || defined(HAS_ENV_CONSTANT)
+#if defined(HAS_EMITTERS) || defined(HAS_ENV_MAP) || defined(DIRECT_ENV_CONSTANT)
 #define HAS_SAMPLED_SOURCES
 #endif
 const float C_EMITTER = W_EMITTER / (W_EMITTER + W_ENV + W_BSDF);
@@ -105,7 +121,7 @@ vec3 one_sample(Surface s, vec3 origin, float u_pick, vec3 u3, vec2 u2) {
         if (cos_s <= 0.0 || dot(s.geometric_normal, dir) <= 0.0 || !unoccluded(origin, dir, 1e30)) {
             return vec3(0.0);
         }
-        return environment_radiance(dir) * cos_s / (C_ENV * pdf + C_BSDF * cos_s * INV_PI);
+        return direct_environment(dir) * cos_s / (C_ENV * pdf + C_BSDF * cos_s * INV_PI);
     }
 #endif
     vec3 dir = sample_cosine_around(s.shading_normal, u2);
@@ -120,7 +136,7 @@ vec3 one_sample(Surface s, vec3 origin, float u_pick, vec3 u3, vec2 u2) {
     while (rayQueryProceedEXT(q)) {
     }
     if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
-        return environment_radiance(dir) * cos_s /
+        return direct_environment(dir) * cos_s /
                (C_ENV * env_technique_pdf(dir) + C_BSDF * pdf_bsdf);
     }
     Surface h = surface_at(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)),

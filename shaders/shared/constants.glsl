@@ -67,5 +67,6 @@ const float SCHLICK_MEAN_C4 = 0.00896681;
 
 const uint BRDF_TWIN_TERMS = 0u;
 const uint BRDF_TWIN_BRDF = 1u;
+const uint BRDF_TWIN_POLYGON = 2u;
 
 #endif

@@ -1,6 +1,6 @@
 // tests/brdf_twin.comp — Rust: tests/tests/brdf_glsl.rs (harness tests/src/twin.rs)
 // GPU side of tests/tests/brdf_glsl.rs: evaluates the production GLSL twin of radcache-material
-// (common/brdf.glsl) over a table of input rows, one invocation per row, and writes the results
+// (common/brdf.glsl, common/polygon.glsl) over a table of input rows, one invocation per row, and writes the results
 // for comparison with the Rust functions. Every row is 16 vec4 in and 16 vec4 out (the harness of
 // tests/src/twin.rs). The layout of each mode is documented at its function and mirrored by the
 // Rust test.
@@ -8,6 +8,7 @@
 #extension GL_GOOGLE_include_directive : require
 
 #include "../common/brdf.glsl"
+#include "../common/polygon.glsl"
 
 layout(local_size_x = 64) in;
 
@@ -69,6 +70,23 @@ void brdf(Row i, inout Row o) {
     o.v[7] = vec4(s.weight, 0.0);
 }
 
+// in: 0 (p, -); 1 (n, -); 2, 3, 4 the triangle's corners; 5, 6 unit vectors a, b.
+// out: 0 (triangle_projected_solid_angle(p, n, t), clip_to_hemisphere's count,
+// edge_term(n, a, b), -); 1..4 the clipped vertices (vectors from p; zero past the count).
+void polygon(Row i, inout Row o) {
+    vec3 t[3] = vec3[3](i.v[2].xyz, i.v[3].xyz, i.v[4].xyz);
+    vec3 q[4];
+    for (int k = 0; k < 4; ++k) {
+        q[k] = vec3(0.0);
+    }
+    uint count = clip_to_hemisphere(i.v[0].xyz, i.v[1].xyz, t, q);
+    float psa = triangle_projected_solid_angle(i.v[0].xyz, i.v[1].xyz, t);
+    o.v[0] = vec4(psa, float(count), edge_term(i.v[1].xyz, i.v[5].xyz, i.v[6].xyz), 0.0);
+    for (uint k = 0u; k < count; ++k) {
+        o.v[1u + k] = vec4(q[k], 0.0);
+    }
+}
+
 void main() {
     uint id = gl_GlobalInvocationID.x;
     if (id >= pc.count) {
@@ -83,6 +101,8 @@ void main() {
         terms(i, o);
     } else if (pc.mode == BRDF_TWIN_BRDF) {
         brdf(i, o);
+    } else if (pc.mode == BRDF_TWIN_POLYGON) {
+        polygon(i, o);
     }
     outputs[id] = o;
 }

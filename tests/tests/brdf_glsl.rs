@@ -28,8 +28,11 @@ use radcache_material::brdf::{
 };
 use radcache_material::fresnel::*;
 use radcache_material::ggx::*;
+use radcache_material::polygon::*;
 use radcache_material::sampling::*;
-use radcache_tests::twin::{check_diffs, unit, v4, BrdfTwinMode, Case, Expect, How, LaneDiff, Row};
+use radcache_tests::twin::{
+    check_diffs, unit, v4, vec, BrdfTwinMode, Case, Expect, How, LaneDiff, Row,
+};
 use radcache_tests::{context, finish, shaders, Rng};
 use radcache_vk::{BindingKind, BindingLayout, Pipeline};
 
@@ -259,6 +262,12 @@ const BRDF_LANES: &Lanes = &[
     (7, 0, 3, "brdf_sample.weight"),
 ];
 
+const POLYGON_LANES: &Lanes = &[
+    (0, 0, 1, "triangle_projected_solid_angle"),
+    (0, 2, 1, "edge_term"),
+    (1, 0, 3, "clip_to_hemisphere"),
+];
+
 /// Prints the largest differences of each function's lanes.
 fn report(names: &Lanes, diffs: &[[LaneDiff; 4]; 16]) {
     for &(slot, first, lanes, name) in names {
@@ -272,6 +281,48 @@ fn report(names: &Lanes, diffs: &[[LaneDiff; 4]; 16]) {
             "{name:<28} max |gpu - cpu| {abs:.2e}, relative {rel:.2e}, of tolerance {tol:.3}"
         );
     }
+}
+
+/// Mode 2: the projected solid angle of triangles around a receiver, many crossing its horizon
+/// (the clipping), some wholly below, one degenerate.
+fn polygons(rng: &mut Rng) -> Vec<Case> {
+    let mut cases = Vec::new();
+    for i in 0..400u32 {
+        let p = vec(rng, 1.0);
+        let n = unit(rng);
+        let centre = p + n * rng.range(-0.3, 1.0) + vec(rng, 0.8);
+        let mut t = [
+            centre + vec(rng, 0.6),
+            centre + vec(rng, 0.6),
+            centre + vec(rng, 0.6),
+        ];
+        if i % 37 == 0 {
+            t[2] = t[0] + (t[1] - t[0]) * 0.5;
+        }
+        let a = unit(rng);
+        let b = if i % 11 == 0 { a } else { unit(rng) };
+        let mut row: Row = [[0.0; 4]; 16];
+        row[0] = v4(p, 0.0);
+        row[1] = v4(n, 0.0);
+        for (k, v) in t.iter().enumerate() {
+            row[2 + k] = v4(*v, 0.0);
+        }
+        row[5] = v4(a, 0.0);
+        row[6] = v4(b, 0.0);
+        let mut q = [Vec3::ZERO; CLIPPED_MAX];
+        let count = clip_to_hemisphere(p, n, t, &mut q);
+        let mut e = Expect::new();
+        // The sum of up to four terms of magnitude up to π: their scale.
+        e.f(0, 0, triangle_projected_solid_angle(p, n, t), 4.0);
+        e.exact(0, 1, count as f32);
+        e.f(0, 2, edge_term(n, a, b), 1.0);
+        let scale = t.iter().map(|v| (*v - p).length()).fold(0.0, f32::max);
+        for (k, v) in q.iter().take(count).enumerate() {
+            e.v(1 + k, *v, scale);
+        }
+        cases.push((row, e));
+    }
+    cases
 }
 
 #[test]
@@ -288,6 +339,8 @@ fn brdf_glsl_twin_matches_the_rust_brdf_on_the_gpu() {
     let bc = brdf(&mut rng);
     let d = check_diffs(&ctx, &pipeline, BrdfTwinMode::Brdf, &bc, &[]);
     report(BRDF_LANES, &d);
+    let d = check_diffs(&ctx, &pipeline, BrdfTwinMode::Polygon, &polygons(&mut rng), &[]);
+    report(POLYGON_LANES, &d);
     drop(pipeline);
     finish(ctx);
 }

@@ -54,7 +54,7 @@ fn same_records(a: &CacheRecords, b: &CacheRecords) -> bool {
     bits(&a.records) == bits(&b.records)
         && bits(&a.temporal) == bits(&b.temporal)
         && a.last_used == b.last_used
-        && (a.frames, a.lifespans) == (b.frames, b.lifespans)
+        && (a.frames, a.lifespans, a.sky) == (b.frames, b.lifespans, b.sky)
 }
 
 /// Relative mean squared difference of two images.

@@ -5,7 +5,7 @@
 use std::f64::consts::PI;
 
 use glam::{DVec3, Quat, Vec3};
-use radcache_render::{CompositePass, DirectPass, EmissionPass, EnvMap, SplatPass};
+use radcache_render::{CompositePass, DirectPass, EmissionPass, EnvMap, SkyLight, SplatPass};
 use radcache_scene::light::LightKind;
 use radcache_scene::writer::{GltfBuilder, LightDesc, MaterialDesc, NodeDesc};
 use radcache_scene::{Environment, Scene};
@@ -55,14 +55,21 @@ fn plane_scene(name: &str, light: Option<(Vec3, f32)>, sky: Option<[f32; 3]>) ->
 fn direct_light_matches_a_point_light_and_a_constant_sky() {
     let (light, intensity, sky) = (Vec3::new(0.3, 1.5, 0.2), 5.0, [0.5, 1.0, 2.0]);
     let albedo = Vec3::from(ALBEDO).as_dvec3();
-    for (name, point) in [("ic-passes-point", true), ("ic-passes-sky", false)] {
+    // The sky is sampled here ([`SkyLight::Direct`]) or left to the records, where the pass
+    // must leave it out entirely: no light, no ray.
+    for (name, point, sky_light) in [
+        ("ic-passes-point", true, SkyLight::Direct),
+        ("ic-passes-sky", false, SkyLight::Direct),
+        ("ic-passes-sky-in-records", false, SkyLight::Records),
+    ] {
         let scene = plane_scene(
             name,
             point.then_some((light, intensity)),
             (!point).then_some(sky),
         );
         let gpu = Gpu::new(&scene, None, (32, 24));
-        let direct = DirectPass::new(&gpu.ctx, &gpu.shaders, &gpu.scene).unwrap();
+        let direct = DirectPass::new(&gpu.ctx, &gpu.shaders, &gpu.scene, sky_light).unwrap();
+        let in_records = sky_light == SkyLight::Records;
         let samples = 4;
         let scopes = gpu.render([0.1, 0.2], Some((&direct, samples, 7)));
         assert!(scopes.iter().any(|s| s == "direct"), "{scopes:?}");
@@ -70,7 +77,7 @@ fn direct_light_matches_a_point_light_and_a_constant_sky() {
         let out = gpu.read(&gpu.gbuffer.direct);
         let mut surfaces = 0;
         for (i, (p, d)) in position.iter().zip(&out).enumerate() {
-            let expected = if p[3] == 0.0 {
+            let expected = if p[3] == 0.0 || in_records {
                 DVec3::ZERO
             } else if point {
                 // ρ/π · I · cosθ / d², exact: a punctual light has no randomness.
@@ -90,9 +97,12 @@ fn direct_light_matches_a_point_light_and_a_constant_sky() {
             "{surfaces} surface pixels"
         );
         // The point light: one shadow ray per pixel, no sampling (nothing to sample); the sky:
-        // one BSDF ray per sample (only BSDF sampling finds a constant environment).
+        // one BSDF ray per sample (only BSDF sampling finds a constant environment), or none
+        // when the records bring it.
         let expected_rays = if point {
             surfaces
+        } else if in_records {
+            0
         } else {
             surfaces * u64::from(samples)
         };
@@ -178,7 +188,7 @@ fn agree(what: &str, a: &[DVec3], b: &[DVec3], pixels: &[usize]) {
 fn direct_light_is_unbiased_on_the_cornell_box() {
     let scene = cornell();
     let gpu = Gpu::new(&scene, None, (16, 16));
-    let direct = DirectPass::new(&gpu.ctx, &gpu.shaders, &gpu.scene).unwrap();
+    let direct = DirectPass::new(&gpu.ctx, &gpu.shaders, &gpu.scene, SkyLight::Direct).unwrap();
     let mut runs = Vec::new();
     for (samples, seed) in [(4, 11), (256, 12)] {
         gpu.render([0.0; 2], Some((&direct, samples, seed)));
@@ -211,7 +221,7 @@ fn direct_light_in_the_furnace_is_albedo_times_emission() {
     let dir = temp_dir("ic-passes-furnace");
     let scene = load(&radcache_scene::assets::write_furnace(&dir, albedo, le).unwrap());
     let gpu = Gpu::new(&scene, None, (16, 16));
-    let direct = DirectPass::new(&gpu.ctx, &gpu.shaders, &gpu.scene).unwrap();
+    let direct = DirectPass::new(&gpu.ctx, &gpu.shaders, &gpu.scene, SkyLight::Direct).unwrap();
     gpu.render([0.0; 2], Some((&direct, 4, 3)));
     let out = gpu.read(&gpu.gbuffer.direct);
     // Every direction sees an emitting wall: irradiance π·Le, direct ρ/π · π·Le = ρ·Le.
@@ -259,7 +269,7 @@ fn composite_sums_direct_indirect_emission_and_environment() {
     let (w, h) = (40, 32);
     let gpu = Gpu::new(&scene, Some(&map), (w, h));
     let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
-    let direct = DirectPass::new(ctx, shaders, &gpu.scene).unwrap();
+    let direct = DirectPass::new(ctx, shaders, &gpu.scene, SkyLight::Direct).unwrap();
     let splat = SplatPass::new(ctx, shaders, w, h).unwrap();
     let composite = CompositePass::new(ctx, shaders, &gpu.scene, w, h).unwrap();
     let emission = EmissionPass::new(ctx, shaders, &gpu.scene).unwrap();

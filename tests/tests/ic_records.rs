@@ -15,7 +15,7 @@ use radcache_cache::radius::{finalize_radius, pixel_footprint};
 use radcache_cache::record::*;
 use radcache_cache::sampling::*;
 use radcache_cache::{IcParams, IC_FAR, R_FLOOR};
-use radcache_render::{record_seed, GBuffer, GpuScene, IcState, RecordPass, R_EPS_REL};
+use radcache_render::{record_seed, GBuffer, GpuScene, IcState, RecordPass, SkyLight, R_EPS_REL};
 use radcache_render::{RECORD_FLAGS_MASK, RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE};
 use radcache_render::{RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED};
 use radcache_scene::Scene;
@@ -316,7 +316,7 @@ fn furnace_records_match_the_analytic_irradiance() {
     let (albedo, le) = (0.5f32, 1.0f32);
     let mut f = fixture(&furnace_scene(le));
     let params = IcParams::draft();
-    let pass = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &params).unwrap();
+    let pass = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &params, SkyLight::Records).unwrap();
     let (m, n) = (params.strata_m, params.strata_n);
     // Shading normal tilted off the geometric one: some directions must be folded.
     let tilted = Vec3::new(0.6, 1.0, 0.0).normalize();
@@ -380,7 +380,7 @@ fn invalid_irradiance_background_and_overflow_are_guarded() {
     // Le = 1e36: every sample is finite (≈ 1e36) but their sum over 16×48 strata overflows.
     let mut f = fixture(&furnace_scene(1e36));
     let params = IcParams::default();
-    let pass = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &params).unwrap();
+    let pass = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &params, SkyLight::Records).unwrap();
     let q = point(5, 5, Vec3::new(0.0, -1.0, 0.0), Vec3::Y);
     // Surface (overflows), background pixel, pixel past the image, and one request past the
     // capacity (base 2 + 3 records); one workgroup more than there are requests.
@@ -450,8 +450,8 @@ fn cornell_records_agree_with_an_independent_estimate() {
     let requests: Vec<u32> = points.iter().map(Point::index).collect();
     let k = points.len() as u32;
     let (draft, fine) = (IcParams::draft(), IcParams::default());
-    let pass_a = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &draft).unwrap();
-    let pass_b = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &fine).unwrap();
+    let pass_a = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &draft, SkyLight::Records).unwrap();
+    let pass_b = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &fine, SkyLight::Records).unwrap();
     let c = counters(0, k, k, 64);
     let a = run(&mut f, &pass_a, &points, &requests, c, 11, 1, 0);
     let again = run(&mut f, &pass_a, &points, &requests, c, 11, 1, 0);

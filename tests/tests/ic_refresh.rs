@@ -88,7 +88,7 @@ fn a_refreshed_record_reproduces_its_value() {
         which.iter().any(|&i| before[i as usize].info[2] == 1),
         "no sub-frame 1 record"
     );
-    let pass = RecordPass::new(&ctx, &shaders, &gpu, &settings.params).unwrap();
+    let pass = RecordPass::new(&ctx, &shaders, &gpu, &settings.params, settings.sky).unwrap();
     let gbuffer = GBuffer::new(&ctx, SIZE, SIZE).unwrap();
 
     let same = refresh(&ctx, &pass, &gpu, &gbuffer, &r, &which, SEED);

@@ -46,6 +46,7 @@ fn records(n: usize) -> CacheRecords {
         last_used: (0..n as u32).map(|i| i % 5).collect(),
         frames: 7,
         lifespans: false,
+        sky: true,
     }
 }
 
@@ -93,14 +94,19 @@ fn a_round_trip_keeps_every_record_bit_for_bit() {
         bytemuck::cast_slice(&original.temporal)
     ));
     assert_eq!(file.records.last_used, original.last_used);
-    assert_eq!((file.records.frames, file.records.lifespans), (7, false));
+    assert_eq!(
+        (file.records.frames, file.records.lifespans, file.records.sky),
+        (7, false, true)
+    );
     // An empty cache is a valid file too.
     let empty = CacheFile::decode(&bytes(0)).unwrap();
     assert_eq!(empty.header.record_count, 0);
     assert_eq!(bytes(0).len(), HEADER_LEN);
     let text = file.header.describe();
     assert!(
-        text.contains("records: 9") && text.contains("strata_m: 8"),
+        text.contains("records: 9")
+            && text.contains("strata_m: 8")
+            && text.contains("sky in the records: yes"),
         "{text}"
     );
 }

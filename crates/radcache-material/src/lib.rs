@@ -11,6 +11,7 @@
 //! | [`ggx`] | α from roughness, Trowbridge–Reitz (GGX) D, Smith Λ and G1, height-correlated V | §3 |
 //! | [`brdf`] | [`Material`], the BRDF (diffuse and specular lobes), the diffuse share | §1, §4, §6 |
 //! | [`sampling`] | cosine and GGX visible-normal sampling, lobe choice, the mixture pdf | §5 |
+//! | [`polygon`] | the irradiance of a uniformly emitting triangle on a Lambertian receiver (Lambert's formula, horizon-clipped) | §7 |
 //!
 //! **GLSL twin.** `shaders/common/brdf.glsl` mirrors the functions one to one (checked by
 //! `tests/glsl.rs`; values compared on lavapipe by `tests/tests/brdf_glsl.rs`): plain
@@ -27,6 +28,7 @@
 pub mod brdf;
 pub mod fresnel;
 pub mod ggx;
+pub mod polygon;
 pub mod sampling;
 
 pub use brdf::{brdf_eval, brdf_eval_lobes, diffuse_share, BrdfLobes, Material};

@@ -32,6 +32,11 @@ fn glsl_path() -> PathBuf {
     crate_dir().join("../../shaders/common/brdf.glsl")
 }
 
+/// The twin of `src/polygon.rs`.
+fn polygon_glsl_path() -> PathBuf {
+    crate_dir().join("../../shaders/common/polygon.glsl")
+}
+
 fn arity(args: &str) -> usize {
     args.split(',').filter(|a| !a.trim().is_empty()).count()
 }
@@ -55,11 +60,17 @@ fn rust_functions() -> BTreeMap<String, usize> {
 
 #[test]
 fn every_rust_function_has_a_glsl_twin() {
-    let text = std::fs::read_to_string(glsl_path()).expect("shaders/common/brdf.glsl");
+    let brdf = std::fs::read_to_string(glsl_path()).expect("shaders/common/brdf.glsl");
     assert!(
-        text.starts_with("// common/brdf.glsl — Rust: crates/radcache-material/src/*.rs"),
+        brdf.starts_with("// common/brdf.glsl — Rust: crates/radcache-material/src/*.rs"),
         "brdf.glsl must name its CPU twin on its first line"
     );
+    let polygon = std::fs::read_to_string(polygon_glsl_path()).expect("common/polygon.glsl");
+    assert!(
+        polygon.starts_with("// common/polygon.glsl — Rust: crates/radcache-material/src/polygon.rs"),
+        "polygon.glsl must name its CPU twin on its first line"
+    );
+    let text = format!("{brdf}\n{polygon}");
     let types = [
         "float",
         "vec3",
@@ -122,6 +133,16 @@ fn constants_are_generated_not_copied() {
     }
     assert_eq!(radcache_material::ggx::ALPHA_MIN, 1.0e-3);
     assert_eq!(radcache_material::brdf::COS_MIN, 1.0e-6);
+}
+
+#[test]
+fn polygon_glsl_compiles() {
+    assert_compiles_with_glslang(
+        polygon_glsl_path().parent().unwrap(),
+        "polygon.glsl",
+        "vec3 t[3] = vec3[3](vec3(0.0, 0.0, 1.0), vec3(1.0, 0.0, 1.0), vec3(0.0, 1.0, 1.0)); \
+         o.v[0] = vec4(triangle_projected_solid_angle(vec3(0.0), vec3(0.0, 0.0, 1.0), t));",
+    );
 }
 
 #[test]

@@ -266,6 +266,8 @@ gpu_enum! {
         Terms = 0,
         /// Evaluation, diffuse share, sampling and pdfs of a material.
         Brdf = 1,
+        /// The projected solid angle of a triangle (radcache-material's `polygon`).
+        Polygon = 2,
     }
 }
 

@@ -14,7 +14,7 @@
 //! | 36..88 | [`IcParams`], 13 words in declaration order (`weight_kind` as its GLSL constant) |
 //! | 88..92 | record count n |
 //! | 92..96 | the renderer's frame count at export (the clock of the last-use marks and of the temporal state's frame numbers) |
-//! | 96..100 | flags (bit 0: the records carry lifespans) |
+//! | 96..100 | flags (bit 0: the records carry lifespans; bit 1: they hold a constant environment's light, the sky) |
 //! | 100..108 | `size_of::<GpuRecord>()`, `size_of::<GpuRecordTemporal>()` (u32 each) |
 //! | 108..116 | payload length in bytes (u64) = n · (176 + 96 + 4) |
 //! | 116..120 | CRC-32 of the payload |
@@ -52,6 +52,7 @@ pub const BYTES_PER_RECORD: u64 =
     (std::mem::size_of::<GpuRecord>() + std::mem::size_of::<GpuRecordTemporal>() + 4) as u64;
 
 const FLAG_LIFESPANS: u32 = 1;
+const FLAG_SKY: u32 = 2;
 
 /// The settings besides the cache parameters that the records depend on (not the camera).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -103,6 +104,8 @@ pub struct CacheRecords {
     pub frames: u32,
     /// The records carry lifespans (temporal caching of moving geometry or lights).
     pub lifespans: bool,
+    /// The records hold a constant environment's light (the sky; `radcache_render::SkyLight`).
+    pub sky: bool,
 }
 
 /// The header of a cache file.
@@ -120,6 +123,8 @@ pub struct CacheHeader {
     pub frames: u32,
     /// The records carry lifespans.
     pub lifespans: bool,
+    /// The records hold the sky's light.
+    pub sky: bool,
     /// Payload bytes.
     pub payload_len: u64,
     /// CRC-32 of the payload.
@@ -179,6 +184,7 @@ impl CacheFile {
             record_count: n as u32,
             frames: records.frames,
             lifespans: records.lifespans,
+            sky: records.sky,
             payload_len: n as u64 * BYTES_PER_RECORD,
             payload_crc: 0,
         };
@@ -211,7 +217,8 @@ impl CacheFile {
         }
         word(&mut out, h.record_count);
         word(&mut out, h.frames);
-        word(&mut out, if h.lifespans { FLAG_LIFESPANS } else { 0 });
+        let flags = [(h.lifespans, FLAG_LIFESPANS), (h.sky, FLAG_SKY)];
+        word(&mut out, flags.iter().filter(|f| f.0).map(|f| f.1).sum());
         word(&mut out, std::mem::size_of::<GpuRecord>() as u32);
         word(&mut out, std::mem::size_of::<GpuRecordTemporal>() as u32);
         out.extend_from_slice(&h.payload_len.to_le_bytes());
@@ -255,6 +262,7 @@ impl CacheFile {
             last_used: words(marks),
             frames: header.frames,
             lifespans: header.lifespans,
+            sky: header.sky,
         };
         Ok(CacheFile { header, records })
     }
@@ -351,7 +359,7 @@ impl CacheHeader {
                 "{payload_len} payload bytes for {record_count} records of {BYTES_PER_RECORD}"
             )));
         }
-        if settings_hash != settings.hash() || flags & !FLAG_LIFESPANS != 0 {
+        if settings_hash != settings.hash() || flags & !(FLAG_LIFESPANS | FLAG_SKY) != 0 {
             return Err(Refusal::Corrupt("inconsistent settings or flags".into()));
         }
         Ok(CacheHeader {
@@ -365,6 +373,7 @@ impl CacheHeader {
             record_count,
             frames,
             lifespans: flags & FLAG_LIFESPANS != 0,
+            sky: flags & FLAG_SKY != 0,
             payload_len,
             payload_crc,
         })
@@ -418,7 +427,7 @@ impl CacheHeader {
         let mut text = format!(
             "format version: {}\nscene content hash: {:016x}\nsettings: {}x{}, time step {} s \
              (hash {:08x})\nrecords: {} ({} payload bytes, checksum {:08x})\nrenderer frames: \
-             {}\nlifespans: {}\ncache parameters:\n",
+             {}\nlifespans: {}\nsky in the records: {}\ncache parameters:\n",
             self.version,
             id.scene_hash,
             s.width,
@@ -430,6 +439,7 @@ impl CacheHeader {
             self.payload_crc,
             self.frames,
             if self.lifespans { "yes" } else { "no" },
+            if self.sky { "yes" } else { "no" },
         );
         for (name, _, value) in param_words(&id.params) {
             text.push_str(&format!("  {name}: {value}\n"));

@@ -4,6 +4,7 @@
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 use radcache_cache::{IcParams, Preset, WeightKind};
+use radcache_render::SkyLight;
 
 /// Cache quality preset.
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -23,6 +24,16 @@ pub enum Weight {
     Tl,
     /// Ward's split-sphere weight.
     Ward,
+}
+
+/// Where a constant environment's light (a sky) enters a cache frame.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sky {
+    /// Through the records (default): the sky's irradiance is interpolated with the indirect
+    /// light and the direct pass casts no ray for it.
+    Records,
+    /// Sampled by the direct pass at every pixel.
+    Direct,
 }
 
 /// The cache's command-line options.
@@ -52,6 +63,9 @@ pub struct IcArgs {
     /// Direct-lighting samples per pixel and sub-frame (`--method ic`; one ray each); default 16.
     #[arg(long)]
     pub direct_samples: Option<u32>,
+    /// Where a constant environment's light (a sky) enters the frame (`--method ic`).
+    #[arg(long, value_enum, default_value_t = Sky::Records)]
+    pub sky: Sky,
 }
 
 fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T)> {
@@ -68,6 +82,14 @@ fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T
 }
 
 impl IcArgs {
+    /// Where the sky's light goes.
+    pub fn sky_light(&self) -> SkyLight {
+        match self.sky {
+            Sky::Records => SkyLight::Records,
+            Sky::Direct => SkyLight::Direct,
+        }
+    }
+
     /// The cache parameters: the preset with the overrides applied, checked.
     pub fn params(&self) -> Result<IcParams> {
         let mut params = IcParams::preset(match self.quality {

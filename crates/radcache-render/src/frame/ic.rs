@@ -58,6 +58,9 @@ pub struct IcRenderer {
     has_records: bool,
     /// Frames rendered (the last-use marks of `IcState::last_used`).
     frames: u32,
+    /// The records hold a constant environment's light ([`crate::SkyLight::Records`] in a scene
+    /// with one).
+    sky_in_records: bool,
 }
 
 impl std::fmt::Debug for IcRenderer {
@@ -95,11 +98,11 @@ impl IcRenderer {
             params,
             gbuffer: GBuffer::new(ctx, w, h)?,
             gbuffer_pass: GBufferPass::new(ctx, shaders)?,
-            direct: DirectPass::new(ctx, shaders, gpu)?,
+            direct: DirectPass::new(ctx, shaders, gpu, settings.sky)?,
             splat: SplatPass::new(ctx, shaders, w, h)?,
             holes: HolePass::new(ctx, shaders)?,
             neighbours: NeighbourPass::new(ctx, shaders)?,
-            records: RecordPass::new(ctx, shaders, gpu, &params)?,
+            records: RecordPass::new(ctx, shaders, gpu, &params, settings.sky)?,
             composite: CompositePass::new(ctx, shaders, gpu, w, h)?,
             emission: EmissionPass::new(ctx, shaders, gpu)?,
             state: IcState::new(ctx, shaders, settings.record_capacity, w * h)?,
@@ -114,6 +117,7 @@ impl IcRenderer {
             reclamp_next: false,
             has_records: false,
             frames: 0,
+            sky_in_records: settings.sky.define(gpu.has_constant_environment()).is_some(),
         })
     }
 

@@ -47,6 +47,32 @@ pub struct IcSettings {
     /// and lifespans (`crate::temporal`). 0 (the default) for a single frame or a scene whose
     /// lighting does not change. Must be set when the renderer is created.
     pub time_step_s: f32,
+    /// Where a constant environment's light (a sky) enters the frame: through the records
+    /// (the default) or the direct pass. Must be set when the renderer is created.
+    pub sky: SkyLight,
+}
+
+/// Where the light of a constant environment (a sky) enters a frame rendered with the cache
+/// (docs/cache-frame.md §2.1).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum SkyLight {
+    /// The records' gathers count it on a first-segment miss and the direct pass leaves it
+    /// out: the sky's smooth irradiance is interpolated like the indirect light, and the
+    /// direct pass spends no ray on it (on the courtyard at 256², 16 of the 17 rays per pixel
+    /// and sub-frame were sky rays; measured in `bench/results.csv`, case `sky_*`).
+    #[default]
+    Records,
+    /// The direct pass samples it at every pixel (one-sample MIS with BSDF sampling), as it
+    /// samples emitters.
+    Direct,
+}
+
+impl SkyLight {
+    /// The shader define of `self` for a scene with (`constant_env`) or without a constant
+    /// environment: none unless the sky goes through the records of a scene that has one.
+    pub fn define(self, constant_env: bool) -> Option<(&'static str, &'static str)> {
+        (self == SkyLight::Records && constant_env).then_some(("IC_SKY_IN_RECORDS", "1"))
+    }
 }
 
 impl Default for IcSettings {
@@ -65,6 +91,7 @@ impl Default for IcSettings {
             evict_after_frames: 60,
             settle_records: false,
             time_step_s: 0.0,
+            sky: SkyLight::Records,
         }
     }
 }

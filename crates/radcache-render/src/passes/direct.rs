@@ -1,5 +1,6 @@
 //! Direct lighting of the cache's frame (`shaders/passes/direct.comp`): next-event estimation with
-//! MIS per surface pixel, compiled with the plan's defines (only the scene's light sources).
+//! MIS per surface pixel, compiled with the plan's defines (only the scene's light sources; a
+//! constant environment only where the sky does not go through the records, [`SkyLight`]).
 
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
@@ -8,6 +9,7 @@ use radcache_vk::{
 
 use crate::bindings::direct as b;
 use crate::error::Result;
+use crate::frame::settings::SkyLight;
 use crate::passes::gbuffer::GBuffer;
 use crate::scene::GpuScene;
 
@@ -38,9 +40,17 @@ impl std::fmt::Debug for DirectPass {
 }
 
 impl DirectPass {
-    /// Compiles the pass for `scene`'s plan.
-    pub fn new(ctx: &Context, shaders: &ShaderCompiler, scene: &GpuScene) -> Result<DirectPass> {
-        let spirv = shaders.compile("passes/direct.comp", &scene.defines())?;
+    /// Compiles the pass for `scene`'s plan; with [`SkyLight::Records`] it leaves a constant
+    /// environment out (the records bring it).
+    pub fn new(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        scene: &GpuScene,
+        sky: SkyLight,
+    ) -> Result<DirectPass> {
+        let mut defines = scene.defines();
+        defines.extend(sky.define(scene.has_constant_environment()));
+        let spirv = shaders.compile("passes/direct.comp", &defines)?;
         let pipeline = Pipeline::compute(
             ctx,
             "direct",

@@ -30,6 +30,7 @@ use radcache_vk::{
 
 use crate::bindings::record as b;
 use crate::error::{Error, Result};
+use crate::frame::settings::SkyLight;
 use crate::passes::gbuffer::GBuffer;
 use crate::scene::GpuScene;
 use radcache_shared::consts::{RecordSource, SEED_SUB_FRAME_MUL};
@@ -121,12 +122,14 @@ struct Io<'a> {
 
 impl RecordPass {
     /// Compiles the pass for `scene`'s plan with the cache parameters `params` (strata, spacing
-    /// limits and weight kind, which sets the validity scale of `R⁻`/`R⁺`).
+    /// limits and weight kind, which sets the validity scale of `R⁻`/`R⁺`); with
+    /// [`SkyLight::Records`] a gather ray that escapes brings a constant environment's radiance.
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
         params: &IcParams,
+        sky: SkyLight,
     ) -> Result<RecordPass> {
         let (m, n) = (params.strata_m, params.strata_n);
         if m < 1 || n < 3 || m.saturating_mul(n) > MAX_STRATA {
@@ -134,7 +137,9 @@ impl RecordPass {
                 "{m}×{n} strata: M ≥ 1, N ≥ 3 and at most {MAX_STRATA} in all"
             )));
         }
-        let spirv = shaders.compile(SHADER, &scene.defines())?;
+        let mut defines = scene.defines();
+        defines.extend(sky.define(scene.has_constant_environment()));
+        let spirv = shaders.compile(SHADER, &defines)?;
         let pipeline = Pipeline::compute(
             ctx,
             "records",

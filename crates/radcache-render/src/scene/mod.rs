@@ -301,6 +301,11 @@ impl GpuScene {
         })
     }
 
+    /// The scene has a constant environment (a sky) that emits light.
+    pub fn has_constant_environment(&self) -> bool {
+        self.env_constant.max_element() > 0.0
+    }
+
     /// The plan the scene was uploaded with.
     pub fn plan(&self) -> &ScenePlan {
         &self.plan

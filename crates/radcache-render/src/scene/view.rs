@@ -63,7 +63,7 @@ impl GpuScene {
         if self.plan.has_punctual_lights() {
             d.push(("HAS_LIGHTS", "1"));
         }
-        if self.env_constant.max_element() > 0.0 {
+        if self.has_constant_environment() {
             d.push(("HAS_ENV_CONSTANT", "1"));
         }
         if self.env_size.0 > 0 {

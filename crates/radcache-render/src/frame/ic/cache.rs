@@ -20,6 +20,7 @@ impl IcRenderer {
             return Ok(CacheRecords {
                 frames: self.frames,
                 lifespans,
+                sky: self.sky_in_records,
                 ..CacheRecords::default()
             });
         }
@@ -30,6 +31,7 @@ impl IcRenderer {
             last_used,
             frames: self.frames,
             lifespans,
+            sky: self.sky_in_records,
         })
     }
 
@@ -52,6 +54,14 @@ impl IcRenderer {
                 "the cache's records {} lifespans, the renderer's {}",
                 if cache.lifespans { "carry" } else { "carry no" },
                 if lifespans { "need them" } else { "have none" }
+            )));
+        }
+        if cache.sky != self.sky_in_records {
+            return Err(Error::Invalid(format!(
+                "the cache's records {} the sky's light, the renderer's {} (`--sky {}`)",
+                if cache.sky { "hold" } else { "do not hold" },
+                if self.sky_in_records { "must" } else { "must not" },
+                if cache.sky { "records" } else { "direct" }
             )));
         }
         if self.temporal.is_none() {

@@ -1,0 +1,59 @@
+// common/polygon.glsl — Rust: crates/radcache-material/src/polygon.rs (the CPU twin, function for
+// function; compared on lavapipe by tests/tests/brdf_glsl.rs)
+// The irradiance a uniformly emitting triangle sends to a Lambertian receiver, in closed form
+// (docs/materials.md §7): Lambert's formula for the projected solid angle after clipping the
+// triangle to the receiver's upper hemisphere.
+#ifndef RADCACHE_POLYGON_GLSL
+#define RADCACHE_POLYGON_GLSL
+
+// `t` clipped to the half-space n·(x − p) ≥ 0, written to q as vectors from p in winding order;
+// returns the vertex count (0, 3 or 4).
+uint clip_to_hemisphere(vec3 p, vec3 n, vec3 t[3], out vec3 q[4]) {
+    uint count = 0u;
+    for (uint i = 0u; i < 3u; ++i) {
+        vec3 a = t[i] - p;
+        vec3 b = t[(i + 1u) % 3u] - p;
+        float da = dot(n, a);
+        float db = dot(n, b);
+        if (da >= 0.0) {
+            q[count] = a;
+            count++;
+        }
+        if ((da >= 0.0) != (db >= 0.0)) {
+            float s = da / (da - db);
+            q[count] = a + (b - a) * s;
+            count++;
+        }
+    }
+    return count < 3u ? 0u : count;
+}
+
+// One term of Lambert's sum: the angle of the edge from unit a to unit b over |a × b|, times
+// n·(a × b).
+float edge_term(vec3 n, vec3 a, vec3 b) {
+    vec3 c = cross(a, b);
+    float s = length(c);
+    float theta = atan(s, dot(a, b));
+    float ratio = s > 1e-7 ? theta / s : 1.0;
+    return dot(n, c) * ratio;
+}
+
+// ∫ cos θ dω of the triangle seen from p (unit normal n), over its part above the tangent plane:
+// the irradiance per unit radiance of a uniformly emitting triangle facing p. In [0, π].
+float triangle_projected_solid_angle(vec3 p, vec3 n, vec3 t[3]) {
+    vec3 q[4];
+    uint count = clip_to_hemisphere(p, n, t, q);
+    float sum = 0.0;
+    for (uint i = 0u; i < count; ++i) {
+        vec3 a = q[i];
+        vec3 b = q[(i + 1u) % count];
+        float la = length(a);
+        float lb = length(b);
+        if (la > 0.0 && lb > 0.0) {
+            sum += edge_term(n, a / la, b / lb);
+        }
+    }
+    return min(0.5 * abs(sum), 3.14159265358979);
+}
+
+#endif
