@@ -4,7 +4,7 @@
 // environment (see one_sample), plus the punctual lights once (they need no sampling). Written:
 // albedo/π × the estimate (emission itself is in the G-buffer's emission image).
 //
-// Sample g of a pixel (g = first_sample + k; sub-frames continue the sequence) draws its random
+// Sample g of a pixel (g = sub_frame · count + k; sub-frames continue the sequence) draws its random
 // numbers from Kronecker sequences (Roberts 2018, the R_d sequences: point g is fract(shift + g·α),
 // α the powers of 1/φ_d, φ_d the real root of x^(d+1) = x + 1; d = 1 is the golden ratio): R1 for
 // the technique, R3 for the light sample, R2 for the BSDF direction, each with a random per-pixel
@@ -18,6 +18,9 @@
 #include "../common/path.glsl"
 #include "../common/gbuffer.glsl"
 #include "../shared/push.glsl"
+#ifdef HAS_ANALYTIC_EMITTERS
+#include "../common/polygon.glsl"
+#endif
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -60,7 +63,10 @@ vec3 direct_environment(vec3 d) {
 // sample instead of one per technique. Probabilities are fixed by the plan: light sampling gets
 // weight 1 per source kind, BSDF sampling 0.25 (1 when a constant environment, which only BSDF
 // sampling finds, is present), normalized.
-#ifdef HAS_EMITTERS
+// With HAS_ANALYTIC_EMITTERS the emitters are outside the one-sample MIS (their own estimate is
+// emitter_ratio_estimate) and BSDF sampling serves the environment alone.
+#if defined(HAS_EMITTERS) && !defined(HAS_ANALYTIC_EMITTERS)
+#define MIS_EMITTERS
 const float W_EMITTER = 1.0;
 #else
 const float W_EMITTER = 0.0;
@@ -76,7 +82,7 @@ const float W_BSDF = 1.0;
 const float W_BSDF = 0.25;
 #endif
 // Without emitters or an environment there is nothing to sample (punctual lights only).
-#if defined(HAS_EMITTERS) || defined(HAS_ENV_MAP) || defined(DIRECT_ENV_CONSTANT)
+#if defined(MIS_EMITTERS) || defined(HAS_ENV_MAP) || defined(DIRECT_ENV_CONSTANT)
 #define HAS_SAMPLED_SOURCES
 #endif
 const float C_EMITTER = W_EMITTER / (W_EMITTER + W_ENV + W_BSDF);
@@ -95,7 +101,7 @@ float env_technique_pdf(vec3 d) {
 // One sample of the irradiance-like estimate Σ L·cos/pdf: `u_pick` chooses the technique, `u3`
 // drives light sampling, `u2` the BSDF direction.
 vec3 one_sample(Surface s, vec3 origin, float u_pick, vec3 u3, vec2 u2) {
-#ifdef HAS_EMITTERS
+#ifdef MIS_EMITTERS
     if (u_pick < C_EMITTER) {
         vec3 dir, le;
         float dist, pdf;
@@ -142,19 +148,73 @@ vec3 one_sample(Surface s, vec3 origin, float u_pick, vec3 u3, vec2 u2) {
     Surface h = surface_at(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)),
                            uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
                            rayQueryGetIntersectionBarycentricsEXT(q, true), dir);
+#ifdef HAS_ANALYTIC_EMITTERS
+    return vec3(0.0);  // an emitter: emitter_ratio_estimate accounts for it
+#else
     vec3 le = material_emission(h.material, h.uv, h.front_face);
     if (all(equal(le, vec3(0.0)))) {
         return vec3(0.0);
     }
     float pdf_light = 0.0;
-#ifdef HAS_EMITTERS
+#ifdef MIS_EMITTERS
     GpuMaterial m = materials[h.material];
     float t = rayQueryGetIntersectionTEXT(q, true);
     float cos_l = abs(dot(h.geometric_normal, dir));
     pdf_light = emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t / max(cos_l, 1e-8);
 #endif
     return le * cos_s / (C_EMITTER * pdf_light + C_BSDF * pdf_bsdf);
+#endif
 }
+
+#ifdef HAS_ANALYTIC_EMITTERS
+// The unshadowed irradiance of every emissive triangle at `origin` (normal n), in closed form
+// (common/polygon.glsl). The plan compiles this in only for a few untextured emitters
+// (radcache_scene::ScenePlan::analytic_emitters), so the radiance is the material's constant.
+vec3 analytic_emitter_irradiance(vec3 origin, vec3 n) {
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < frame.counts.x; ++i) {
+        GpuEmitter e = emitters[i];
+        vec3 ng = cross(e.p1.xyz - e.p0.xyz, e.p2.xyz - e.p0.xyz);
+        bool front = dot(origin - e.p0.xyz, ng) > 0.0;
+        vec3 le = material_emission(uint(e.uv2_material.z), vec2(0.0), front);
+        if (any(greaterThan(le, vec3(0.0)))) {
+            vec3 t[3] = vec3[3](e.p0.xyz, e.p1.xyz, e.p2.xyz);
+            sum += le * triangle_projected_solid_angle(origin, n, t);
+        }
+    }
+    return sum;
+}
+
+// The sums of the ratio estimator of the emitters' direct light (Heitz, Hill, McGuire 2018,
+// "Combining analytic direct illumination and stochastic shadows"; docs/cache-frame.md §2.2):
+// over `count` light samples (g = first .. first + count of the pixel's R3 sequence), Σ f/p and
+// Σ V·f/p with f the unshadowed integrand. The estimate is the closed-form unshadowed irradiance
+// times their ratio, the visible fraction (the same samples above and below: exact where the
+// emitters are wholly visible or wholly hidden, noisy only in penumbrae; consistent, biased by
+// O(1/count) there).
+void emitter_ratio_sums(Surface s, vec3 origin, uint first, uint count, vec3 shift,
+                        inout vec3 sum_all, inout vec3 sum_visible) {
+    for (uint k = 0u; k < count; ++k) {
+        vec3 dir, le;
+        float dist, pdf;
+        if (!sample_emitter(s.position, kronecker3(first + k, shift), dir, dist, le, pdf)) {
+            continue;
+        }
+        float cos_s = dot(s.shading_normal, dir);
+        if (cos_s <= 0.0 || dot(s.geometric_normal, dir) <= 0.0) {
+            continue;
+        }
+        vec3 f = le * cos_s / pdf;
+        if (any(isnan(f)) || any(isinf(f))) {
+            continue;
+        }
+        sum_all += f;
+        if (unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+            sum_visible += f;
+        }
+    }
+}
+#endif
 
 // Punctual lights (delta lights: no sampling, one shadow ray each, the same for every sample).
 vec3 punctual(Surface s, vec3 origin) {
@@ -174,16 +234,17 @@ vec3 punctual(Surface s, vec3 origin) {
     return sum;
 }
 
-void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(pixel, ivec2(frame.resolution.xy)))) {
-        return;
-    }
-    GSample g = gbuffer_load(pixel);
-    if (!g.surface) {
-        imageStore(g_direct, pixel, vec4(0.0));
-        return;
-    }
+// The light of one surface pixel: `rest` (everything but the emitters under
+// HAS_ANALYTIC_EMITTERS) and, for the ratio estimator, the emitters' closed-form unshadowed
+// irradiance and the pixel's sample sums.
+struct PixelLight {
+    vec3 rest;
+    vec3 unshadowed;
+    vec3 sum_all;
+    vec3 sum_visible;
+};
+
+PixelLight pixel_light(GSample g, ivec2 pixel) {
     Surface s;
     s.position = g.position;
     s.geometric_normal = g.geometric;
@@ -193,15 +254,35 @@ void main() {
     s.front_face = true;
     vec3 origin = offset_ray_origin(s.position, s.geometric_normal);
     uint index = uint(pixel.y) * frame.resolution.x + uint(pixel.x);
-    vec3 sum = vec3(0.0);
-    uint n = max(pc.samples, 1u);
+    PixelLight light;
+    light.unshadowed = vec3(0.0);
+    light.sum_all = vec3(0.0);
+    light.sum_visible = vec3(0.0);
+    uint samples = max(pc.samples, 1u);
     Rng rng = rng_init(index, 0xffffffffu, pc.seed);
     float shift_pick = rng_next(rng);
     vec3 shift_light = vec3(rng_next(rng), rng_next2(rng));
     vec2 shift_bsdf = rng_next2(rng);
+    // Samples of the one-sample MIS loop per sub-frame (sub-frames continue its sequences).
+    uint n = samples;
+#ifdef HAS_ANALYTIC_EMITTERS
+    // The emitters take their own shadow rays, a quarter of the samples (the ratio estimator
+    // with its neighbourhood reaches about the noise of `samples` MIS samples with them:
+    // docs/cache-frame.md §2.2); the one-sample MIS loop keeps the rest for the environment.
+    uint n_emitters = max(1u, (samples + 3u) / 4u);
+#ifdef HAS_SAMPLED_SOURCES
+    n = max(1u, samples - n_emitters);
+#endif
+    light.unshadowed = analytic_emitter_irradiance(origin, s.shading_normal);
+    if (any(greaterThan(light.unshadowed, vec3(0.0)))) {
+        emitter_ratio_sums(s, origin, pc.sub_frame * n_emitters, n_emitters, shift_light,
+                           light.sum_all, light.sum_visible);
+    }
+#endif
+    vec3 sum = vec3(0.0);
 #ifdef HAS_SAMPLED_SOURCES
     for (uint k = 0u; k < n; ++k) {
-        uint g = pc.first_sample + k;
+        uint g = pc.sub_frame * n + k;
         // The technique from the golden-ratio sequence, so each pixel's picks are stratified too.
         float u_pick = min(fract(shift_pick + float(g) * 0.6180339887), ONE_MINUS_EPS);
         vec3 e = one_sample(s, origin, u_pick, kronecker3(g, shift_light), kronecker2(g, shift_bsdf));
@@ -210,7 +291,84 @@ void main() {
         }
     }
 #endif
-    vec3 e = sum / float(n) + punctual(s, origin);
+    light.rest = sum / float(n) + punctual(s, origin);
+    return light;
+}
+
+#ifdef HAS_ANALYTIC_EMITTERS
+// The workgroup's pixels' sample sums, positions and normals, for the ratio's neighbourhood.
+shared vec3 s_sum_all[64];
+shared vec3 s_sum_visible[64];
+shared vec4 s_position[64];  // w: 1 for a surface pixel
+shared vec3 s_normal[64];
+
+// The visible fraction of the emitters' light at this pixel: Σ sum_visible / Σ sum_all over the
+// pixel and the neighbours of its 3×3 block (within its 8×8 workgroup) that lie on the same
+// surface: normals within 25°, within one pixel footprint of its tangent plane and three of its
+// position (docs/cache-frame.md §2.2). Per channel; a channel no sample reached counts as hidden.
+vec3 neighbourhood_ratio(GSample g, PixelLight light) {
+    ivec2 l = ivec2(gl_LocalInvocationID.xy);
+    vec3 all_sum = light.sum_all;
+    vec3 visible = light.sum_visible;
+    float reach = 3.0 * g.footprint;
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            ivec2 q = l + ivec2(dx, dy);
+            if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThan(q, ivec2(7)))) {
+                continue;
+            }
+            uint j = uint(q.y * 8 + q.x);
+            vec3 d = s_position[j].xyz - g.position;
+            if (s_position[j].w == 0.0 || dot(s_normal[j], g.normal) < 0.9 ||
+                abs(dot(d, g.normal)) > g.footprint || dot(d, d) > reach * reach) {
+                continue;
+            }
+            all_sum += s_sum_all[j];
+            visible += s_sum_visible[j];
+        }
+    }
+    return vec3(all_sum.r > 0.0 ? visible.r / all_sum.r : 0.0,
+                all_sum.g > 0.0 ? visible.g / all_sum.g : 0.0,
+                all_sum.b > 0.0 ? visible.b / all_sum.b : 0.0);
+}
+#endif
+
+void main() {
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    bool inside = all(lessThan(pixel, ivec2(frame.resolution.xy)));
+    GSample g;
+    g.surface = false;
+    if (inside) {
+        g = gbuffer_load(pixel);
+    }
+    PixelLight light;
+    light.rest = vec3(0.0);
+    light.unshadowed = vec3(0.0);
+    light.sum_all = vec3(0.0);
+    light.sum_visible = vec3(0.0);
+    if (g.surface) {
+        light = pixel_light(g, pixel);
+    }
+    vec3 e = light.rest;
+#ifdef HAS_ANALYTIC_EMITTERS
+    // Every invocation of the workgroup reaches this barrier (no early return above).
+    uint lid = gl_LocalInvocationIndex;
+    s_sum_all[lid] = light.sum_all;
+    s_sum_visible[lid] = light.sum_visible;
+    s_position[lid] = vec4(g.position, g.surface ? 1.0 : 0.0);
+    s_normal[lid] = g.normal;
+    barrier();
+    if (g.surface) {
+        e += light.unshadowed * neighbourhood_ratio(g, light);
+    }
+#endif
+    if (!inside) {
+        return;
+    }
+    if (!g.surface) {
+        imageStore(g_direct, pixel, vec4(0.0));
+        return;
+    }
     if (any(isnan(e)) || any(isinf(e))) {
         e = vec3(0.0);
     }

@@ -11,7 +11,7 @@ struct CompositePush {
 struct DirectPush {
     uint samples;
     uint seed;
-    uint first_sample;
+    uint sub_frame;
     uint pad;
 };  // 16 bytes
 

@@ -339,7 +339,13 @@ fn brdf_glsl_twin_matches_the_rust_brdf_on_the_gpu() {
     let bc = brdf(&mut rng);
     let d = check_diffs(&ctx, &pipeline, BrdfTwinMode::Brdf, &bc, &[]);
     report(BRDF_LANES, &d);
-    let d = check_diffs(&ctx, &pipeline, BrdfTwinMode::Polygon, &polygons(&mut rng), &[]);
+    let d = check_diffs(
+        &ctx,
+        &pipeline,
+        BrdfTwinMode::Polygon,
+        &polygons(&mut rng),
+        &[],
+    );
     report(POLYGON_LANES, &d);
     drop(pipeline);
     finish(ctx);

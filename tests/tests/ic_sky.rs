@@ -63,14 +63,27 @@ fn the_sky_through_the_records_matches_the_path_tracer() {
     let reference = image(SIZE, SIZE, reference.pixels);
     let mut metrics: Vec<(SkyLight, Metrics)> = Vec::new();
     for sky in [SkyLight::Direct, SkyLight::Records] {
-        let (out, stats) =
-            render_ic(&ctx, &shaders, &scene, &mut gpu, &settings(sky), &mut |_| {}).unwrap();
-        assert!(stats.records > 0 && stats.rejected_records == 0, "{stats:?}");
+        let (out, stats) = render_ic(
+            &ctx,
+            &shaders,
+            &scene,
+            &mut gpu,
+            &settings(sky),
+            &mut |_| {},
+        )
+        .unwrap();
+        assert!(
+            stats.records > 0 && stats.rejected_records == 0,
+            "{stats:?}"
+        );
         let m = compare(&reference, &image(out.width, out.height, out.pixels)).unwrap();
         eprintln!("sky {sky:?}: {m}");
         assert_eq!(m.nonfinite_candidate, 0);
         for (c, r) in m.mean_ratio.iter().enumerate() {
-            assert!((r - 1.0).abs() <= 0.03, "sky {sky:?}: channel {c} mean ratio {r}");
+            assert!(
+                (r - 1.0).abs() <= 0.03,
+                "sky {sky:?}: channel {c} mean ratio {r}"
+            );
         }
         metrics.push((sky, m));
     }
@@ -94,7 +107,13 @@ fn records_holding_the_sky_are_refused_where_the_sky_is_sampled() {
     let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
     let mut with_sky = IcRenderer::new(&ctx, &shaders, &gpu, &settings(SkyLight::Records)).unwrap();
     with_sky
-        .render(&ctx, &scene, &mut gpu, &settings(SkyLight::Records), &mut |_| {})
+        .render(
+            &ctx,
+            &scene,
+            &mut gpu,
+            &settings(SkyLight::Records),
+            &mut |_| {},
+        )
         .unwrap();
     let cache = with_sky.export_cache(&ctx).unwrap();
     assert!(cache.sky && !cache.records.is_empty());

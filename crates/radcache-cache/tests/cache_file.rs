@@ -95,7 +95,11 @@ fn a_round_trip_keeps_every_record_bit_for_bit() {
     ));
     assert_eq!(file.records.last_used, original.last_used);
     assert_eq!(
-        (file.records.frames, file.records.lifespans, file.records.sky),
+        (
+            file.records.frames,
+            file.records.lifespans,
+            file.records.sky
+        ),
         (7, false, true)
     );
     // An empty cache is a valid file too.

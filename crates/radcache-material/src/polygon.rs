@@ -115,7 +115,10 @@ mod tests {
     struct Lcg(u64);
     impl Lcg {
         fn f(&mut self) -> f32 {
-            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((self.0 >> 40) as f32) / (1u64 << 24) as f32
         }
         fn v(&mut self, s: f32) -> Vec3 {
@@ -147,7 +150,11 @@ mod tests {
 
     #[test]
     fn below_the_horizon_or_degenerate_gives_zero() {
-        let t = [Vec3::new(0.0, 0.0, -1.0), Vec3::new(1.0, 0.0, -1.0), Vec3::new(0.0, 1.0, -2.0)];
+        let t = [
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::new(0.0, 1.0, -2.0),
+        ];
         assert_eq!(triangle_projected_solid_angle(Vec3::ZERO, Vec3::Z, t), 0.0);
         let line = [Vec3::Z, Vec3::new(1.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 1.0)];
         assert!(triangle_projected_solid_angle(Vec3::ZERO, Vec3::Z, line).abs() < 1e-6);
@@ -164,7 +171,11 @@ mod tests {
             let p = rng.v(0.5);
             let n = rng.v(1.0).normalize();
             let centre = p + n * 0.6 + rng.v(0.8);
-            let t = [centre + rng.v(0.5), centre + rng.v(0.5), centre + rng.v(0.5)];
+            let t = [
+                centre + rng.v(0.5),
+                centre + rng.v(0.5),
+                centre + rng.v(0.5),
+            ];
             let above = t.iter().filter(|v| n.dot(**v - p) >= 0.0).count();
             crossing += usize::from(above == 1 || above == 2);
             let got = f64::from(triangle_projected_solid_angle(p, n, t));
@@ -175,8 +186,14 @@ mod tests {
             );
             // The winding does not matter.
             let back = f64::from(triangle_projected_solid_angle(p, n, [t[0], t[2], t[1]]));
-            assert!((back - got).abs() <= 1e-4 * got.max(1e-2), "{back} vs {got}");
+            assert!(
+                (back - got).abs() <= 1e-4 * got.max(1e-2),
+                "{back} vs {got}"
+            );
         }
-        assert!(crossing >= 10, "only {crossing} triangles crossed the horizon");
+        assert!(
+            crossing >= 10,
+            "only {crossing} triangles crossed the horizon"
+        );
     }
 }

@@ -67,7 +67,8 @@ fn every_rust_function_has_a_glsl_twin() {
     );
     let polygon = std::fs::read_to_string(polygon_glsl_path()).expect("common/polygon.glsl");
     assert!(
-        polygon.starts_with("// common/polygon.glsl — Rust: crates/radcache-material/src/polygon.rs"),
+        polygon
+            .starts_with("// common/polygon.glsl — Rust: crates/radcache-material/src/polygon.rs"),
         "polygon.glsl must name its CPU twin on its first line"
     );
     let text = format!("{brdf}\n{polygon}");

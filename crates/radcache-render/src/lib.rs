@@ -24,7 +24,7 @@ pub use error::{Error, Result};
 pub use frame::clock::{Span, Track};
 pub use frame::ic::{render_ic, IcRenderer};
 pub use frame::path::{render_path, Budget, FrameOutput, PathSettings, Progress};
-pub use frame::settings::{sub_frame_jitter, IcDebug, IcSettings, IcStats, SkyLight};
+pub use frame::settings::{sub_frame_jitter, EmitterLight, IcDebug, IcSettings, IcStats, SkyLight};
 pub use passes::aov::{render_aovs, AovPass, Aovs};
 pub use passes::composite::CompositePass;
 pub use passes::direct::DirectPass;

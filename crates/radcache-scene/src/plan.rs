@@ -68,6 +68,11 @@ pub struct AnimationPlan {
     pub time_range: Option<(f32, f32)>,
 }
 
+/// Most emissive triangles whose unshadowed light the cache's direct pass computes in closed
+/// form ([`ScenePlan::analytic_emitters`]): each costs every pixel one horizon-clipped polygon
+/// integral per sub-frame, a few dozen flops beside a shadow ray's traversal.
+pub const ANALYTIC_EMITTERS_MAX: usize = 16;
+
 /// Rendering plan of a scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScenePlan {
@@ -75,6 +80,10 @@ pub struct ScenePlan {
     pub emissive_triangles: usize,
     /// Their total luminance-weighted power (W).
     pub emissive_power: f32,
+    /// The cache's direct pass computes the emitters' unshadowed light in closed form and
+    /// samples only their visibility (the ratio estimator, docs/cache-frame.md §2.2): at most
+    /// [`ANALYTIC_EMITTERS_MAX`] emissive triangles, none with an emissive texture.
+    pub analytic_emitters: bool,
     /// Punctual light instances by kind.
     pub lights: LightCounts,
     /// Environment kind.
@@ -111,8 +120,14 @@ impl ScenePlan {
         } else {
             AnimationKind::None
         };
+        let textured_emission = scene
+            .materials
+            .iter()
+            .any(|m| m.emissive_texture.is_some() && m.emissive.max_element() > 0.0);
+        let count = emitters.triangles.len();
         ScenePlan {
-            emissive_triangles: emitters.triangles.len(),
+            analytic_emitters: count > 0 && count <= ANALYTIC_EMITTERS_MAX && !textured_emission,
+            emissive_triangles: count,
             emissive_power: emitters.total_power,
             lights,
             environment: match scene.environment {
@@ -176,8 +191,14 @@ impl fmt::Display for ScenePlan {
         if self.has_emissive() {
             writeln!(
                 f,
-                "  emissive triangles: {} (power {:.4} W)",
-                self.emissive_triangles, self.emissive_power
+                "  emissive triangles: {} (power {:.4} W; cache frames: {})",
+                self.emissive_triangles,
+                self.emissive_power,
+                if self.analytic_emitters {
+                    "unshadowed light in closed form, shadows sampled"
+                } else {
+                    "sampled with MIS"
+                }
             )?;
         } else {
             writeln!(f, "  emissive triangles: none")?;
@@ -194,7 +215,9 @@ impl fmt::Display for ScenePlan {
         }
         let env = match self.environment {
             EnvironmentKind::None => "none",
-            EnvironmentKind::Constant => "constant",
+            EnvironmentKind::Constant => {
+                "constant (cache frames: its light gathered by the records, unless `--sky direct`)"
+            }
             EnvironmentKind::Map => "map",
         };
         writeln!(f, "  environment: {env}")?;

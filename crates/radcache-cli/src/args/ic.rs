@@ -4,7 +4,7 @@
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 use radcache_cache::{IcParams, Preset, WeightKind};
-use radcache_render::SkyLight;
+use radcache_render::{EmitterLight, SkyLight};
 
 /// Cache quality preset.
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -34,6 +34,16 @@ pub enum Sky {
     Records,
     /// Sampled by the direct pass at every pixel.
     Direct,
+}
+
+/// How the direct pass estimates the light of emissive triangles.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Emitters {
+    /// The unshadowed light in closed form, its shadows sampled (default; where the plan allows:
+    /// a few untextured emitters, see `radcache info`).
+    Analytic,
+    /// Light and BSDF sampling with MIS.
+    Sampled,
 }
 
 /// The cache's command-line options.
@@ -66,6 +76,9 @@ pub struct IcArgs {
     /// Where a constant environment's light (a sky) enters the frame (`--method ic`).
     #[arg(long, value_enum, default_value_t = Sky::Records)]
     pub sky: Sky,
+    /// How the direct pass estimates the light of emissive triangles (`--method ic`).
+    #[arg(long, value_enum, default_value_t = Emitters::Analytic)]
+    pub emitters: Emitters,
 }
 
 fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T)> {
@@ -82,6 +95,14 @@ fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T
 }
 
 impl IcArgs {
+    /// How the emitters' direct light is estimated.
+    pub fn emitter_light(&self) -> EmitterLight {
+        match self.emitters {
+            Emitters::Analytic => EmitterLight::Analytic,
+            Emitters::Sampled => EmitterLight::Sampled,
+        }
+    }
+
     /// Where the sky's light goes.
     pub fn sky_light(&self) -> SkyLight {
         match self.sky {

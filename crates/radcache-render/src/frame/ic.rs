@@ -98,7 +98,7 @@ impl IcRenderer {
             params,
             gbuffer: GBuffer::new(ctx, w, h)?,
             gbuffer_pass: GBufferPass::new(ctx, shaders)?,
-            direct: DirectPass::new(ctx, shaders, gpu, settings.sky)?,
+            direct: DirectPass::new(ctx, shaders, gpu, settings.sky, settings.emitters)?,
             splat: SplatPass::new(ctx, shaders, w, h)?,
             holes: HolePass::new(ctx, shaders)?,
             neighbours: NeighbourPass::new(ctx, shaders)?,
@@ -117,7 +117,10 @@ impl IcRenderer {
             reclamp_next: false,
             has_records: false,
             frames: 0,
-            sky_in_records: settings.sky.define(gpu.has_constant_environment()).is_some(),
+            sky_in_records: settings
+                .sky
+                .define(gpu.has_constant_environment())
+                .is_some(),
         })
     }
 

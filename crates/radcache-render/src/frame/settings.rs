@@ -23,7 +23,10 @@ pub struct IcSettings {
     /// 256², 8 sub-frames halve the relMSE of 4 at the same number of direct samples, because
     /// edges dominate the error).
     pub sub_frames: u32,
-    /// Direct-lighting samples per pixel and sub-frame (one ray each, one-sample MIS).
+    /// Direct-lighting samples per pixel and sub-frame (one ray each, one-sample MIS). Where
+    /// the emitters' light is taken in closed form ([`EmitterLight::Analytic`]), a quarter of
+    /// them (rounded up) are the emitters' shadow rays, which measured about the noise of all of
+    /// them sampled with MIS (docs/cache-frame.md §2.2), and the rest go to the environment.
     pub direct_samples: u32,
     /// Seed of the random sequences.
     pub seed: u32,
@@ -50,6 +53,31 @@ pub struct IcSettings {
     /// Where a constant environment's light (a sky) enters the frame: through the records
     /// (the default) or the direct pass. Must be set when the renderer is created.
     pub sky: SkyLight,
+    /// How the direct pass estimates the light of emissive triangles. Must be set when the
+    /// renderer is created.
+    pub emitters: EmitterLight,
+}
+
+/// How the cache's direct pass estimates the light of emissive triangles (docs/cache-frame.md
+/// §2.2).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum EmitterLight {
+    /// Where the plan allows it (`ScenePlan::analytic_emitters`: a few untextured emitters),
+    /// the unshadowed light in closed form times the visible fraction of the light samples
+    /// (the ratio estimator); elsewhere as [`EmitterLight::Sampled`].
+    #[default]
+    Analytic,
+    /// One-sample MIS of light and BSDF sampling.
+    Sampled,
+}
+
+impl EmitterLight {
+    /// The shader define of `self` for a scene whose plan allows the closed form
+    /// (`analytic_allowed`).
+    pub fn define(self, analytic_allowed: bool) -> Option<(&'static str, &'static str)> {
+        (self == EmitterLight::Analytic && analytic_allowed)
+            .then_some(("HAS_ANALYTIC_EMITTERS", "1"))
+    }
 }
 
 /// Where the light of a constant environment (a sky) enters a frame rendered with the cache
@@ -92,6 +120,7 @@ impl Default for IcSettings {
             settle_records: false,
             time_step_s: 0.0,
             sky: SkyLight::Records,
+            emitters: EmitterLight::Analytic,
         }
     }
 }

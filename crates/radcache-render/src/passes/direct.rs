@@ -9,7 +9,7 @@ use radcache_vk::{
 
 use crate::bindings::direct as b;
 use crate::error::Result;
-use crate::frame::settings::SkyLight;
+use crate::frame::settings::{EmitterLight, SkyLight};
 use crate::passes::gbuffer::GBuffer;
 use crate::scene::GpuScene;
 
@@ -20,8 +20,8 @@ radcache_shared::gpu_struct! {
         pub samples: u32 => "uint",
         /// Seed.
         pub seed: u32 => "uint",
-        /// First sample.
-        pub first_sample: u32 => "uint",
+        /// Sub-frame (its samples continue the previous sub-frames' sequences).
+        pub sub_frame: u32 => "uint",
         /// Padding.
         pub pad: u32 => "uint",
     }
@@ -41,15 +41,18 @@ impl std::fmt::Debug for DirectPass {
 
 impl DirectPass {
     /// Compiles the pass for `scene`'s plan; with [`SkyLight::Records`] it leaves a constant
-    /// environment out (the records bring it).
+    /// environment out (the records bring it), with [`EmitterLight::Analytic`] it takes the
+    /// emitters' unshadowed light in closed form where the plan allows.
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
         sky: SkyLight,
+        emitters: EmitterLight,
     ) -> Result<DirectPass> {
         let mut defines = scene.defines();
         defines.extend(sky.define(scene.has_constant_environment()));
+        defines.extend(emitters.define(scene.plan().analytic_emitters));
         let spirv = shaders.compile("passes/direct.comp", &defines)?;
         let pipeline = Pipeline::compute(
             ctx,
@@ -71,16 +74,16 @@ impl DirectPass {
         Ok(DirectPass { pipeline, rays })
     }
 
-    /// Records `samples` estimates per pixel into the G-buffer's direct image: samples
-    /// `first_sample .. first_sample + samples` of the pixel's low-discrepancy sequence for the
-    /// frame's `seed` (sub-frames continue one sequence: pass `k × samples` for sub-frame k).
+    /// Records `samples` estimates per pixel into the G-buffer's direct image for sub-frame
+    /// `sub_frame` of the frame's `seed`: the pixel's low-discrepancy sequences continue from
+    /// one sub-frame to the next (sub-frame k takes their samples `k × count ..`).
     pub fn record(
         &self,
         rec: &mut Recorder,
         scene: &GpuScene,
         gbuffer: &GBuffer,
         samples: u32,
-        first_sample: u32,
+        sub_frame: u32,
         seed: u32,
     ) -> Result<()> {
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
@@ -91,7 +94,7 @@ impl DirectPass {
         let push = DirectPush {
             samples: samples.max(1),
             seed,
-            first_sample,
+            sub_frame,
             pad: 0,
         };
         let (w, h) = (gbuffer.width, gbuffer.height);

@@ -60,7 +60,11 @@ impl IcRenderer {
             return Err(Error::Invalid(format!(
                 "the cache's records {} the sky's light, the renderer's {} (`--sky {}`)",
                 if cache.sky { "hold" } else { "do not hold" },
-                if self.sky_in_records { "must" } else { "must not" },
+                if self.sky_in_records {
+                    "must"
+                } else {
+                    "must not"
+                },
                 if cache.sky { "records" } else { "direct" }
             )));
         }

@@ -273,10 +273,14 @@ impl IcRenderer {
         let (gbuffer, state) = (&self.gbuffer, &self.state);
         let mut rec = ctx.begin("ic.shade")?;
         self.gbuffer_pass.record(&mut rec, gpu, gbuffer, jitter)?;
-        let samples = settings.direct_samples;
-        let first_sample = k * samples.max(1);
-        self.direct
-            .record(&mut rec, gpu, gbuffer, samples, first_sample, settings.seed)?;
+        self.direct.record(
+            &mut rec,
+            gpu,
+            gbuffer,
+            settings.direct_samples,
+            k,
+            settings.seed,
+        )?;
         self.splat.record(
             &mut rec,
             "splat",
