@@ -40,7 +40,7 @@ vec2 kronecker2(uint g, vec2 shift) {
     return min(fract(shift + float(g) * alpha), vec2(ONE_MINUS_EPS));
 }
 
-// The sky in the records (IC_SKY_IN_RECORDS, docs/cache-frame.md §2.1): a constant environment's
+// The sky in the records (IC_SKY_IN_RECORDS, docs/cache-frame.md §8.3): a constant environment's
 // light then reaches the frame through the records' gathers, which count it on a first-segment
 // miss, and this pass leaves it out (it samples only emitters, the map and punctual lights).
 #if defined(HAS_ENV_CONSTANT) && !defined(IC_SKY_IN_RECORDS)
@@ -186,7 +186,7 @@ vec3 analytic_emitter_irradiance(vec3 origin, vec3 n) {
 }
 
 // The sums of the ratio estimator of the emitters' direct light (Heitz, Hill, McGuire 2018,
-// "Combining analytic direct illumination and stochastic shadows"; docs/cache-frame.md §2.2):
+// "Combining analytic direct illumination and stochastic shadows"; docs/cache-frame.md §8.2):
 // over `count` light samples (g = first .. first + count of the pixel's R3 sequence), Σ f/p and
 // Σ V·f/p with f the unshadowed integrand. The estimate is the closed-form unshadowed irradiance
 // times their ratio, the visible fraction (the same samples above and below: exact where the
@@ -268,7 +268,7 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
 #ifdef HAS_ANALYTIC_EMITTERS
     // The emitters take their own shadow rays, a quarter of the samples (the ratio estimator
     // with its neighbourhood reaches about the noise of `samples` MIS samples with them:
-    // docs/cache-frame.md §2.2); the one-sample MIS loop keeps the rest for the environment.
+    // docs/cache-frame.md §8.2); the one-sample MIS loop keeps the rest for the environment.
     uint n_emitters = max(1u, (samples + 3u) / 4u);
 #ifdef HAS_SAMPLED_SOURCES
     n = max(1u, samples - n_emitters);
@@ -305,7 +305,7 @@ shared vec3 s_normal[64];
 // The visible fraction of the emitters' light at this pixel: Σ sum_visible / Σ sum_all over the
 // pixel and the neighbours of its 3×3 block (within its 8×8 workgroup) that lie on the same
 // surface: normals within 25°, within one pixel footprint of its tangent plane and three of its
-// position (docs/cache-frame.md §2.2). Per channel; a channel no sample reached counts as hidden.
+// position (docs/cache-frame.md §8.2). Per channel; a channel no sample reached counts as hidden.
 vec3 neighbourhood_ratio(GSample g, PixelLight light) {
     ivec2 l = ivec2(gl_LocalInvocationID.xy);
     vec3 all_sum = light.sum_all;

@@ -18,7 +18,7 @@
 // roulette costs little variance per ray saved; common/path.glsl, with path regeneration),
 // WITHOUT the emission of the first hit and WITHOUT the environment on a first-segment miss (the
 // direct pass accounts for both at the shading point) — except, with IC_SKY_IN_RECORDS, a constant
-// environment's radiance on a first-segment miss (the sky in the records, docs/cache-frame.md §2.1).
+// environment's radiance on a first-segment miss (the sky in the records, docs/cache-frame.md §8.3).
 // r_jk is the first hit's distance, IC_FAR on a miss. A non-finite sample counts as 0.
 //
 // Record (§2.6, §3, §4): one invocation sums the strata exactly as the CPU twin
@@ -221,7 +221,7 @@ void main() {
         if (st.done) {
             vec3 l = path_radiance(st);
 #ifdef IC_SKY_IN_RECORDS
-            // The sky in the records (docs/cache-frame.md §2.1): a first segment that escapes
+            // The sky in the records (docs/cache-frame.md §8.3): a first segment that escapes
             // brings the constant environment's radiance, which the direct pass leaves out.
             if (st.first_t >= IC_PATH_MISS) {
                 l += frame.environment.rgb;

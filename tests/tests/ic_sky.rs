@@ -1,4 +1,4 @@
-//! The sky through the records (`SkyLight`, docs/cache-frame.md §2.1) on lavapipe: the Cornell box
+//! The sky through the records (`SkyLight`, docs/cache-frame.md §8.3) on lavapipe: the Cornell box
 //! opened to a constant sky renders the same with the sky's light gathered by the records as with
 //! it sampled by the direct pass, and both match the path tracer; records made with the sky in
 //! them are refused by a renderer that samples it directly.

@@ -4,6 +4,7 @@
 //! | file | scene | size | spp | seed |
 //! |---|---|---|---|---|
 //! | `cornell_256.exr` | `assets/cornell/cornell.gltf` | 256×256 | 2048 | 12345 |
+//! | `courtyard_256.exr` | `assets/courtyard/courtyard.gltf` | 256×256 | 1024 | 0 |
 
 use anyhow::{Context as _, Result};
 use radcache_image::{write_exr, ExrOptions, Image, Metadata};
@@ -26,13 +27,22 @@ pub struct Reference {
 }
 
 /// The references the tests use.
-pub const REFERENCES: &[Reference] = &[Reference {
-    file: "cornell_256.exr",
-    scene: "assets/cornell/cornell.gltf",
-    size: (256, 256),
-    spp: 2048,
-    seed: 12345,
-}];
+pub const REFERENCES: &[Reference] = &[
+    Reference {
+        file: "cornell_256.exr",
+        scene: "assets/cornell/cornell.gltf",
+        size: (256, 256),
+        spp: 2048,
+        seed: 12345,
+    },
+    Reference {
+        file: "courtyard_256.exr",
+        scene: "assets/courtyard/courtyard.gltf",
+        size: (256, 256),
+        spp: 1024,
+        seed: 0,
+    },
+];
 
 pub fn run(args: &[&str]) -> Result<()> {
     anyhow::ensure!(args.is_empty(), "usage: cargo xtask refs");

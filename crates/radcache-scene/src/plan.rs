@@ -81,7 +81,7 @@ pub struct ScenePlan {
     /// Their total luminance-weighted power (W).
     pub emissive_power: f32,
     /// The cache's direct pass computes the emitters' unshadowed light in closed form and
-    /// samples only their visibility (the ratio estimator, docs/cache-frame.md §2.2): at most
+    /// samples only their visibility (the ratio estimator, docs/cache-frame.md §8.2): at most
     /// [`ANALYTIC_EMITTERS_MAX`] emissive triangles, none with an emissive texture.
     pub analytic_emitters: bool,
     /// Punctual light instances by kind.

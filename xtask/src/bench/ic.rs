@@ -1,6 +1,8 @@
-//! `cargo xtask bench ic`: the irradiance cache on the Cornell box against the path tracer.
+//! `cargo xtask bench ic [--scene cornell|courtyard]`: the irradiance cache against the path
+//! tracer, on the Cornell box (the default) or the Sponza-class courtyard.
 //!
-//! At 256² (where `tests/refs/cornell_256.exr` is the reference), for each quality preset: the IC
+//! At 256² (where `tests/refs/<scene>_256.exr` is the reference), for each quality preset (the
+//! courtyard: the default only): the IC
 //! frame's time (everything `render_ic` does, pipeline creation included), records and rays and
 //! its relMSE; the path tracer's relMSE at 4, 16 and 64 spp and its time per spp; the
 //! path tracer's time to reach the IC's relMSE, from relMSE ∝ 1/spp fitted to the measured points
@@ -11,24 +13,62 @@
 //! time of the record-creation submissions (lavapipe's timestamps do not bracket asynchronous
 //! compute work; this time also holds the neighbour pass and the submission overhead, so the
 //! share is a lower bound), set against the raw incoherent ray-query rate in the same scene (the
-//! Cornell box's triangles, rays from random surface points, measured in the same run).
+//! scene's triangles, rays from random surface points, measured in the same run). Beside the
+//! defaults, the frame at 256² with the direct light of before the closed-form emitters and the
+//! sky through the records (`--emitters sampled --sky direct`; case suffix `_sampled_light`),
+//! with its direct rays and shade-phase time, so one run shows what they changed.
+
+/// A scene of the benchmark: name, glTF, reference, the presets timed at 256² and whether the
+/// default is also timed at 512².
+struct BenchScene {
+    name: &'static str,
+    gltf: &'static str,
+    reference: &'static str,
+    presets: &'static [Preset],
+    at_512: bool,
+}
+
+const SCENES: &[BenchScene] = &[
+    BenchScene {
+        name: "cornell",
+        gltf: "assets/cornell/cornell.gltf",
+        reference: "tests/refs/cornell_256.exr",
+        presets: &[Preset::Draft, Preset::Default, Preset::High],
+        at_512: true,
+    },
+    BenchScene {
+        name: "courtyard",
+        gltf: "assets/courtyard/courtyard.gltf",
+        reference: "tests/refs/courtyard_256.exr",
+        presets: &[Preset::Default],
+        at_512: false,
+    },
+];
 
 use anyhow::Result;
 use radcache_cache::{IcParams, Preset};
 use radcache_image::{compare, read_exr, Image};
-use radcache_render::{render_ic, render_path, Budget, GpuScene, IcSettings, PathSettings};
+use radcache_render::{
+    render_ic, render_path, Budget, EmitterLight, GpuScene, IcSettings, PathSettings, SkyLight,
+};
 use radcache_scene::{LoadOptions, Scene};
 
 use super::harness::{Bench, Figure};
 
 pub fn run(args: &[&str]) -> Result<()> {
-    anyhow::ensure!(args.is_empty(), "usage: cargo xtask bench ic");
+    let usage = "usage: cargo xtask bench ic [--scene cornell|courtyard]";
+    let which = match args {
+        [] => "cornell",
+        ["--scene", name] => name,
+        _ => anyhow::bail!(usage),
+    };
+    let bs = SCENES
+        .iter()
+        .find(|s| s.name == which)
+        .ok_or_else(|| anyhow::anyhow!("no benchmark scene {which:?}; {usage}"))?;
     let root = crate::root();
-    let (scene, _) = Scene::load(
-        &root.join("assets/cornell/cornell.gltf"),
-        &LoadOptions::default(),
-    )?;
-    let (reference, ref_meta) = read_exr(root.join("tests/refs/cornell_256.exr"))?;
+    let (scene, _) = Scene::load(&root.join(bs.gltf), &LoadOptions::default())?;
+    let (reference, ref_meta) = read_exr(root.join(bs.reference))?;
     let ref_spp = ref_meta
         .spp
         .ok_or_else(|| anyhow::anyhow!("the reference's EXR does not record its spp"))?;
@@ -37,48 +77,64 @@ pub fn run(args: &[&str]) -> Result<()> {
     let raw = super::scene_rays::incoherent_rate_in(ctx, shaders, &scene)?;
     let mut gpu = GpuScene::new(ctx, &scene, None)?;
     let mut figures = vec![Figure::new(
-        "cornell_raw_incoherent",
+        format!("{}_raw_incoherent", bs.name),
         "rays_per_s",
         raw,
         "rays/s",
     )];
     println!(
-        "device: {}; raw incoherent rate in the Cornell box {:.2} Mrays/s",
+        "device: {}; raw incoherent rate in the {} {:.2} Mrays/s",
         bench.device(),
+        bs.name,
         raw / 1e6
     );
     let draft = IcSettings {
         params: IcParams::draft(),
         ..IcSettings::default()
     };
+    let sampled_light = IcSettings {
+        emitters: EmitterLight::Sampled,
+        sky: SkyLight::Direct,
+        ..draft.clone()
+    };
     bench.warm_up_ic(&scene, &mut gpu, draft)?;
+    bench.warm_up_ic(&scene, &mut gpu, sampled_light)?;
     bench.warm_up_path(&scene, &mut gpu)?;
 
-    // (size, preset): every preset at the reference's size, the default at 512².
-    let cases = [
-        (256u32, Preset::Draft),
-        (256, Preset::Default),
-        (256, Preset::High),
-        (512, Preset::Default),
-    ];
+    // (size, preset, sampled light): every preset at the reference's size, the default at 512²,
+    // and the default at 256² with the direct light sampled as before.
+    let mut cases: Vec<(u32, Preset, bool)> = bs.presets.iter().map(|&p| (256, p, false)).collect();
+    if bs.at_512 {
+        cases.push((512, Preset::Default, false));
+    }
+    cases.push((256, Preset::Default, true));
     let mut matched = Vec::new(); // (case, relMSE, time) of the frames with a reference
-    for (size, preset) in cases {
-        let settings = IcSettings {
+    for (size, preset, sampled) in cases {
+        let mut settings = IcSettings {
             width: size,
             height: size,
             params: IcParams::preset(preset),
             ..IcSettings::default()
         };
+        if sampled {
+            settings.emitters = EmitterLight::Sampled;
+            settings.sky = SkyLight::Direct;
+        }
         let (out, stats) = render_ic(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
         let record_rays = stats.record_rays as f64;
         let level_s = stats.record_pass_s;
         let rays: u64 = out.rays.values().sum();
         let name = format!("{preset:?}").to_lowercase();
-        let case = if preset == Preset::Default {
-            format!("cornell_{size}")
+        let mut case = if preset == Preset::Default {
+            format!("{}_{size}", bs.name)
         } else {
-            format!("cornell_{size}_{name}")
+            format!("{}_{size}_{name}", bs.name)
         };
+        if sampled {
+            case.push_str("_sampled_light");
+        }
+        let direct_rays = out.rays.get("direct").copied().unwrap_or(0) as f64;
+        let shade_s = stats.phases_s.get("shade").copied().unwrap_or(0.0);
         println!(
             "IC {size}² {name}: {:.2} s, {} records {:?}, {:.1} M rays ({:.1} M in records)",
             out.time_s,
@@ -101,6 +157,13 @@ pub fn run(args: &[&str]) -> Result<()> {
             "records",
         ));
         figures.push(Figure::new(&case, "ic_rays", rays as f64, "rays"));
+        figures.push(Figure::new(&case, "ic_direct_rays", direct_rays, "rays"));
+        figures.push(Figure::new(&case, "ic_shade_s", shade_s, "s"));
+        println!(
+            "  direct rays {:.2} M, shade phase {shade_s:.2} s ({:.0}% of the frame)",
+            direct_rays / 1e6,
+            100.0 * shade_s / out.time_s
+        );
         if level_s > 0.0 {
             let rate = record_rays / level_s;
             println!(
@@ -148,13 +211,13 @@ pub fn run(args: &[&str]) -> Result<()> {
             out.time_s, m.relmse
         );
         figures.push(Figure::new(
-            format!("cornell_256_pt{spp}"),
+            format!("{}_256_pt{spp}", bs.name),
             "time_s",
             out.time_s,
             "s",
         ));
         figures.push(Figure::new(
-            format!("cornell_256_pt{spp}"),
+            format!("{}_256_pt{spp}", bs.name),
             "relmse",
             m.relmse,
             "relMSE",
@@ -173,7 +236,7 @@ pub fn run(args: &[&str]) -> Result<()> {
         "PT: relMSE × spp = {c:.3e}, {t1:.3} s per spp; the {ref_spp}-spp reference's own relMSE ≈ {e_ref:.2e}"
     );
     figures.push(Figure::new(
-        "cornell_256",
+        format!("{}_256", bs.name),
         "reference_relmse",
         e_ref,
         "relMSE",

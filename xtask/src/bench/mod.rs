@@ -23,7 +23,7 @@ pub fn run(args: &[&str]) -> Result<()> {
         ["scaling", rest @ ..] => scaling::run(rest),
         ["temporal", rest @ ..] => temporal::run(rest),
         _ => bail!(
-            "usage: cargo xtask bench rays [--rays N] | pt [--spp N] | ic \
+            "usage: cargo xtask bench rays [--rays N] | pt [--spp N] | ic [--scene cornell|courtyard] \
              | scaling [--preset draft|default|high] [--max-size N] \
              | temporal [--frames N] [--size S] [--preset P] [--reference-frames K] \
              [--reference-spp SPP]"

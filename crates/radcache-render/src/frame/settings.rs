@@ -26,7 +26,7 @@ pub struct IcSettings {
     /// Direct-lighting samples per pixel and sub-frame (one ray each, one-sample MIS). Where
     /// the emitters' light is taken in closed form ([`EmitterLight::Analytic`]), a quarter of
     /// them (rounded up) are the emitters' shadow rays, which measured about the noise of all of
-    /// them sampled with MIS (docs/cache-frame.md §2.2), and the rest go to the environment.
+    /// them sampled with MIS (docs/cache-frame.md §8.2), and the rest go to the environment.
     pub direct_samples: u32,
     /// Seed of the random sequences.
     pub seed: u32,
@@ -81,7 +81,7 @@ impl EmitterLight {
 }
 
 /// Where the light of a constant environment (a sky) enters a frame rendered with the cache
-/// (docs/cache-frame.md §2.1).
+/// (docs/cache-frame.md §8.3).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum SkyLight {
     /// The records' gathers count it on a first-segment miss and the direct pass leaves it
