@@ -12,7 +12,7 @@ use radcache_render::{PathSettings, SkyLight};
 use radcache_scene::{EnvOverride, LoadOptions, Scene};
 use radcache_tests::{context, finish, shaders};
 
-const SIZE: u32 = 40;
+const SIZE: u32 = 32;
 const SKY: [f32; 3] = [0.6, 0.5, 0.4];
 
 /// The Cornell box under a constant sky, which lights its inside through the open side.
@@ -56,7 +56,7 @@ fn the_sky_through_the_records_matches_the_path_tracer() {
     let path = PathSettings {
         width: SIZE,
         height: SIZE,
-        budget: Budget::Samples(1024),
+        budget: Budget::Samples(512),
         ..PathSettings::default()
     };
     let reference = render_path(&ctx, &shaders, &scene, &mut gpu, &path, &mut |_| {}).unwrap();
