@@ -22,7 +22,7 @@
 //! [`RecordPass::record_refresh`]).
 
 use radcache_cache::sampling::ircache_hash;
-use radcache_cache::IcParams;
+use radcache_cache::{ErrorControl, IcParams};
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, ImageUse, MemoryLocation, Pipeline, Recorder,
     Resource, ShaderCompiler,
@@ -121,7 +121,8 @@ struct Io<'a> {
 
 impl RecordPass {
     /// Compiles the pass for `scene`'s plan with the cache parameters `params` (strata, spacing
-    /// limits and weight kind, which sets the validity scale of `R⁻`/`R⁺`).
+    /// limits and weight kind, which sets the validity scale of `R⁻`/`R⁺`; the Hessian error
+    /// control is compiled in with the define `IC_HESSIAN`).
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
@@ -134,7 +135,11 @@ impl RecordPass {
                 "{m}×{n} strata: M ≥ 1, N ≥ 3 and at most {MAX_STRATA} in all"
             )));
         }
-        let spirv = shaders.compile(SHADER, &scene.defines())?;
+        let mut defines = scene.defines();
+        if params.error_control == ErrorControl::Hessian {
+            defines.push(("IC_HESSIAN", "1"));
+        }
+        let spirv = shaders.compile(SHADER, &defines)?;
         let pipeline = Pipeline::compute(
             ctx,
             "records",
