@@ -30,8 +30,8 @@
 //
 // Hessian error control (§10, compiled in with the define IC_HESSIAN, IcParams::error_control):
 // R = hessian_radius of the edge Hessians of the sample mesh instead of max(R_harm,
-// R_min_restricted); the invocations sum the cells j·N + k ≡ lid (mod RECORD_GROUP) (the CPU
-// twin radcache_cache::compute_hessian sums them in index order) and invocation 0 adds the
+// R_min_restricted); each invocation sums a contiguous run of cells (the CPU twin
+// radcache_cache::compute_hessian sums them all in index order) and invocation 0 adds the
 // partial sums. The mesh uses the unfolded directions (a folded stratum keeps the direction its
 // jitter gives).
 //
@@ -121,15 +121,30 @@ vec4 hessian_share(uint lid, uint m, uint n, uint seed, float r_eps) {
             y_cap = y;
         }
     }
+    // A contiguous run of cells, so that along a row cell (j, k−1)'s B, C, D are this cell's
+    // BL, B, A and only C, D and AU are new.
+    uint per = (count + RECORD_GROUP - 1u) / RECORD_GROUP;
+    uint end = min(lid * per + per, count);
     vec4 acc = vec4(0.0);
-    for (uint i = lid; i < count; i += RECORD_GROUP) {
+    vec4 a = vec4(0.0), b = vec4(0.0), c = vec4(0.0), d = vec4(0.0), bl = vec4(0.0);
+    float ya = 0.0, yb = 0.0, yc = 0.0, yd = 0.0, y_bl = 0.0;
+    for (uint i = lid * per; i < end; ++i) {
         uint j = i / n, k = i % n;
-        float ya, yb, yc, yd, y_bl, y_au = 0.0;
-        vec4 a = mesh_vertex(j, k, m, n, seed, r_eps, mean_y, ya);
-        vec4 b = mesh_vertex(j + 1u, k, m, n, seed, r_eps, mean_y, yb);
-        vec4 c = mesh_vertex(j + 1u, k + 1u, m, n, seed, r_eps, mean_y, yc);
-        vec4 d = mesh_vertex(j, k + 1u, m, n, seed, r_eps, mean_y, yd);
-        vec4 bl = mesh_vertex(j + 1u, k + n - 1u, m, n, seed, r_eps, mean_y, y_bl);
+        if (i != lid * per && k != 0u) {
+            bl = b;
+            y_bl = yb;
+            a = d;
+            ya = yd;
+            b = c;
+            yb = yc;
+        } else {
+            a = mesh_vertex(j, k, m, n, seed, r_eps, mean_y, ya);
+            b = mesh_vertex(j + 1u, k, m, n, seed, r_eps, mean_y, yb);
+            bl = mesh_vertex(j + 1u, k + n - 1u, m, n, seed, r_eps, mean_y, y_bl);
+        }
+        c = mesh_vertex(j + 1u, k + 1u, m, n, seed, r_eps, mean_y, yc);
+        d = mesh_vertex(j, k + 1u, m, n, seed, r_eps, mean_y, yd);
+        float y_au = 0.0;
         vec4 au = j > 0u ? mesh_vertex(j - 1u, k + 1u, m, n, seed, r_eps, mean_y, y_au) : vec4(0.0);
         acc += hessian_cell(a, b, c, d, bl, au, vec4(ya, yb, yc, yd), y_bl, y_au, y_cap, j == 0u, j + 1u == m);
     }

@@ -53,7 +53,7 @@ pub fn hessian_angle_terms(s2: f32, h: f32) -> Vec3 {
         let (mut p0, mut p1, mut p2) = (0.0f32, 0.0f32, 0.0f32);
         for i in 0..SERIES_TERMS {
             let k = (SERIES_TERMS - 1 - i) as f32;
-            let sign = if (SERIES_TERMS - 1 - i) % 2 == 0 {
+            let sign = if (SERIES_TERMS - 1 - i).is_multiple_of(2) {
                 1.0
             } else {
                 -1.0
@@ -246,7 +246,9 @@ pub fn hessian_radius(h: Vec4, footprint: f32) -> f32 {
     let mean = 0.5 * (h.y + h.w);
     let half = 0.5 * (h.y - h.w);
     let lambda = mean.abs() + (half * half + h.z * h.z).sqrt();
-    if !(h.x > 0.0) || !(lambda > 0.0) {
+    // NaN fails both tests too.
+    let usable = h.x > 0.0 && lambda > 0.0;
+    if !usable {
         return IC_FAR;
     }
     let rel = lambda / h.x;

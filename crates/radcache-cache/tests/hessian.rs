@@ -279,8 +279,8 @@ fn record_hessian_from_samples_matches_the_reference() {
                 // farthest-vertex rule gives to the background (a stratum wide).
                 let pi = std::f32::consts::PI;
                 assert!(got.x > 0.2 * pi && got.x < 1.001 * pi, "E' {}", got.x);
-                for c in 0..3 {
-                    mean[c] += hess(got)[c] / got.x as f64 / seeds as f64;
+                for (acc, h) in mean.iter_mut().zip(hess(got)) {
+                    *acc += h / got.x as f64 / seeds as f64;
                 }
             }
             let err = diff(mean, rel) / norm(rel);
