@@ -128,7 +128,8 @@ gpu_consts! {
     /// Per-channel upper bound of the extrapolated irradiance relative to the record's value.
     pub const EXTRAPOLATION_MAX_FACTOR: f32 = 4.0;
     /// Hessian error control (docs/irradiance-cache.md §10.4): the bound on a record's integrated
-    /// second-order error, `R = (4·HESSIAN_ERROR·s²/|λ|)^{1/4}` (`s` the pixel footprint).
+    /// second-order error in pixels, `R = (4·HESSIAN_ERROR·s²/|λ|)^{1/4}` (`s` the pixel
+    /// footprint); an order-of-magnitude choice, not tuned.
     pub const HESSIAN_ERROR: f32 = 1000.0;
     /// Below `τ = S/h²` of this value the edge Hessian uses the series of `atan(√τ)/√τ`
     /// (docs/irradiance-cache.md §10.3).
