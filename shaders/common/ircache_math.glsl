@@ -4,7 +4,7 @@
 // Irradiance-cache formulas of docs/irradiance-cache.md (cited in this file as a bare §N; other
 // docs/ files by name): hemisphere sampling (§2.1, §2.2), record sums and gradients (§2.5, §3.1,
 // §3.2), radius post-processing (§4.2-§4.7), weights and splat radius (§5.1-§5.4, §5.6, §7.2),
-// extrapolation (§6.1, §6.2), temporal formulas (docs/temporal.md §3.3). Each function has the same
+// extrapolation (§6.1, §6.2), Hessian error control (§10), temporal formulas (docs/temporal.md §3.3). Each function has the same
 // name, arguments (in order) and guards as its Rust reference; Rust tuples/structs become `out`
 // parameters, `[Vec3; 3]` RGB gradients become three vec3 (R, G, B). The Rust docs hold the
 // formulas; comments here only name the section. GLSL 4.60 core, no extension; include once
@@ -17,7 +17,7 @@
 #define IRCACHE_MATH_GLSL
 
 // IC_FAR, R_FLOOR, WARD_MIN_ERROR, TL_NORMAL_SCALE, KAPPA_MIN, ELEVATION_MIN_SIN2,
-// EXTRAPOLATION_MAX_FACTOR, WEIGHT_WARD, WEIGHT_TL: declared once in Rust (radcache_shared::consts).
+// EXTRAPOLATION_MAX_FACTOR, HESSIAN_ERROR, HESSIAN_SERIES_TAU, WEIGHT_WARD, WEIGHT_TL: declared once in Rust (radcache_shared::consts).
 #include "../shared/constants.glsl"
 
 const float IC_PI = 3.14159265358979;
@@ -223,6 +223,146 @@ void finalize_radius(float r, vec3 e, vec3 gt_r, vec3 gt_g, vec3 gt_b, float r_n
     r_hi_out = min(max(r_hi, r_lo_out), IC_FAR);
     r_used = clamp_radius(r_orig, r_lo_out, r_hi_out);
     grad_t_scale = gradient_attenuation(r_orig, r_lo_out);
+}
+
+// ---- Hessian error control (§10; Rust: hessian.rs) ----
+
+// Series terms of atan(sqrt(tau))/sqrt(tau) below HESSIAN_SERIES_TAU.
+const uint HESSIAN_SERIES_TERMS = 13u;
+
+vec3 hessian_angle_terms(float s2, float h) {
+    float q = s2 + h * h;
+    if (q <= 0.0 || (s2 <= 0.0 && h <= 0.0)) {
+        return vec3(0.0);
+    }
+    if (h > 0.0 && s2 < HESSIAN_SERIES_TAU * h * h) {
+        float tau = s2 / (h * h);
+        float p0 = 0.0, p1 = 0.0, p2 = 0.0;
+        for (uint i = 0u; i < HESSIAN_SERIES_TERMS; ++i) {
+            uint ki = HESSIAN_SERIES_TERMS - 1u - i;
+            float k = float(ki);
+            float c = ((ki & 1u) == 0u ? 1.0 : -1.0) / (2.0 * k + 1.0);
+            p0 = p0 * tau + c;
+            if (ki >= 1u) {
+                p1 = p1 * tau + c * k;
+            }
+            if (ki >= 2u) {
+                p2 = p2 * tau + c * k * (k - 1.0);
+            }
+        }
+        float h2 = h * h;
+        return vec3(p0 / h, p1 / (h2 * h), p2 / (h2 * h2 * h));
+    }
+    float s = sqrt(s2);
+    float gamma = atan(s, h);
+    float g = gamma / s;
+    float g_s = h / (2.0 * s2 * q) - gamma / (2.0 * s2 * s);
+    float g_ss = -3.0 * h / (4.0 * s2 * s2 * q) - h / (2.0 * s2 * q * q) + 3.0 * gamma / (4.0 * s2 * s2 * s);
+    return vec3(g, g_s, g_ss);
+}
+
+float hessian_vertex_distance(vec4 v) { return v.w > 0.0 ? min(length(v.xyz), IC_FAR) : IC_FAR; }
+
+// Symmetric u v^T + v u^T as (xx, xy, yy).
+vec3 hessian_outer(vec2 u, vec2 v) { return vec3(2.0 * u.x * v.x, u.x * v.y + u.y * v.x, 2.0 * u.y * v.y); }
+
+vec4 hessian_edge(vec4 a, vec4 b) {
+    float alpha = a.w > 0.0 ? 1.0 : 0.0;
+    float beta = b.w > 0.0 ? 1.0 : 0.0;
+    float la = length(a.xyz);
+    float lb = length(b.xyz);
+    if (la <= 0.0 || lb <= 0.0) {
+        return vec4(0.0);
+    }
+    if (alpha * beta > 0.0 && la > 1.0e4 * lb) {
+        alpha = 0.0;
+    }
+    if (alpha * beta > 0.0 && lb > 1.0e4 * la) {
+        beta = 0.0;
+    }
+    float scale = max(alpha * la, beta * lb);
+    float inv = scale > 0.0 ? 1.0 / scale : 1.0;
+    vec3 av = a.xyz * (alpha > 0.0 ? inv : 1.0 / la);
+    vec3 bv = b.xyz * (beta > 0.0 ? inv : 1.0 / lb);
+    vec3 c = cross(av, bv);
+    float s2 = dot(c, c);
+    float h = dot(av, bv);
+    float m = c.z;
+    vec3 g = hessian_angle_terms(s2, h);
+    float f = 0.5 * m * g.x;
+    if (scale <= 0.0 || (g.x == 0.0 && g.y == 0.0)) {
+        return vec4(f, 0.0, 0.0, 0.0);
+    }
+    float q = s2 + h * h;
+    float g_h = -1.0 / q;
+    float g_hh = 2.0 * h / (q * q);
+    float g_sh = 1.0 / (q * q);
+    vec3 w = bv * alpha - av * beta;
+    vec2 gs = 2.0 * cross(c, w).xy;
+    vec2 gh = -(bv * alpha + av * beta).xy;
+    vec2 gm = vec2(-w.y, w.x);
+    float w2 = dot(w, w);
+    vec3 hs = vec3(2.0 * (w2 - w.x * w.x), -2.0 * w.x * w.y, 2.0 * (w2 - w.y * w.y));
+    vec3 hh = vec3(1.0, 0.0, 1.0) * (2.0 * alpha * beta);
+    vec3 hess = (hs * g.y + hh * g_h) * m + hessian_outer(gs, gs) * (0.5 * m * g.z)
+              + hessian_outer(gh, gh) * (0.5 * m * g_hh) + hessian_outer(gs, gh) * (m * g_sh)
+              + hessian_outer(gs, gm) * g.y + hessian_outer(gh, gm) * g_h;
+    float k = 0.5 * inv * inv;
+    return vec4(f, hess * k);
+}
+
+vec4 hessian_vertex(uint j, uint k, uint m, uint n, uint seed, float r, float r_eps) {
+    float xi, psi;
+    stratum_jitter(seed, stratum_index(j, k, n), xi, psi);
+    vec3 d = stratum_direction_local(j, k, m, n, xi, psi);
+    if (is_valid_sample(r, r_eps) && r < IC_FAR) {
+        return vec4(d * r, 1.0);
+    }
+    return vec4(d, 0.0);
+}
+
+vec4 hessian_horizon_vertex(vec4 v) {
+    float len = length(v.xy);
+    vec2 dir = len > 0.0 ? v.xy / len : vec2(1.0, 0.0);
+    float dist = v.w > 0.0 ? length(v.xyz) : 1.0;
+    return vec4(dir * dist, 0.0, v.w);
+}
+
+float hessian_luminance(float y, float mean_y) { return mean_y > 0.0 ? 0.99 * max(y, 0.0) / mean_y + 0.01 : 1.0; }
+
+float hessian_farthest(vec4 a, float y_a, vec4 b, float y_b, vec4 c, float y_c) {
+    float da = hessian_vertex_distance(a);
+    float db = hessian_vertex_distance(b);
+    float dc = hessian_vertex_distance(c);
+    if (da >= db && da >= dc) {
+        return y_a;
+    }
+    return db >= dc ? y_b : y_c;
+}
+
+vec4 hessian_cell(vec4 a, vec4 b, vec4 c, vec4 d, vec4 bl, vec4 au, vec4 y, float y_bl, float y_au, float y_cap,
+                  bool first, bool last) {
+    float y_lo = hessian_farthest(a, y.x, b, y.y, d, y.w);
+    float y_hi = hessian_farthest(b, y.y, c, y.z, d, y.w);
+    float y_left = hessian_farthest(bl, y_bl, b, y.y, a, y.x);
+    float y_above = first ? y_cap : hessian_farthest(a, y.x, d, y.w, au, y_au);
+    vec4 sum = hessian_edge(b, d) * (y_lo - y_hi) + hessian_edge(a, b) * (y_lo - y_left)
+             + hessian_edge(a, d) * (y_above - y_lo);
+    if (last) {
+        sum += hessian_edge(b, c) * y_hi;
+    }
+    return sum;
+}
+
+float hessian_radius(vec4 h, float footprint) {
+    float mean = 0.5 * (h.y + h.w);
+    float half_d = 0.5 * (h.y - h.w);
+    float lambda = abs(mean) + sqrt(half_d * half_d + h.z * h.z);
+    if (!(h.x > 0.0) || !(lambda > 0.0)) {
+        return IC_FAR;
+    }
+    float rel = lambda / h.x;
+    return min(sqrt(2.0 * max(footprint, 0.0) * sqrt(HESSIAN_ERROR / rel)), IC_FAR);
 }
 
 // ---- weights (§5.1-§5.4, §5.6, §7.2) ----

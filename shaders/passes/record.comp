@@ -29,6 +29,13 @@
 // [R⁻, R⁺] = radius_bounds(footprint, min_px, max_px, v_scale). The translational gradient is
 // stored unattenuated, its attenuation min(1, R_orig/R⁻) in irradiance.w.
 //
+// Hessian error control (§10, compiled in with the define IC_HESSIAN, IcParams::error_control):
+// R = hessian_radius of the edge Hessians of the sample mesh instead of max(R_harm,
+// R_min_restricted); each invocation sums a contiguous run of cells (the CPU twin
+// radcache_cache::compute_hessian sums them all in index order) and invocation 0 adds the
+// partial sums. The mesh uses the unfolded directions (a folded stratum keeps the direction its
+// jitter gives).
+//
 // Guards (§2.7): irradiance that is not storable (irradiance_is_valid) or a requested pixel without
 // a surface gives a REJECTED record: E = 0, no gradients, zero normal (every weight's normal test
 // fails), R_orig = IC_FAR (it clamps no neighbour) and R⁻ = R⁺ = R_FLOOR (its splat is empty);
@@ -76,6 +83,75 @@ shared uint s_next;  // the next stratum no invocation has taken
 vec3 stratum_l(uint i) {
     return vec3(s_lr[i], s_lg[i], s_lb[i]);
 }
+
+#ifdef IC_HESSIAN
+shared vec4 s_hessian[RECORD_GROUP];  // per-invocation partial sums
+
+// Vertex (j, k) of the sample mesh (row m: the horizon), k wrapping, and its normalised luminance.
+vec4 mesh_vertex(uint j, uint k, uint m, uint n, uint seed, float r_eps, float mean_y, out float y) {
+    uint kk = k % n;
+    uint js = min(j, m - 1u);
+    uint i = stratum_index(js, kk, n);
+    vec4 v = hessian_vertex(js, kk, m, n, seed, s_r[i], r_eps);
+    y = hessian_luminance(luminance_rec709(stratum_l(i)), mean_y);
+    return j >= m ? hessian_horizon_vertex(v) : v;
+}
+
+// This invocation's share of radcache_cache::compute_hessian: (E', H_tt, H_tb, H_bb).
+vec4 hessian_share(uint lid, uint m, uint n, uint seed, float r_eps) {
+    uint count = m * n;
+    float part = 0.0;
+    for (uint i = lid; i < count; i += RECORD_GROUP) {
+        part += luminance_rec709(stratum_l(i));
+    }
+    s_hessian[lid] = vec4(part, 0.0, 0.0, 0.0);
+    barrier();
+    float sum_y = 0.0;
+    for (uint g = 0u; g < RECORD_GROUP; ++g) {
+        sum_y += s_hessian[g].x;
+    }
+    barrier();
+    float mean_y = sum_y / float(count);
+    float cap_d = -1.0, y_cap = 1.0;
+    for (uint k = 0u; k < n; ++k) {
+        float y;
+        vec4 v = mesh_vertex(0u, k, m, n, seed, r_eps, mean_y, y);
+        float d = hessian_vertex_distance(v);
+        if (d > cap_d) {
+            cap_d = d;
+            y_cap = y;
+        }
+    }
+    // A contiguous run of cells, so that along a row cell (j, k−1)'s B, C, D are this cell's
+    // BL, B, A and only C, D and AU are new.
+    uint per = (count + RECORD_GROUP - 1u) / RECORD_GROUP;
+    uint end = min(lid * per + per, count);
+    vec4 acc = vec4(0.0);
+    vec4 a = vec4(0.0), b = vec4(0.0), c = vec4(0.0), d = vec4(0.0), bl = vec4(0.0);
+    float ya = 0.0, yb = 0.0, yc = 0.0, yd = 0.0, y_bl = 0.0;
+    for (uint i = lid * per; i < end; ++i) {
+        uint j = i / n, k = i % n;
+        if (i != lid * per && k != 0u) {
+            bl = b;
+            y_bl = yb;
+            a = d;
+            ya = yd;
+            b = c;
+            yb = yc;
+        } else {
+            a = mesh_vertex(j, k, m, n, seed, r_eps, mean_y, ya);
+            b = mesh_vertex(j + 1u, k, m, n, seed, r_eps, mean_y, yb);
+            bl = mesh_vertex(j + 1u, k + n - 1u, m, n, seed, r_eps, mean_y, y_bl);
+        }
+        c = mesh_vertex(j + 1u, k + 1u, m, n, seed, r_eps, mean_y, yc);
+        d = mesh_vertex(j, k + 1u, m, n, seed, r_eps, mean_y, yd);
+        float y_au = 0.0;
+        vec4 au = j > 0u ? mesh_vertex(j - 1u, k + 1u, m, n, seed, r_eps, mean_y, y_au) : vec4(0.0);
+        acc += hessian_cell(a, b, c, d, bl, au, vec4(ya, yb, yc, yd), y_bl, y_au, y_cap, j == 0u, j + 1u == m);
+    }
+    return acc;
+}
+#endif
 
 uvec4 record_info(uint pixel_index, uint flags) {
     return uvec4(pixel_index, g_level_subframe & 0xffffu, g_level_subframe >> 16u, flags);
@@ -243,6 +319,11 @@ void main() {
     }
     atomicAdd(s_rays, rays_traced);
     barrier();
+#ifdef IC_HESSIAN
+    vec4 share = hessian_share(lid, m, n, record_seed, pc.r_eps_rel * frame.camera_position.w);
+    s_hessian[lid] = share;
+    barrier();
+#endif
     if (lid != 0u) {
         return;
     }
@@ -298,7 +379,15 @@ void main() {
 
     // Radius (§4.7 steps 1, 3-5; step 2, neighbour clamping, is the neighbour pass).
     float r_harm = harmonic_mean_distance(sum_inv, float(valid));
+#ifdef IC_HESSIAN
+    vec4 hessian = vec4(0.0);
+    for (uint gi = 0u; gi < RECORD_GROUP; ++gi) {
+        hessian += s_hessian[gi];
+    }
+    float r_raw = hessian_radius(hessian, g.footprint);
+#else
     float r_raw = max(r_harm, min(r_min_restricted, IC_FAR));
+#endif
     float r_lo, r_hi;
     radius_bounds(g.footprint, pc.min_px, pc.max_px, pc.v_scale, r_lo, r_hi);
     float r_orig, r_used, lo, hi, att;

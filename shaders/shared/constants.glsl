@@ -9,6 +9,8 @@ const float TL_NORMAL_SCALE = 0.12325641;
 const float KAPPA_MIN = 0.001;
 const float ELEVATION_MIN_SIN2 = 0.03015369;
 const float EXTRAPOLATION_MAX_FACTOR = 4.0;
+const float HESSIAN_ERROR = 1000.0;
+const float HESSIAN_SERIES_TAU = 0.15;
 const uint WEIGHT_WARD = 0u;
 const uint WEIGHT_TL = 1u;
 
@@ -55,6 +57,8 @@ const uint TWIN_EXTRAPOLATE = 2u;
 const uint TWIN_RADIUS = 3u;
 const uint TWIN_RECORD = 4u;
 const uint TWIN_TEMPORAL = 5u;
+const uint TWIN_HESSIAN_TERMS = 6u;
+const uint TWIN_HESSIAN_RECORD = 7u;
 
 const float ALPHA_MIN = 0.001;
 const float COS_MIN = 1e-6;

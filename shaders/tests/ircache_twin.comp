@@ -177,6 +177,76 @@ void temporal(Row i, inout Row o) {
     o.v[2] = vec4(temporal_extrapolate(i.v[0].xyz, i.v[3].xyz, i.v[2].z), 0.0);
 }
 
+// Hessian terms. in: 0 a; 1 b (vertices); 2 (S, h, footprint, -); 3 (j, k, m, n) bits; 4 (seed bits,
+// r, r_eps, mean_y); 5 c; 6 d; 7 bl; 8 au; 9 (y_a, y_b, y_c, y_d); 10 (y_bl, y_au, y_cap, flags
+// bits: 1 first, 2 last); 11 h (E', H_tt, H_tb, H_bb); 12 (u, v) of hessian_outer.
+// out: 0 hessian_edge(a, b); 1 (hessian_angle_terms(S, h), hessian_vertex_distance(a));
+// 2 hessian_vertex; 3 hessian_horizon_vertex(a); 4 (hessian_luminance(r, mean_y),
+// hessian_farthest(a, y_a, b, y_b, c, y_c), hessian_radius(h, footprint), -); 5 hessian_cell;
+// 6 (hessian_outer, -).
+void hessian_terms(Row i, inout Row o) {
+    vec4 a = i.v[0], b = i.v[1], c = i.v[5], d = i.v[6];
+    o.v[0] = hessian_edge(a, b);
+    o.v[1] = vec4(hessian_angle_terms(i.v[2].x, i.v[2].y), hessian_vertex_distance(a));
+    uint j = bits(i.v[3].x), k = bits(i.v[3].y), m = bits(i.v[3].z), n = bits(i.v[3].w);
+    o.v[2] = hessian_vertex(j, k, m, n, bits(i.v[4].x), i.v[4].y, i.v[4].z);
+    o.v[3] = hessian_horizon_vertex(a);
+    vec4 y = i.v[9];
+    o.v[4] = vec4(hessian_luminance(i.v[4].y, i.v[4].w), hessian_farthest(a, y.x, b, y.y, c, y.z),
+                  hessian_radius(i.v[11], i.v[2].z), 0.0);
+    uint flags = bits(i.v[10].w);
+    o.v[5] = hessian_cell(a, b, c, d, i.v[7], i.v[8], y, i.v[10].x, i.v[10].y, i.v[10].z, (flags & 1u) != 0u,
+                          (flags & 2u) != 0u);
+    o.v[6] = vec4(hessian_outer(i.v[12].xy, i.v[12].zw), 0.0);
+}
+
+// A sample set's compute_hessian and radius: in 0 (footprint, r_eps, -, -); 1 (m, n, first sample,
+// seed) bits. out 0 (E', H_tt, H_tb, H_bb); 1 (hessian_radius, -, -, -).
+vec4 twin_vertex(uint first, uint j, uint k, uint m, uint n, uint seed, float r_eps, float mean_y, out float y) {
+    uint kk = k % n;
+    uint js = min(j, m - 1u);
+    vec4 s = samples[first + stratum_index(js, kk, n)];
+    vec4 v = hessian_vertex(js, kk, m, n, seed, s.w, r_eps);
+    y = hessian_luminance(luminance_rec709(s.rgb), mean_y);
+    return j >= m ? hessian_horizon_vertex(v) : v;
+}
+
+void hessian_record(Row i, inout Row o) {
+    float r_eps = i.v[0].y;
+    uint m = bits(i.v[1].x), n = bits(i.v[1].y), first = bits(i.v[1].z), seed = bits(i.v[1].w);
+    uint count = m * n;
+    float sum_y = 0.0;
+    for (uint s = 0u; s < count; ++s) {
+        sum_y += luminance_rec709(samples[first + s].rgb);
+    }
+    float mean_y = sum_y / float(count);
+    float cap_d = -1.0, y_cap = 1.0;
+    for (uint k = 0u; k < n; ++k) {
+        float y;
+        vec4 v = twin_vertex(first, 0u, k, m, n, seed, r_eps, mean_y, y);
+        float d = hessian_vertex_distance(v);
+        if (d > cap_d) {
+            cap_d = d;
+            y_cap = y;
+        }
+    }
+    vec4 sum = vec4(0.0);
+    for (uint j = 0u; j < m; ++j) {
+        for (uint k = 0u; k < n; ++k) {
+            float ya, yb, yc, yd, y_bl, y_au = 0.0;
+            vec4 a = twin_vertex(first, j, k, m, n, seed, r_eps, mean_y, ya);
+            vec4 b = twin_vertex(first, j + 1u, k, m, n, seed, r_eps, mean_y, yb);
+            vec4 c = twin_vertex(first, j + 1u, k + 1u, m, n, seed, r_eps, mean_y, yc);
+            vec4 d = twin_vertex(first, j, k + 1u, m, n, seed, r_eps, mean_y, yd);
+            vec4 bl = twin_vertex(first, j + 1u, k + n - 1u, m, n, seed, r_eps, mean_y, y_bl);
+            vec4 au = j > 0u ? twin_vertex(first, j - 1u, k + 1u, m, n, seed, r_eps, mean_y, y_au) : vec4(0.0);
+            sum += hessian_cell(a, b, c, d, bl, au, vec4(ya, yb, yc, yd), y_bl, y_au, y_cap, j == 0u, j + 1u == m);
+        }
+    }
+    o.v[0] = sum;
+    o.v[1] = vec4(hessian_radius(sum, i.v[0].x), 0.0, 0.0, 0.0);
+}
+
 void main() {
     uint id = gl_GlobalInvocationID.x;
     if (id >= pc.count) {
@@ -199,6 +269,10 @@ void main() {
         record(i, o);
     } else if (pc.mode == TWIN_TEMPORAL) {
         temporal(i, o);
+    } else if (pc.mode == TWIN_HESSIAN_TERMS) {
+        hessian_terms(i, o);
+    } else if (pc.mode == TWIN_HESSIAN_RECORD) {
+        hessian_record(i, o);
     }
     outputs[id] = o;
 }

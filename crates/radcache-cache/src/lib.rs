@@ -12,6 +12,7 @@
 //! | [`weight`] | Ward and Tabellion–Lamorlette weights with in-front and normal tests, weight cap, splat radius | §5.1–§5.4, §5.6, §7.2 |
 //! | [`extrapolate`] | gradient extrapolation with the negative/exploding guards | §6.1, §6.2 |
 //! | [`temporal`] | temporal gradient, lifespan, temporal extrapolation | `docs/temporal.md` §3.3 |
+//! | [`hessian`] | Hessian-based error control: edge Hessians of the sample mesh, eigenvalues, radius | §10 |
 //! | [`params`] | [`IcParams`] and its `draft`/`default`/`high` presets | §2.2, §8.1 |
 //! | [`cache_file`] | the cache file: header, records, validation (no formula, no GLSL twin) | — |
 //!
@@ -21,7 +22,7 @@
 //! test can evaluate both sides over a table of inputs; functions returning several values return
 //! a tuple or small struct here and use `out` parameters, in field order, in GLSL. RGB gradients
 //! are three world-space vectors, one per colour channel (`[Vec3; 3]` here, three `vec3` arguments
-//! in GLSL). Only [`compute_record`] (slices; the GPU pass reduces the per-stratum terms in shared
+//! in GLSL). Only [`compute_record`], [`compute_hessian`] (slices; the GPU pass reduces the per-stratum terms in shared
 //! memory) and the test helper `sampling::stratum_contains` have no twin. `tests/glsl.rs` checks
 //! names, arities and constants and compiles the GLSL when `glslangValidator` is installed.
 //!
@@ -39,6 +40,7 @@
 
 pub mod cache_file;
 pub mod extrapolate;
+pub mod hessian;
 pub mod params;
 pub mod radius;
 pub mod record;
@@ -47,7 +49,8 @@ pub mod temporal;
 pub mod weight;
 
 pub use extrapolate::extrapolate_irradiance;
-pub use params::{IcParams, Preset};
+pub use hessian::compute_hessian;
+pub use params::{ErrorControl, IcParams, Preset};
 pub use radius::{finalize_radius, FinalRadius};
 pub use record::{compute_record, RecordEstimate};
 pub use weight::{record_weight, splat_radius, WeightKind};
@@ -56,8 +59,8 @@ use glam::Vec3;
 
 // The constants shared with GLSL are declared once, in `radcache_shared::consts`.
 pub use radcache_shared::consts::{
-    ELEVATION_MIN_SIN2, EXTRAPOLATION_MAX_FACTOR, IC_FAR, KAPPA_MIN, R_FLOOR, TL_NORMAL_SCALE,
-    WARD_MIN_ERROR,
+    ELEVATION_MIN_SIN2, EXTRAPOLATION_MAX_FACTOR, HESSIAN_ERROR, HESSIAN_SERIES_TAU, IC_FAR,
+    KAPPA_MIN, R_FLOOR, TL_NORMAL_SCALE, WARD_MIN_ERROR,
 };
 
 /// `min(max(x, lo), hi)` in GLSL's order. Unlike `f32::clamp` it never panics (`lo > hi` gives `hi`)

@@ -4,6 +4,7 @@
 //! | Field | draft | default | high | Source / reason |
 //! |---|---|---|---|---|
 //! | `weight_kind` | T&L | T&L | T&L | see [`crate::weight`] for why T&L is the default |
+//! | `error_control` | split sphere | split sphere | split sphere | §4.1; the Hessian rule (§10) is a measured alternative |
 //! | `accuracy` (Ward `a`) | 0.3 | 0.15 | 0.1 | §8.1; RADIANCE `rvu` 0.3, `rtrace` 0.1 |
 //! | `kappa` (T&L `κ`) | 0.75 | 0.5 | 1.5 | Mitsuba's κ = 1 with `qualityAdjustment` 0.5 after the overture; default measured (below, §8.2); larger κ = smaller zones |
 //! | `min_spacing_px` | 3 | 4 | 1.5 | validity radius floor in pixels; Mitsuba 3; 4 measured (below, §8.2) |
@@ -59,11 +60,24 @@ pub enum Preset {
     High,
 }
 
+/// How a record's radius `R` is chosen before the gradient limit and the clamps (§4.1, §10).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ErrorControl {
+    /// Ward's split sphere: `R = max(R_harm, R_min_restricted)` (§4.1). The default.
+    #[default]
+    SplitSphere,
+    /// Schwarzhaupt et al.'s Hessian error control: `R` from the largest eigenvalue of the
+    /// irradiance Hessian (§10; the record pass compiles it in with the define `IC_HESSIAN`).
+    Hessian,
+}
+
 /// Parameters of the irradiance cache (see the module table for values and sources).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IcParams {
     /// Interpolation weight (§5).
     pub weight_kind: WeightKind,
+    /// Radius rule (§4.1, §10); not stored in cache files.
+    pub error_control: ErrorControl,
     /// Ward accuracy `a` (§5.2); used when `weight_kind` is Ward.
     pub accuracy: f32,
     /// Tabellion–Lamorlette `κ` (§5.3); used when `weight_kind` is T&L.
@@ -104,6 +118,7 @@ impl IcParams {
     pub fn preset(preset: Preset) -> Self {
         let base = Self {
             weight_kind: WeightKind::default(),
+            error_control: ErrorControl::default(),
             accuracy: 0.15,
             kappa: 0.5,
             min_spacing_px: 4.0,

@@ -16,10 +16,14 @@ use radcache_shared::glsl_twin::{
 };
 
 /// Rust functions with no GLSL twin (slices / test helpers) and their reason.
-const RUST_ONLY: [(&str, &str); 2] = [
+const RUST_ONLY: [(&str, &str); 3] = [
     (
         "compute_record",
         "takes slices; the GPU pass reduces the per-stratum terms",
+    ),
+    (
+        "compute_hessian",
+        "takes slices; the GPU pass sums the per-cell terms",
     ),
     ("stratum_contains", "test helper"),
 ];
@@ -135,6 +139,8 @@ fn constants_are_generated_not_copied() {
         "KAPPA_MIN",
         "ELEVATION_MIN_SIN2",
         "EXTRAPOLATION_MAX_FACTOR",
+        "HESSIAN_ERROR",
+        "HESSIAN_SERIES_TAU",
         "WEIGHT_WARD",
         "WEIGHT_TL",
     ];

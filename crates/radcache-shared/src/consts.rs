@@ -127,6 +127,13 @@ gpu_consts! {
     pub const ELEVATION_MIN_SIN2: f32 = 0.030_153_69;
     /// Per-channel upper bound of the extrapolated irradiance relative to the record's value.
     pub const EXTRAPOLATION_MAX_FACTOR: f32 = 4.0;
+    /// Hessian error control (docs/irradiance-cache.md §10.4): the bound on a record's integrated
+    /// second-order error in pixels, `R = (4·HESSIAN_ERROR·s²/|λ|)^{1/4}` (`s` the pixel
+    /// footprint); an order-of-magnitude choice, not tuned.
+    pub const HESSIAN_ERROR: f32 = 1000.0;
+    /// Below `τ = S/h²` of this value the edge Hessian uses the series of `atan(√τ)/√τ`
+    /// (docs/irradiance-cache.md §10.3).
+    pub const HESSIAN_SERIES_TAU: f32 = 0.15;
     /// `WeightKind::Ward` on the GPU.
     pub const WEIGHT_WARD: u32 = 0;
     /// `WeightKind::TabellionLamorlette` on the GPU.
@@ -286,6 +293,10 @@ gpu_enum! {
         Record = 4,
         /// The temporal formulas.
         Temporal = 5,
+        /// The Hessian error control's per-edge and per-cell functions.
+        HessianTerms = 6,
+        /// A whole record's Hessian and radius from stratum samples.
+        HessianRecord = 7,
     }
 }
 

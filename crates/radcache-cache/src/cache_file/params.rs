@@ -52,6 +52,8 @@ pub(super) fn params_from_words(w: &[u32; 13]) -> Result<IcParams, Refusal> {
     let f = f32::from_bits;
     Ok(IcParams {
         weight_kind,
+        // Not one of the file's words (docs/irradiance-cache.md §10.5).
+        error_control: crate::params::ErrorControl::default(),
         accuracy: f(w[1]),
         kappa: f(w[2]),
         min_spacing_px: f(w[3]),

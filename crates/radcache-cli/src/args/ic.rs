@@ -3,7 +3,7 @@
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
-use radcache_cache::{IcParams, Preset, WeightKind};
+use radcache_cache::{ErrorControl, IcParams, Preset, WeightKind};
 use radcache_render::{EmitterLight, SkyLight};
 
 /// Cache quality preset.
@@ -46,6 +46,15 @@ pub enum Emitters {
     Sampled,
 }
 
+/// The rule that sets a record's radius.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ErrorControlArg {
+    /// Ward's split sphere: the harmonic-mean hit distance (default).
+    SplitSphere,
+    /// Schwarzhaupt et al.'s Hessian error control (docs/irradiance-cache.md §10).
+    Hessian,
+}
+
 /// The cache's command-line options.
 #[derive(Args, Debug)]
 pub struct IcArgs {
@@ -55,6 +64,9 @@ pub struct IcArgs {
     /// Cache interpolation weight (`--method ic`).
     #[arg(long, value_enum)]
     pub weight: Option<Weight>,
+    /// Record radius rule (`--method ic`): split-sphere (default) or hessian.
+    #[arg(long, value_enum)]
+    pub error_control: Option<ErrorControlArg>,
     /// Cache accuracy: Ward's a, or 1/κ for Tabellion–Lamorlette (smaller is more accurate).
     #[arg(long)]
     pub accuracy: Option<f32>,
@@ -122,6 +134,12 @@ impl IcArgs {
             params.weight_kind = match w {
                 Weight::Tl => WeightKind::TabellionLamorlette,
                 Weight::Ward => WeightKind::Ward,
+            };
+        }
+        if let Some(e) = self.error_control {
+            params.error_control = match e {
+                ErrorControlArg::SplitSphere => ErrorControl::SplitSphere,
+                ErrorControlArg::Hessian => ErrorControl::Hessian,
             };
         }
         if let Some(a) = self.accuracy {

@@ -22,7 +22,7 @@
 //! [`RecordPass::record_refresh`]).
 
 use radcache_cache::sampling::ircache_hash;
-use radcache_cache::IcParams;
+use radcache_cache::{ErrorControl, IcParams};
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, ImageUse, MemoryLocation, Pipeline, Recorder,
     Resource, ShaderCompiler,
@@ -122,8 +122,9 @@ struct Io<'a> {
 
 impl RecordPass {
     /// Compiles the pass for `scene`'s plan with the cache parameters `params` (strata, spacing
-    /// limits and weight kind, which sets the validity scale of `R⁻`/`R⁺`); with
-    /// [`SkyLight::Records`] a gather ray that escapes brings a constant environment's radiance.
+    /// limits and weight kind, which sets the validity scale of `R⁻`/`R⁺`; the Hessian error
+    /// control is compiled in with the define `IC_HESSIAN`); with [`SkyLight::Records`] a gather
+    /// ray that escapes brings a constant environment's radiance.
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
@@ -139,6 +140,9 @@ impl RecordPass {
         }
         let mut defines = scene.defines();
         defines.extend(sky.define(scene.has_constant_environment()));
+        if params.error_control == ErrorControl::Hessian {
+            defines.push(("IC_HESSIAN", "1"));
+        }
         let spirv = shaders.compile(SHADER, &defines)?;
         let pipeline = Pipeline::compute(
             ctx,
