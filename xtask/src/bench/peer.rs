@@ -8,7 +8,7 @@
 //!    `~/.cache/radcache/peer/<hash>/`);
 //! 2. the reference: Mitsuba at `--reference-spp` (default 8192) samples per pixel, cached as an
 //!    EXR beside the export (keyed by the export's hash, which covers resolution and camera, and
-//!    the spp), so a second run reuses it;
+//!    the spp), so a second run reuses it (or any cached one with more samples);
 //! 3. radcache renders the frame with `--method ic` at the default preset in-process after a
 //!    warm-up frame, as `bench ic` does: its wall time is T;
 //! 4. Mitsuba renders for the same T: a discarded warm-up pass compiles its kernels (not in the
@@ -96,7 +96,6 @@ fn parse(args: &[&str]) -> Result<Options> {
 pub fn run(args: &[&str]) -> Result<()> {
     let opts = parse(args)?;
     let peer = Mitsuba::find()?;
-    let cache = mitsuba::cache_root()?.join("peer");
     let root = crate::root();
     let bench = Bench::new("peer")?;
     println!(
@@ -104,65 +103,26 @@ pub fn run(args: &[&str]) -> Result<()> {
         bench.device(),
         peer.version()
     );
+    for (s, file) in &opts.radcache_refs {
+        let path = root.join(file);
+        anyhow::ensure!(
+            path.exists(),
+            "bench peer: radcache reference for {s}: {} does not exist",
+            path.display()
+        );
+    }
     let mut figures = Vec::new();
     let mut rows = Vec::new();
     for (name, t) in &opts.scenes {
-        let (scene, _) = Scene::load(
-            &root.join(format!("assets/{name}/{name}.gltf")),
-            &LoadOptions::default(),
-        )?;
-        let aspect = scene.camera.perspective.aspect_ratio.unwrap_or(1.0);
-        let height = opts.height;
-        let width = ((height as f32 * aspect).round() as u32).max(1);
-        let xml = mitsuba::export(&scene, *t, width, height, &cache)?;
-        let reference = reference(&peer, &xml, opts.reference_spp)?;
-        let case = format!("{name}_{height}");
-        for (s, file) in opts.radcache_refs.iter().filter(|(s, _)| s == name) {
-            let path = root.join(file);
-            let (rc_ref, meta) =
-                read_exr(&path).with_context(|| format!("radcache reference for {s}"))?;
-            let m = compare(&rc_ref, &reference)?;
-            let dev = m.max_mean_ratio_dev();
-            println!(
-                "{name}: Mitsuba {} spp against radcache's {} ({} spp): mean ratio {:.4?} \
-                 (max |dev| {:.2}%), relMSE {:.3e}",
-                opts.reference_spp,
-                file,
-                meta.spp.map_or("?".into(), |s| s.to_string()),
-                m.mean_ratio,
-                100.0 * dev,
-                m.relmse
-            );
-            figures.push(Figure::new(&case, "validation_mean_dev", dev, "ratio"));
-            figures.push(Figure::new(&case, "validation_relmse", m.relmse, "relMSE"));
+        let scene_run = one_scene(&bench, &peer, &opts, name, *t, &mut figures);
+        match scene_run {
+            Ok(row) => rows.push(row),
+            Err(e) => {
+                // Keep the finished scenes' figures.
+                bench.finish(&figures)?;
+                return Err(e.context(format!("bench peer: scene {name}")));
+            }
         }
-
-        // radcache: default preset, in-process, warm.
-        let (ctx, shaders) = (bench.ctx(), bench.shaders());
-        let mut gpu = GpuScene::new(ctx, &scene, None)?;
-        let settings = IcSettings {
-            width,
-            height,
-            params: IcParams::preset(Preset::Default),
-            time: *t,
-            ..IcSettings::default()
-        };
-        bench.warm_up_ic(&scene, &mut gpu, settings.clone())?;
-        let (out, _) = render_ic(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
-        drop(gpu);
-        let rc_image = Image::from_pixels(out.width, out.height, out.pixels)?;
-        let big_t = out.time_s;
-
-        let mi = peer.render(&xml, PeerBudget::Seconds(big_t), PASS_SPP)?;
-        let rc = compare(&reference, &rc_image)?;
-        let pm = compare(&reference, &mi.image)?;
-        // Mitsuba's relMSE × spp, with the reference's noise (same estimator) fitted out.
-        let c = pm.relmse / (1.0 / f64::from(mi.spp) + 1.0 / f64::from(opts.reference_spp));
-        let e_ref = c / f64::from(opts.reference_spp);
-        let row = Row::new(name, big_t, &rc, &mi, &pm, e_ref);
-        row.print();
-        row.figures(&case, &mut figures);
-        rows.push(row);
     }
     println!("\n| scene | T s | radcache relMSE | block RMSE | FLIP | Mitsuba spp | time s | relMSE | block RMSE | FLIP | relMSE Mitsuba/radcache |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
@@ -172,15 +132,97 @@ pub fn run(args: &[&str]) -> Result<()> {
     bench.finish(&figures)
 }
 
-/// Mitsuba's long render of `xml`, cached beside the export.
-fn reference(peer: &Mitsuba, xml: &std::path::Path, spp: u32) -> Result<Image> {
-    let path = xml.with_file_name(format!("reference_{spp}spp.exr"));
-    if path.exists() {
+/// One scene: export, reference, validation, radcache's frame and Mitsuba's equal-time render.
+fn one_scene(
+    bench: &Bench,
+    peer: &Mitsuba,
+    opts: &Options,
+    name: &str,
+    t: f32,
+    figures: &mut Vec<Figure>,
+) -> Result<Row> {
+    let root = crate::root();
+    let cache = mitsuba::cache_root()?.join("peer");
+    let (scene, _) = Scene::load(
+        &root.join(format!("assets/{name}/{name}.gltf")),
+        &LoadOptions::default(),
+    )?;
+    let aspect = scene.camera.perspective.aspect_ratio.unwrap_or(1.0);
+    let height = opts.height;
+    let width = ((height as f32 * aspect).round() as u32).max(1);
+    let xml = mitsuba::export(&scene, t, width, height, &cache)?;
+    let (reference, ref_spp) = reference(peer, &xml, opts.reference_spp)?;
+    let case = format!("{name}_{height}");
+    for (s, file) in opts.radcache_refs.iter().filter(|(s, _)| s == name) {
+        let path = root.join(file);
+        let (rc_ref, meta) =
+            read_exr(&path).with_context(|| format!("radcache reference for {s}"))?;
+        let m = compare(&rc_ref, &reference)?;
+        let dev = m.max_mean_ratio_dev();
+        println!(
+            "{name}: Mitsuba {} spp against radcache's {} ({} spp): mean ratio {:.4?} \
+             (max |dev| {:.2}%), relMSE {:.3e}",
+            ref_spp,
+            file,
+            meta.spp.map_or("?".into(), |s| s.to_string()),
+            m.mean_ratio,
+            100.0 * dev,
+            m.relmse
+        );
+        figures.push(Figure::new(&case, "validation_mean_dev", dev, "ratio"));
+        figures.push(Figure::new(&case, "validation_relmse", m.relmse, "relMSE"));
+    }
+
+    // radcache: default preset, in-process, warm.
+    let (ctx, shaders) = (bench.ctx(), bench.shaders());
+    let mut gpu = GpuScene::new(ctx, &scene, None)?;
+    let settings = IcSettings {
+        width,
+        height,
+        params: IcParams::preset(Preset::Default),
+        time: t,
+        ..IcSettings::default()
+    };
+    bench.warm_up_ic(&scene, &mut gpu, settings.clone())?;
+    let (out, _) = render_ic(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
+    drop(gpu);
+    let rc_image = Image::from_pixels(out.width, out.height, out.pixels)?;
+    let big_t = out.time_s;
+
+    let mi = peer.render(&xml, PeerBudget::Seconds(big_t), PASS_SPP)?;
+    let rc = compare(&reference, &rc_image)?;
+    let pm = compare(&reference, &mi.image)?;
+    // Mitsuba's relMSE × spp, with the reference's noise (same estimator) fitted out.
+    let c = pm.relmse / (1.0 / f64::from(mi.spp) + 1.0 / f64::from(ref_spp));
+    let e_ref = c / f64::from(ref_spp);
+    let row = Row::new(name, big_t, &rc, &mi, &pm, e_ref);
+    row.print();
+    row.figures(&case, figures);
+    Ok(row)
+}
+
+/// Mitsuba's long render of `xml` and its spp: the cached one beside the export with the most
+/// samples if it has at least `spp` (an unreadable one is ignored with a warning), else a new one.
+fn reference(peer: &Mitsuba, xml: &std::path::Path, spp: u32) -> Result<(Image, u32)> {
+    let dir = xml.parent().unwrap_or(std::path::Path::new("."));
+    let mut cached: Vec<(u32, std::path::PathBuf)> = std::fs::read_dir(dir)
+        .with_context(|| format!("reading {}", dir.display()))?
+        .filter_map(|e| {
+            let path = e.ok()?.path();
+            let name = path.file_name()?.to_str()?;
+            let n = name.strip_prefix("reference_")?.strip_suffix("spp.exr")?;
+            Some((n.parse().ok()?, path))
+        })
+        .filter(|(n, _)| *n >= spp)
+        .collect();
+    cached.sort();
+    for (n, path) in cached.into_iter().rev() {
         match read_exr(&path) {
-            Ok((image, _)) => return Ok(image),
+            Ok((image, _)) => return Ok((image, n)),
             Err(e) => log::warn!("ignoring the cached reference: {e}"),
         }
     }
+    let path = dir.join(format!("reference_{spp}spp.exr"));
     println!(
         "rendering the Mitsuba reference at {spp} spp into {}",
         path.display()
@@ -196,7 +238,7 @@ fn reference(peer: &Mitsuba, xml: &std::path::Path, spp: u32) -> Result<Image> {
         ..ExrOptions::default()
     };
     write_exr(&path, &r.image, &meta, &options)?;
-    Ok(r.image)
+    Ok((r.image, r.spp))
 }
 
 /// One scene's figures.
