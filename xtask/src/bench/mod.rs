@@ -6,6 +6,7 @@
 
 mod harness;
 mod ic;
+mod peer;
 mod pt;
 mod rays;
 mod scaling;
@@ -22,11 +23,13 @@ pub fn run(args: &[&str]) -> Result<()> {
         ["ic", rest @ ..] => ic::run(rest),
         ["scaling", rest @ ..] => scaling::run(rest),
         ["temporal", rest @ ..] => temporal::run(rest),
+        ["peer", rest @ ..] => peer::run(rest),
         _ => bail!(
             "usage: cargo xtask bench rays [--rays N] | pt [--spp N] | ic [--scene cornell|courtyard] \
              | scaling [--preset draft|default|high] [--max-size N] \
              | temporal [--frames N] [--size S] [--preset P] [--reference-frames K] \
-             [--reference-spp SPP]"
+             [--reference-spp SPP] \
+             | peer [--scenes a,b,..] [--reference-spp N] [--height H] [--radcache-ref SCENE=FILE.exr]"
         ),
     }
 }
