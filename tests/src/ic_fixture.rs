@@ -293,3 +293,24 @@ pub fn sequence_settings(size: u32, time: f32, frame: u32) -> radcache_render::I
         ..radcache_render::IcSettings::default()
     }
 }
+
+/// A G-buffer texel as `shaders/tests/gbuffer_fill.comp` reads it: pixel, position, shading
+/// normal and footprint, geometric normal (the record-pass tests write G-buffers from these).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GbufferPoint {
+    /// Pixel (x, y).
+    pub pixel: [u32; 4],
+    /// Position.
+    pub p: Vec3,
+    /// Padding.
+    pub pad_p: f32,
+    /// Shading normal.
+    pub n: Vec3,
+    /// World size of one pixel at `p`.
+    pub footprint: f32,
+    /// Geometric normal.
+    pub ng: Vec3,
+    /// Padding.
+    pub pad_ng: f32,
+}

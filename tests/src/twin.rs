@@ -4,10 +4,22 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use radcache_vk::{vk, Access, Context, Pipeline, Resource};
+use radcache_vk::{vk, Access, BindingKind, BindingLayout, Context, Pipeline, Resource};
 
 use crate::Rng;
 pub use radcache_shared::consts::{BrdfTwinMode, TwinMode};
+
+/// The pipeline of the twin shader `shaders/tests/<file>`: its three storage buffers (inputs,
+/// outputs, samples) and the 8-byte push block `{mode, count}`.
+pub fn twin_pipeline(ctx: &Context, file: &str, name: &str) -> Pipeline {
+    let spirv = crate::shaders()
+        .compile(&format!("tests/{file}"), &[])
+        .unwrap();
+    let layout: Vec<BindingLayout> = (0..3)
+        .map(|b| BindingLayout::new(b, BindingKind::StorageBuffer))
+        .collect();
+    Pipeline::compute(ctx, name, &spirv, &layout, 8).unwrap()
+}
 
 /// A twin shader's mode (its push constant `mode`).
 pub trait ShaderMode: Copy {

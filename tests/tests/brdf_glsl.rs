@@ -31,10 +31,9 @@ use radcache_material::ggx::*;
 use radcache_material::polygon::*;
 use radcache_material::sampling::*;
 use radcache_tests::twin::{
-    check_diffs, unit, v4, vec, BrdfTwinMode, Case, Expect, How, LaneDiff, Row,
+    check_diffs, twin_pipeline, unit, v4, vec, BrdfTwinMode, Case, Expect, How, LaneDiff, Row,
 };
-use radcache_tests::{context, finish, shaders, Rng};
-use radcache_vk::{BindingKind, BindingLayout, Pipeline};
+use radcache_tests::{context, finish, Rng};
 
 /// The scale of sampled unit-vector components (GPU `cos`/`sin`; see the header).
 const SINCOS_SCALE: f32 = 10.0;
@@ -328,11 +327,7 @@ fn polygons(rng: &mut Rng) -> Vec<Case> {
 #[test]
 fn brdf_glsl_twin_matches_the_rust_brdf_on_the_gpu() {
     let ctx = context();
-    let spirv = shaders().compile("tests/brdf_twin.comp", &[]).unwrap();
-    let layout: Vec<BindingLayout> = (0..3)
-        .map(|b| BindingLayout::new(b, BindingKind::StorageBuffer))
-        .collect();
-    let pipeline = Pipeline::compute(&ctx, "brdf_twin", &spirv, &layout, 8).unwrap();
+    let pipeline = twin_pipeline(&ctx, "brdf_twin.comp", "brdf_twin");
     let mut rng = Rng::new(0xb2df_2026);
     let d = check_diffs(&ctx, &pipeline, BrdfTwinMode::Terms, &terms(&mut rng), &[]);
     report(TERM_LANES, &d);

@@ -17,9 +17,8 @@
 use glam::{Vec2, Vec3, Vec4};
 use radcache_cache::hessian::*;
 use radcache_cache::{luminance_rec709, HESSIAN_SERIES_TAU, IC_FAR};
-use radcache_tests::twin::{check_diffs, ub, unit, v4, Case, Expect, Row, TwinMode};
-use radcache_tests::{context, finish, shaders, Rng};
-use radcache_vk::{BindingKind, BindingLayout, Pipeline};
+use radcache_tests::twin::{check_diffs, twin_pipeline, ub, unit, v4, Case, Expect, Row, TwinMode};
+use radcache_tests::{context, finish, Rng};
 
 /// A random vertex in the upper half space: a point at distance in `[0.05, 5]` or a direction.
 fn vertex(rng: &mut Rng, finite: bool) -> Vec4 {
@@ -248,11 +247,7 @@ fn records(rng: &mut Rng) -> (Vec<Case>, Vec<[f32; 4]>) {
 #[test]
 fn hessian_twin_matches_the_rust_formulas_on_the_gpu() {
     let ctx = context();
-    let spirv = shaders().compile("tests/ircache_twin.comp", &[]).unwrap();
-    let layout: Vec<BindingLayout> = (0..3)
-        .map(|b| BindingLayout::new(b, BindingKind::StorageBuffer))
-        .collect();
-    let pipeline = Pipeline::compute(&ctx, "ircache_twin", &spirv, &layout, 8).unwrap();
+    let pipeline = twin_pipeline(&ctx, "ircache_twin.comp", "ircache_twin");
     let mut rng = Rng::new(0x4e55_1a2b);
     let report = |name: &str, d: [[radcache_tests::twin::LaneDiff; 4]; 16], slots: usize| {
         for (s, lanes) in d.iter().take(slots).enumerate() {

@@ -7,7 +7,7 @@
 //! of the Hessian's relative tolerance, `1e-5 · max Y' · Σ 1/r²` over its `|λ|`). The irradiance
 //! is that of the split-sphere pass, and `R_H` is not its harmonic-mean distance.
 
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Zeroable;
 use glam::Vec3;
 use radcache_cache::hessian::{compute_hessian, hessian_luminance, hessian_radius};
 use radcache_cache::radius::{finalize_radius, pixel_footprint};
@@ -15,26 +15,13 @@ use radcache_cache::{luminance_rec709, ErrorControl, IcParams, IC_FAR};
 use radcache_render::{record_seed, GBuffer, GpuScene, IcState, RecordPass, SkyLight, R_EPS_REL};
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::geometry::intersect;
-use radcache_tests::ic_fixture::fill_gbuffer_points;
+use radcache_tests::ic_fixture::{fill_gbuffer_points, GbufferPoint};
 use radcache_tests::scenes::load;
 use radcache_tests::{context, finish, shaders};
 use radcache_vk::{vk, Access, BindingKind, BindingLayout, Pipeline};
 
 const W: u32 = 32;
 const H: u32 = 32;
-
-/// A G-buffer texel as `gbuffer_fill.comp` reads it.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct Point {
-    pixel: [u32; 4],
-    p: Vec3,
-    pad_p: f32,
-    n: Vec3,
-    footprint: f32,
-    ng: Vec3,
-    pad_ng: f32,
-}
 
 fn xyz(v: [f32; 4]) -> Vec3 {
     Vec3::new(v[0], v[1], v[2])
@@ -80,7 +67,7 @@ fn hessian_records_match_the_cpu_twin() {
         (1, 30),
         (12, 18),
     ];
-    let points: Vec<Point> = pixels
+    let points: Vec<GbufferPoint> = pixels
         .iter()
         .map(|&(x, y)| {
             let sx = ((x as f32 + 0.5) / W as f32 * 2.0 - 1.0) * tan_half;
@@ -94,7 +81,7 @@ fn hessian_records_match_the_cpu_twin() {
             let (t, tri) = hits.min_by(|a, b| a.0.total_cmp(&b.0)).expect("a surface");
             let ng = (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize();
             let ng = if ng.dot(d) > 0.0 { -ng } else { ng };
-            let mut q = Point::zeroed();
+            let mut q = GbufferPoint::zeroed();
             q.pixel = [x, y, 0, 0];
             q.p = (o.as_dvec3() + d.as_dvec3() * t).as_vec3();
             (q.n, q.ng) = (ng, ng);

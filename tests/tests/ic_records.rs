@@ -9,7 +9,7 @@
 //! (Cornell box), within 5 standard errors taken from the per-stratum spread (treating the strata
 //! as independent samples, which overestimates the error of a stratified estimate).
 
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Zeroable;
 use glam::Vec3;
 use radcache_cache::radius::{finalize_radius, pixel_footprint};
 use radcache_cache::record::*;
@@ -21,7 +21,7 @@ use radcache_render::{RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP, RECORD_F
 use radcache_scene::Scene;
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::geometry::intersect;
-use radcache_tests::ic_fixture::fill_gbuffer_points;
+use radcache_tests::ic_fixture::{fill_gbuffer_points, GbufferPoint};
 use radcache_tests::scenes::{load, temp_dir};
 use radcache_tests::{context, finish, shaders};
 use radcache_vk::ShaderCompiler;
@@ -33,30 +33,14 @@ const H: u32 = 32;
 /// Record slots the tests look at (the pass must leave the others alone).
 const SLOTS: usize = 16;
 
-/// A G-buffer texel, as `gbuffer_fill.comp` reads it: pixel, position, shading normal and
-/// footprint, geometric normal.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct Point {
-    pixel: [u32; 4],
-    p: Vec3,
-    pad_p: f32,
-    n: Vec3,
-    footprint: f32,
-    ng: Vec3,
-    pad_ng: f32,
-}
-
-fn point(x: u32, y: u32, p: Vec3, n: Vec3) -> Point {
-    let mut q = Point::zeroed();
+fn point(x: u32, y: u32, p: Vec3, n: Vec3) -> GbufferPoint {
+    let mut q = GbufferPoint::zeroed();
     (q.pixel, q.p, q.n, q.ng, q.footprint) = ([x, y, 0, 0], p, n, n, 0.01);
     q
 }
 
-impl Point {
-    fn index(&self) -> u32 {
-        self.pixel[1] * W + self.pixel[0]
-    }
+fn point_index(q: &GbufferPoint) -> u32 {
+    q.pixel[1] * W + q.pixel[0]
 }
 
 struct Fixture {
@@ -121,7 +105,7 @@ fn sentinel() -> GpuRecord {
 fn run(
     f: &mut Fixture,
     pass: &RecordPass,
-    points: &[Point],
+    points: &[GbufferPoint],
     requests: &[u32],
     counters: IcCounters,
     seed: u32,
@@ -226,7 +210,7 @@ fn gradient_scales(l: &[Vec3], r: &[f32], m: u32, n: u32, r_eps: f32) -> (f32, f
 fn check_record(
     f: &Fixture,
     params: &IcParams,
-    q: &Point,
+    q: &GbufferPoint,
     rec: &GpuRecord,
     samples: &[[f32; 4]],
     level: u32,
@@ -271,15 +255,15 @@ fn check_record(
     let flags = up_flag | if down { RECORD_FLAG_CLAMPED_DOWN } else { 0 };
     let own_flags = rec.info[3] & RECORD_FLAGS_MASK & !RECORD_FLAG_FOLDED;
     assert_eq!(own_flags, flags, "{rec:?}");
-    assert_eq!(rec.info[..3], [q.index(), level, sub_frame]);
+    assert_eq!(rec.info[..3], [point_index(q), level, sub_frame]);
     est
 }
 
 /// The gather direction of stratum `i` as the pass must generate it, and whether it was folded.
-fn direction(q: &Point, m: u32, n: u32, seed: u32, i: u32) -> (Vec3, bool) {
+fn direction(q: &GbufferPoint, m: u32, n: u32, seed: u32, i: u32) -> (Vec3, bool) {
     let nn = normalize_or_z(q.n);
     let (t, b) = basis_from_normal(nn);
-    let (xi, psi) = stratum_jitter(record_seed(q.index(), seed), i);
+    let (xi, psi) = stratum_jitter(record_seed(point_index(q), seed), i);
     let local = stratum_direction_local(i / n, i % n, m, n, xi, psi);
     let d = frame_to_world(local, t, b, nn);
     let below = d.dot(q.ng);
@@ -288,7 +272,13 @@ fn direction(q: &Point, m: u32, n: u32, seed: u32, i: u32) -> (Vec3, bool) {
 }
 
 /// Compares every gather distance with a CPU ray cast; returns (mismatches, folded directions).
-fn check_distances(f: &Fixture, q: &Point, p: &IcParams, seed: u32, s: &[[f32; 4]]) -> [usize; 2] {
+fn check_distances(
+    f: &Fixture,
+    q: &GbufferPoint,
+    p: &IcParams,
+    seed: u32,
+    s: &[[f32; 4]],
+) -> [usize; 2] {
     let (m, n) = (p.strata_m, p.strata_n);
     let (mut bad, mut folded) = (0, 0);
     for (i, s) in s.iter().enumerate() {
@@ -329,7 +319,7 @@ fn furnace_records_match_the_analytic_irradiance() {
         point(28, 30, Vec3::new(0.5, 1.0, 0.5), -Vec3::Y),
         tilted,
     ];
-    let requests: Vec<u32> = points.iter().map(Point::index).collect();
+    let requests: Vec<u32> = points.iter().map(point_index).collect();
     let (base, seed, level, sub_frame) = (3u32, 17u32, 2u32, 1u32);
     let c = counters(base, 5, 5, 64);
     let out = run(&mut f, &pass, &points, &requests, c, seed, level, sub_frame);
@@ -384,7 +374,7 @@ fn invalid_irradiance_background_and_overflow_are_guarded() {
     let q = point(5, 5, Vec3::new(0.0, -1.0, 0.0), Vec3::Y);
     // Surface (overflows), background pixel, pixel past the image, and one request past the
     // capacity (base 2 + 3 records); one workgroup more than there are requests.
-    let requests = [q.index(), 10 * W + 10, W * H + 7, q.index()];
+    let requests = [point_index(&q), 10 * W + 10, W * H + 7, point_index(&q)];
     let c = counters(2, 4, 5, 5);
     let out = run(&mut f, &pass, &[q], &requests, c, 5, 0, 3);
     let (l, r) = split(&out.samples[..params.sample_count() as usize]);
@@ -416,7 +406,7 @@ fn invalid_irradiance_background_and_overflow_are_guarded() {
 }
 
 /// The first surface hit through the centre of pixel `(x, y)`, computed on the CPU.
-fn surface_at_pixel(f: &Fixture, scene: &Scene, x: u32, y: u32) -> Point {
+fn surface_at_pixel(f: &Fixture, scene: &Scene, x: u32, y: u32) -> GbufferPoint {
     let view = scene.camera_at(0.0);
     let tan_half = (view.perspective.yfov * 0.5).tan();
     let sx = ((x as f32 + 0.5) / W as f32 * 2.0 - 1.0) * tan_half * W as f32 / H as f32;
@@ -444,10 +434,10 @@ fn cornell_records_agree_with_an_independent_estimate() {
     let mut f = fixture(&scene);
     let pixels = [(16, 26), (3, 16), (28, 16), (16, 6), (9, 29), (23, 21)];
     let at = |(x, y)| surface_at_pixel(&f, &scene, x, y);
-    let mut points: Vec<Point> = pixels.into_iter().map(at).collect();
+    let mut points: Vec<GbufferPoint> = pixels.into_iter().map(at).collect();
     // A tiny footprint puts R⁺ below the record's radius: it must be clamped down.
     points[1].footprint = 1e-4;
-    let requests: Vec<u32> = points.iter().map(Point::index).collect();
+    let requests: Vec<u32> = points.iter().map(point_index).collect();
     let k = points.len() as u32;
     let (draft, fine) = (IcParams::draft(), IcParams::default());
     let pass_a = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &draft, SkyLight::Records).unwrap();

@@ -21,9 +21,10 @@ use radcache_cache::sampling::*;
 use radcache_cache::temporal::*;
 use radcache_cache::weight::*;
 use radcache_cache::{luminance_rec709, IC_FAR};
-use radcache_tests::twin::{check, ub, unit, v4, vec, Case, Expect, How, Row, TwinMode};
-use radcache_tests::{context, finish, shaders, Rng};
-use radcache_vk::{BindingKind, BindingLayout, Pipeline};
+use radcache_tests::twin::{
+    check, twin_pipeline, ub, unit, v4, vec, Case, Expect, How, Row, TwinMode,
+};
+use radcache_tests::{context, finish, Rng};
 
 /// Mode 0: sampling, stratum coefficients and the frame.
 fn sampling(rng: &mut Rng) -> Vec<Case> {
@@ -402,11 +403,7 @@ fn temporal(rng: &mut Rng) -> Vec<Case> {
 #[test]
 fn glsl_twin_matches_the_rust_formulas_on_the_gpu() {
     let ctx = context();
-    let spirv = shaders().compile("tests/ircache_twin.comp", &[]).unwrap();
-    let layout: Vec<BindingLayout> = (0..3)
-        .map(|b| BindingLayout::new(b, BindingKind::StorageBuffer))
-        .collect();
-    let pipeline = Pipeline::compute(&ctx, "ircache_twin", &spirv, &layout, 8).unwrap();
+    let pipeline = twin_pipeline(&ctx, "ircache_twin.comp", "ircache_twin");
     let mut rng = Rng::new(0x1c_2024);
     check(
         &ctx,
