@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use radcache_cache::cache_file::{
     CacheFile, CacheFileError, CacheIdentity, CacheRecords, CacheSettings, Refusal, HEADER_LEN,
 };
-use radcache_cache::IcParams;
+use radcache_cache::{ErrorControl, IcParams};
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
 
 fn identity() -> CacheIdentity {
@@ -206,6 +206,33 @@ fn other_cache_parameters_are_refused_by_name() {
     let mut preset = identity();
     preset.params = IcParams::default();
     assert!(matches!(refusal(&path, &preset).0, Refusal::OtherParams(_)));
+}
+
+/// The radius rule is kept in the header's flags: a file made with the Hessian rule reads back
+/// with it and is refused by a render that uses the split sphere, and the other way round.
+#[test]
+fn the_error_control_rule_round_trips_and_is_refused_when_it_differs() {
+    let mut hessian = identity();
+    hessian.params.error_control = ErrorControl::Hessian;
+    let path = write(
+        "hessian.rcache",
+        &CacheFile::new(hessian, records(2)).encode(),
+    );
+    let file = CacheFile::load(&path, &hessian, 100).unwrap();
+    assert_eq!(
+        file.header.identity.params.error_control,
+        ErrorControl::Hessian
+    );
+    assert!(file.header.describe().contains("error_control: Hessian"));
+    let (r, text) = refusal(&path, &identity());
+    assert!(matches!(r, Refusal::OtherParams(_)), "{text}");
+    assert!(
+        text.contains("error_control Hessian (this render: SplitSphere)"),
+        "{text}"
+    );
+    let split = write("split.rcache", &bytes(2));
+    let (r, text) = refusal(&split, &hessian);
+    assert!(matches!(r, Refusal::OtherParams(_)), "{text}");
 }
 
 #[test]

@@ -14,7 +14,7 @@
 //! | 36..88 | [`IcParams`], 13 words in declaration order (`weight_kind` as its GLSL constant) |
 //! | 88..92 | record count n |
 //! | 92..96 | the renderer's frame count at export (the clock of the last-use marks and of the temporal state's frame numbers) |
-//! | 96..100 | flags (bit 0: the records carry lifespans; bit 1: they hold a constant environment's light, the sky) |
+//! | 96..100 | flags (bit 0: the records carry lifespans; bit 1: they hold a constant environment's light, the sky; bit 2: the Hessian error control sized them, `IcParams::error_control`) |
 //! | 100..108 | `size_of::<GpuRecord>()`, `size_of::<GpuRecordTemporal>()` (u32 each) |
 //! | 108..116 | payload length in bytes (u64) = n · (176 + 96 + 4) |
 //! | 116..120 | CRC-32 of the payload |
@@ -34,7 +34,7 @@ use std::path::Path;
 
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
 
-use crate::params::IcParams;
+use crate::params::{ErrorControl, IcParams};
 
 pub use error::{CacheFileError, Refusal};
 pub use params::ParamValue;
@@ -53,6 +53,7 @@ pub const BYTES_PER_RECORD: u64 =
 
 const FLAG_LIFESPANS: u32 = 1;
 const FLAG_SKY: u32 = 2;
+const FLAG_HESSIAN: u32 = 4;
 
 /// The settings besides the cache parameters that the records depend on (not the camera).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -217,7 +218,12 @@ impl CacheFile {
         }
         word(&mut out, h.record_count);
         word(&mut out, h.frames);
-        let flags = [(h.lifespans, FLAG_LIFESPANS), (h.sky, FLAG_SKY)];
+        let hessian = h.identity.params.error_control == ErrorControl::Hessian;
+        let flags = [
+            (h.lifespans, FLAG_LIFESPANS),
+            (h.sky, FLAG_SKY),
+            (hessian, FLAG_HESSIAN),
+        ];
         word(&mut out, flags.iter().filter(|f| f.0).map(|f| f.1).sum());
         word(&mut out, std::mem::size_of::<GpuRecord>() as u32);
         word(&mut out, std::mem::size_of::<GpuRecordTemporal>() as u32);
@@ -340,8 +346,11 @@ impl CacheHeader {
         let settings_hash = r.u32();
         let mut w = [0u32; 13];
         w.iter_mut().for_each(|w| *w = r.u32());
-        let params = params_from_words(&w)?;
+        let mut params = params_from_words(&w)?;
         let (record_count, frames, flags) = (r.u32(), r.u32(), r.u32());
+        if flags & FLAG_HESSIAN != 0 {
+            params.error_control = ErrorControl::Hessian;
+        }
         let sizes = (r.u32() as usize, r.u32() as usize);
         let (payload_len, payload_crc) = (r.u64(), r.u32());
         let ours = (
@@ -359,7 +368,9 @@ impl CacheHeader {
                 "{payload_len} payload bytes for {record_count} records of {BYTES_PER_RECORD}"
             )));
         }
-        if settings_hash != settings.hash() || flags & !(FLAG_LIFESPANS | FLAG_SKY) != 0 {
+        if settings_hash != settings.hash()
+            || flags & !(FLAG_LIFESPANS | FLAG_SKY | FLAG_HESSIAN) != 0
+        {
             return Err(Refusal::Corrupt("inconsistent settings or flags".into()));
         }
         Ok(CacheHeader {
@@ -389,12 +400,20 @@ impl CacheHeader {
                 scene: expected.scene_hash,
             });
         }
-        let differ: Vec<String> = param_words(&ours.params)
+        let mut differ: Vec<String> = param_words(&ours.params)
             .iter()
             .zip(param_words(&expected.params))
             .filter(|(a, b)| a.1 != b.1)
             .map(|(a, b)| format!("{} {} (this render: {})", a.0, a.2, b.2))
             .collect();
+        let rule = |p: &IcParams| format!("{:?}", p.error_control);
+        if ours.params.error_control != expected.params.error_control {
+            differ.push(format!(
+                "error_control {} (this render: {})",
+                rule(&ours.params),
+                rule(&expected.params)
+            ));
+        }
         if !differ.is_empty() {
             return Err(Refusal::OtherParams(differ.join(", ")));
         }
@@ -444,6 +463,7 @@ impl CacheHeader {
         for (name, _, value) in param_words(&id.params) {
             text.push_str(&format!("  {name}: {value}\n"));
         }
+        text.push_str(&format!("  error_control: {:?}\n", id.params.error_control));
         text
     }
 
