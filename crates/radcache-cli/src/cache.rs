@@ -247,15 +247,7 @@ fn build(args: &BuildArgs) -> Result<ExitCode> {
     }
     drop(renderer);
     drop(gpu);
-    let first = ctx.first_validation_error();
-    let report = ctx.shutdown();
-    if report.validation_errors > 0 {
-        bail!(
-            "{} Vulkan validation errors (first: {})",
-            report.validation_errors,
-            first.unwrap_or_default()
-        );
-    }
+    crate::frame::shut_down(ctx)?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -243,15 +243,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<ExitCode> {
         points.push(p);
     }
     drop(gpu);
-    let first_error = ctx.first_validation_error();
-    let shutdown = ctx.shutdown();
-    if shutdown.validation_errors > 0 {
-        bail!(
-            "{} Vulkan validation errors (first: {})",
-            shutdown.validation_errors,
-            first_error.unwrap_or_default()
-        );
-    }
+    crate::frame::shut_down(ctx)?;
 
     let (c, e_ref) = analyse(&mut points, reference_spp);
     let info = report::RunInfo {

@@ -321,3 +321,18 @@ pub fn pipelines_entry(setup: &FrameSetup<'_>) -> Value {
         },
     })
 }
+
+/// Shuts the device down after every GPU object of the run was dropped; fails when the
+/// validation layer reported an error (a bug, even where the outputs are already written).
+pub fn shut_down(ctx: Context) -> Result<()> {
+    let first = ctx.first_validation_error();
+    let report = ctx.shutdown();
+    if report.validation_errors > 0 {
+        anyhow::bail!(
+            "{} Vulkan validation errors (first: {})",
+            report.validation_errors,
+            first.unwrap_or_default()
+        );
+    }
+    Ok(())
+}
