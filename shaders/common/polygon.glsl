@@ -9,18 +9,25 @@
 // `t` clipped to the half-space n·(x − p) ≥ 0, written to q as vectors from p in winding order;
 // returns the vertex count (0, 3 or 4).
 uint clip_to_hemisphere(vec3 p, vec3 n, vec3 t[3], out vec3 q[4]) {
+    // Each corner's side is decided once, so an edge and its neighbour agree on it (at most 4
+    // vertices come out; recomputing a distance could round differently and overflow q).
+    float d[3];
+    for (uint i = 0u; i < 3u; ++i) {
+        d[i] = dot(n, t[i] - p);
+    }
     uint count = 0u;
     for (uint i = 0u; i < 3u; ++i) {
+        uint j = (i + 1u) % 3u;
         vec3 a = t[i] - p;
-        vec3 b = t[(i + 1u) % 3u] - p;
-        float da = dot(n, a);
-        float db = dot(n, b);
-        if (da >= 0.0) {
+        vec3 b = t[j] - p;
+        bool a_in = d[i] >= 0.0;
+        bool b_in = d[j] >= 0.0;
+        if (a_in && count < 4u) {
             q[count] = a;
             count++;
         }
-        if ((da >= 0.0) != (db >= 0.0)) {
-            float s = da / (da - db);
+        if (a_in != b_in && count < 4u) {
+            float s = d[i] / (d[i] - d[j]);
             q[count] = a + (b - a) * s;
             count++;
         }

@@ -24,18 +24,20 @@ pub fn clip_to_hemisphere(
     triangle: [Vec3; 3],
     out: &mut [Vec3; CLIPPED_MAX],
 ) -> usize {
+    // Each corner's side is decided once, so an edge and its neighbour agree on it (at most
+    // CLIPPED_MAX vertices come out).
+    let d = triangle.map(|v| n.dot(v - p));
     let mut count = 0;
     for i in 0..3 {
-        let a = triangle[i] - p;
-        let b = triangle[(i + 1) % 3] - p;
-        let (da, db) = (n.dot(a), n.dot(b));
-        if da >= 0.0 {
+        let j = (i + 1) % 3;
+        let (a, b) = (triangle[i] - p, triangle[j] - p);
+        let (a_in, b_in) = (d[i] >= 0.0, d[j] >= 0.0);
+        if a_in && count < CLIPPED_MAX {
             out[count] = a;
             count += 1;
         }
-        // The edge crosses the plane: add the crossing point.
-        if (da >= 0.0) != (db >= 0.0) {
-            let t = da / (da - db);
+        if a_in != b_in && count < CLIPPED_MAX {
+            let t = d[i] / (d[i] - d[j]);
             out[count] = a + (b - a) * t;
             count += 1;
         }
