@@ -296,14 +296,40 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
 }
 
 #ifdef HAS_ANALYTIC_EMITTERS
-// The visible fraction of the emitters' light at this pixel, per channel; a channel no sample
-// reached counts as hidden. (A 3×3 neighbourhood in shared memory lowered the noise further but
-// is left out: lavapipe aborted rarely in concurrent runs once it was in, docs/cache-frame.md §8.2.)
-vec3 pixel_ratio(PixelLight light) {
-    vec3 a = light.sum_all;
-    vec3 v = light.sum_visible;
-    return vec3(a.r > 0.0 ? v.r / a.r : 0.0, a.g > 0.0 ? v.g / a.g : 0.0,
-                a.b > 0.0 ? v.b / a.b : 0.0);
+// The workgroup's pixels' sample sums, positions and normals, for the ratio's neighbourhood.
+shared vec3 s_sum_all[64];
+shared vec3 s_sum_visible[64];
+shared vec4 s_position[64];  // w: 1 for a surface pixel
+shared vec3 s_normal[64];
+
+// The visible fraction of the emitters' light at this pixel: Σ sum_visible / Σ sum_all over the
+// pixel and the neighbours of its 3×3 block (within its 8×8 workgroup) that lie on the same
+// surface: normals within 25°, within one pixel footprint of its tangent plane and three of its
+// position (docs/cache-frame.md §8.2). Per channel; a channel no sample reached counts as hidden.
+vec3 neighbourhood_ratio(GSample g, PixelLight light) {
+    ivec2 l = ivec2(gl_LocalInvocationID.xy);
+    vec3 all_sum = light.sum_all;
+    vec3 visible = light.sum_visible;
+    float reach = 3.0 * g.footprint;
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            ivec2 q = l + ivec2(dx, dy);
+            if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThan(q, ivec2(7)))) {
+                continue;
+            }
+            uint j = uint(q.y * 8 + q.x);
+            vec3 d = s_position[j].xyz - g.position;
+            if (s_position[j].w == 0.0 || dot(s_normal[j], g.normal) < 0.9 ||
+                abs(dot(d, g.normal)) > g.footprint || dot(d, d) > reach * reach) {
+                continue;
+            }
+            all_sum += s_sum_all[j];
+            visible += s_sum_visible[j];
+        }
+    }
+    return vec3(all_sum.r > 0.0 ? visible.r / all_sum.r : 0.0,
+                all_sum.g > 0.0 ? visible.g / all_sum.g : 0.0,
+                all_sum.b > 0.0 ? visible.b / all_sum.b : 0.0);
 }
 #endif
 
@@ -325,8 +351,15 @@ void main() {
     }
     vec3 e = light.rest;
 #ifdef HAS_ANALYTIC_EMITTERS
+    // Every invocation of the workgroup reaches this barrier (no early return above).
+    uint lid = gl_LocalInvocationIndex;
+    s_sum_all[lid] = light.sum_all;
+    s_sum_visible[lid] = light.sum_visible;
+    s_position[lid] = vec4(g.position, g.surface ? 1.0 : 0.0);
+    s_normal[lid] = g.normal;
+    barrier();
     if (g.surface) {
-        e += light.unshadowed * pixel_ratio(light);
+        e += light.unshadowed * neighbourhood_ratio(g, light);
     }
 #endif
     if (!inside) {
