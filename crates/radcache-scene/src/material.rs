@@ -36,6 +36,14 @@ pub struct Material {
     pub roughness: f32,
     /// Metallic-roughness texture (linear; B = metallic, G = roughness).
     pub metallic_roughness_texture: Option<TextureRef>,
+    /// Index of refraction of the dielectric layer (`KHR_materials_ior`, default 1.5), ≥ 1.
+    pub ior: f32,
+    /// Strength of the dielectric's specular layer (`KHR_materials_specular.specularFactor`,
+    /// default 1) in `[0, 1]`. 0 with metallic 0 makes the material exactly Lambertian.
+    pub specular_factor: f32,
+    /// Colour of the dielectric's F0 (`KHR_materials_specular.specularColorFactor`, linear,
+    /// default 1).
+    pub specular_color: Vec3,
     /// Emitted radiance W/(sr·m²): emissive factor × emissive strength.
     pub emissive: Vec3,
     /// Emissive texture (sRGB), multiplied with `emissive`.
@@ -54,6 +62,9 @@ impl Material {
             metallic: 0.0,
             roughness: 1.0,
             metallic_roughness_texture: None,
+            ior: 1.5,
+            specular_factor: 1.0,
+            specular_color: Vec3::ONE,
             emissive: Vec3::ZERO,
             emissive_texture: None,
             double_sided: false,
@@ -63,6 +74,14 @@ impl Material {
     /// Diffuse albedo of the untextured material: base colour × (1 − metallic).
     pub fn diffuse_albedo(&self) -> Vec3 {
         self.base_color.truncate() * (1.0 - self.metallic.clamp(0.0, 1.0))
+    }
+
+    /// True when the material reflects as a Lambertian surface alone: metallic 0 and no
+    /// specular layer (`specularFactor` 0), so that the glTF BRDF is exactly `base colour/π`
+    /// (docs/materials.md §4.2). A scene whose materials are all Lambertian compiles no
+    /// specular code (`ScenePlan::specular`).
+    pub fn is_lambertian(&self) -> bool {
+        self.metallic == 0.0 && self.specular_factor == 0.0
     }
 
     /// True when the material emits light (non-zero `emissive`).
@@ -155,6 +174,9 @@ pub(crate) fn load_materials(
                 &user,
                 warnings,
             )?,
+            ior: 1.5,
+            specular_factor: 1.0,
+            specular_color: Vec3::ONE,
             emissive,
             emissive_texture: textures.get(src, m.emissive_texture(), true, &user, warnings)?,
             double_sided: m.double_sided(),

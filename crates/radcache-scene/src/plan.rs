@@ -84,6 +84,10 @@ pub struct ScenePlan {
     /// samples only their visibility (the ratio estimator, docs/cache-frame.md §8.2): at most
     /// [`ANALYTIC_EMITTERS_MAX`] emissive triangles, none with an emissive texture.
     pub analytic_emitters: bool,
+    /// Some material has a specular lobe (metallic, or a dielectric specular layer): the passes
+    /// compile the full metallic-roughness BRDF (`HAS_SPECULAR`). False when every material is
+    /// Lambertian ([`Material::is_lambertian`](crate::Material::is_lambertian)).
+    pub specular: bool,
     /// Punctual light instances by kind.
     pub lights: LightCounts,
     /// Environment kind.
@@ -127,6 +131,7 @@ impl ScenePlan {
         let count = emitters.triangles.len();
         ScenePlan {
             analytic_emitters: count > 0 && count <= ANALYTIC_EMITTERS_MAX && !textured_emission,
+            specular: scene.materials.iter().any(|m| !m.is_lambertian()),
             emissive_triangles: count,
             emissive_power: emitters.total_power,
             lights,

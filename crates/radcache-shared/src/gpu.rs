@@ -41,11 +41,14 @@ gpu_struct! {
         pub base_color: [f32; 4] => "vec4",
         /// Emitted radiance (rgb, factor × strength) and double-sidedness (w: 1 or 0).
         pub emission: [f32; 4] => "vec4",
-        /// Texture indices: base colour, emissive (−1 for none), unused, unused.
+        /// Texture indices: base colour, emissive, metallic-roughness (−1 for none), unused.
         pub textures: [i32; 4] => "ivec4",
         /// Metallic, roughness, luminance of the mean emitted radiance (texture mean included; the
-        /// emitter sampling table is built from it, so light-sampling pdfs use it), unused.
+        /// emitter sampling table is built from it, so light-sampling pdfs use it), index of
+        /// refraction.
         pub params: [f32; 4] => "vec4",
+        /// The dielectric's specular colour (rgb, `KHR_materials_specular`) and specular factor (w).
+        pub specular: [f32; 4] => "vec4",
     }
 }
 
