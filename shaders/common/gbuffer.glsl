@@ -5,16 +5,20 @@
 //   +1 normal     xyz unit shading normal, turned toward the camera; w = pixel footprint (world
 //                 size of one pixel at the point, ircache_math.glsl `pixel_footprint`)
 //   +2 geometric  xyz unit geometric normal, turned toward the camera; w = material index
-//   +3 albedo     rgb diffuse albedo (base colour × (1 − metallic), textured); w = the mesh
-//                 instance (custom index; exact as a float below 2^24)
-//   +4 emission   rgb radiance emitted toward the camera (front/back rule applied); w = 0
-//   +5 direct     rgb direct light reflected toward the camera (albedo/π × NEE, MIS); w = 0
+//   +3 albedo     rgb diffuse albedo (base colour × (1 − metallic), textured; with HAS_SPECULAR
+//                 the textured base colour); w = the mesh instance (custom index; exact as a
+//                 float below 2^24)
+//   +4 emission   rgb radiance emitted toward the camera (front/back rule applied); w = 0, with
+//                 HAS_SPECULAR metallic and roughness (common/gbuffer_pack.glsl)
+//   +5 direct     rgb direct light reflected toward the camera (albedo/π × NEE, MIS; with
+//                 HAS_SPECULAR the full BRDF's, plus the specular lobe's indirect light); w = 0
 //
 // Pass-specific resources start at B_GBUFFER_END (generated with the rest).
 #ifndef RADCACHE_GBUFFER_GLSL
 #define RADCACHE_GBUFFER_GLSL
 
 #include "../shared/bindings.glsl"
+#include "gbuffer_pack.glsl"
 
 #ifndef GBUFFER_DIRECT_ACCESS
 #define GBUFFER_DIRECT_ACCESS readonly
@@ -35,8 +39,12 @@ struct GSample {
     vec3 geometric;    // toward the camera
     uint material;
     uint instance;     // mesh instance (custom index)
-    vec3 albedo;
+    vec3 albedo;       // with HAS_SPECULAR: the base colour
     vec3 emission;
+#ifdef HAS_SPECULAR
+    float metallic;
+    float roughness;
+#endif
 };
 
 GSample gbuffer_load(ivec2 pixel) {
@@ -53,8 +61,24 @@ GSample gbuffer_load(ivec2 pixel) {
     vec4 a = imageLoad(g_albedo, pixel);
     s.albedo = a.rgb;
     s.instance = uint(max(a.w, 0.0));
-    s.emission = imageLoad(g_emission, pixel).rgb;
+    vec4 e = imageLoad(g_emission, pixel);
+    s.emission = e.rgb;
+#ifdef HAS_SPECULAR
+    vec2 mr = gbuffer_unpack_metallic_roughness(e.w);
+    s.metallic = mr.x;
+    s.roughness = mr.y;
+#endif
     return s;
 }
+
+#if defined(HAS_SPECULAR) && defined(RADCACHE_SCENE_GLSL)
+// The BRDF parameters of a G-buffer sample: its base colour, metallic and roughness (textured,
+// from the G-buffer), its material's index of refraction and specular layer.
+Material gbuffer_material(GSample g) {
+    GpuMaterial mat = materials[g.material];
+    return Material(g.albedo, g.metallic, g.roughness, max(mat.params.w, 1.0),
+                    clamp(mat.specular.w, 0.0, 1.0), max(mat.specular.rgb, vec3(0.0)));
+}
+#endif
 
 #endif

@@ -87,6 +87,94 @@ vec3 direct_light(Surface s, inout Rng rng) {
     return sum;
 }
 
+#ifdef HAS_SPECULAR
+// The metallic-roughness BRDF at a surface point, in its shading frame (t, b, n), for the view
+// direction `v` (local, toward the viewer). Where the interpolated shading normal faces away from
+// the viewer (v·n ≤ 0 although the geometric normal faces it: silhouettes of smooth-shaded
+// meshes) the geometric normal takes its place, so the surface never turns black there.
+struct Bsdf {
+    vec3 t;
+    vec3 b;
+    vec3 n;
+    vec3 v;
+    Material m;
+};
+
+Bsdf bsdf_at(Surface s, Material m, vec3 to_viewer) {
+    Bsdf f;
+    f.n = dot(s.shading_normal, to_viewer) > COS_MIN ? s.shading_normal : s.geometric_normal;
+    orthonormal_basis(f.n, f.t, f.b);
+    f.v = vec3(dot(to_viewer, f.t), dot(to_viewer, f.b), dot(to_viewer, f.n));
+    f.m = m;
+    return f;
+}
+
+vec3 bsdf_local(Bsdf f, vec3 dir) { return vec3(dot(dir, f.t), dot(dir, f.b), dot(dir, f.n)); }
+
+vec3 bsdf_world(Bsdf f, vec3 l) { return normalize(f.t * l.x + f.b * l.y + f.n * l.z); }
+
+// f(v, l)·(n·l) for world direction `dir` (0 below the shading or the geometric horizon).
+vec3 bsdf_f_cos(Bsdf f, Surface s, vec3 dir) {
+    vec3 l = bsdf_local(f, dir);
+    if (l.z <= 0.0 || dot(s.geometric_normal, dir) <= 0.0) {
+        return vec3(0.0);
+    }
+    return brdf_eval(f.m, f.v, l) * l.z;
+}
+
+// The solid-angle pdf with which brdf_sample draws world direction `dir`.
+float bsdf_pdf_dir(Bsdf f, vec3 dir) { return brdf_pdf(f.m, f.v, bsdf_local(f, dir)); }
+
+// Next-event estimate of the light that s reflects toward the viewer: Σ f·L·cos/pdf over one
+// sample of each plan-enabled source, MIS-weighted (power heuristic) against BSDF sampling as
+// in direct_light.
+vec3 direct_reflected(Surface s, Bsdf f, inout Rng rng) {
+    vec3 sum = vec3(0.0);
+    vec3 origin = offset_ray_origin(s.position, s.geometric_normal);
+#ifdef HAS_EMITTERS
+    {
+        vec3 dir, le;
+        float dist, pdf;
+        vec3 u = vec3(rng_next(rng), rng_next2(rng));
+        if (sample_emitter(s.position, u, dir, dist, le, pdf)) {
+            vec3 fc = bsdf_f_cos(f, s, dir);
+            if (any(greaterThan(fc, vec3(0.0))) && unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+                float w = power_heuristic(pdf, bsdf_pdf_dir(f, dir));
+                sum += le * fc * w / pdf;
+            }
+        }
+    }
+#endif
+#ifdef HAS_LIGHTS
+    for (uint i = 0u; i < frame.counts.y; ++i) {
+        vec3 dir;
+        float dist;
+        vec3 e = punctual_incident(lights[i], s.position, dir, dist);
+        vec3 fc = bsdf_f_cos(f, s, dir);
+        if (any(greaterThan(fc, vec3(0.0))) && any(greaterThan(e, vec3(0.0))) &&
+            unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+            sum += e * fc;
+        }
+    }
+#endif
+#ifdef HAS_ENV_MAP
+    {
+        vec3 dir, le;
+        float pdf;
+        vec3 u = vec3(rng_next(rng), rng_next2(rng));
+        if (sample_environment(u, dir, le, pdf)) {
+            vec3 fc = bsdf_f_cos(f, s, dir);
+            if (any(greaterThan(fc, vec3(0.0))) && unoccluded(origin, dir, 1e30)) {
+                float w = power_heuristic(pdf, bsdf_pdf_dir(f, dir));
+                sum += le * fc * w / pdf;
+            }
+        }
+    }
+#endif
+    return sum;
+}
+#endif
+
 // A path in flight, advanced one vertex at a time by path_step (so a caller can start a new path
 // in an invocation whose path ended while others go on: see passes/record.comp).
 struct PathState {
@@ -160,10 +248,23 @@ void path_step(inout PathState st, inout Rng rng) {
 #endif
         st.radiance += st.throughput * le * w;
     }
+#ifdef HAS_SPECULAR
+    // The full BRDF: next-event estimation weighted by f·cos, then a BRDF-sampled continuation.
+    Bsdf f = bsdf_at(s, material_at(s.material, s.uv), -st.ray.dir);
+    st.radiance += st.throughput * direct_reflected(s, f, rng);
+    BrdfSample bs = brdf_sample(f.m, f.v, vec3(rng_next2(rng), rng_next(rng)));
+    vec3 next_dir = bsdf_world(f, bs.l);
+    st.throughput *= bs.weight;
+    if (bs.pdf <= 0.0 || dot(next_dir, s.geometric_normal) <= 0.0) {
+        st.done = true;  // below the surface: no contribution
+        return;
+    }
+#else
     vec3 albedo = material_albedo(s.material, s.uv);
     st.radiance += st.throughput * albedo * INV_PI * direct_light(s, rng);
 
     st.throughput *= albedo;
+#endif
     uint depth = st.depth;
     st.depth++;
     if (depth >= st.rr_start) {
@@ -178,12 +279,17 @@ void path_step(inout PathState st, inout Rng rng) {
         st.done = true;
         return;
     }
+#ifdef HAS_SPECULAR
+    st.ray.dir = next_dir;
+    st.bsdf_pdf = bs.pdf;
+#else
     st.ray.dir = sample_cosine_around(s.shading_normal, rng_next2(rng));
     if (dot(st.ray.dir, s.geometric_normal) <= 0.0) {
         st.done = true;  // the shading normal sent the sample below the surface: no contribution
         return;
     }
     st.bsdf_pdf = dot(st.ray.dir, s.shading_normal) * INV_PI;
+#endif
     st.ray.origin = offset_ray_origin(s.position, s.geometric_normal);
 }
 

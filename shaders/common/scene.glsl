@@ -154,6 +154,31 @@ vec3 material_albedo(uint m, vec2 uv) {
     return clamp(base * (1.0 - mat.params.x), 0.0, 1.0);
 }
 
+#ifdef HAS_SPECULAR
+#include "brdf.glsl"
+
+// The metallic-roughness BRDF parameters of material m at uv (docs/materials.md §1): factors ×
+// textures (base colour sRGB, metallic from the blue and roughness from the green channel of the
+// metallic-roughness texture), clamped to their ranges.
+Material material_at(uint m, vec2 uv) {
+    GpuMaterial mat = materials[m];
+    vec3 base = mat.base_color.rgb;
+    if (mat.textures.x >= 0) {
+        base *= texture_sample(mat.textures.x, uv).rgb;
+    }
+    float metallic = mat.params.x;
+    float roughness = mat.params.y;
+    if (mat.textures.z >= 0) {
+        vec4 mr = texture_sample(mat.textures.z, uv);
+        roughness *= mr.g;
+        metallic *= mr.b;
+    }
+    return Material(clamp(base, 0.0, 1.0), clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0),
+                    max(mat.params.w, 1.0), clamp(mat.specular.w, 0.0, 1.0),
+                    max(mat.specular.rgb, vec3(0.0)));
+}
+#endif
+
 // Emitted radiance toward the viewer: front face only, or both when double-sided.
 vec3 material_emission(uint m, vec2 uv, bool front_face) {
     GpuMaterial mat = materials[m];

@@ -1,6 +1,7 @@
 // passes/composite.comp — Rust: crates/radcache-render/src/passes/composite.rs
 // Composite of one sub-frame (docs/cache-frame.md §6.4 normalisation): on surfaces
-// L = direct + albedo/π · Σw·Ẽ / Σw (0 where no record reaches the pixel), on the background the
+// L = direct + albedo/π · Σw·Ẽ / Σw (0 where no record reaches the pixel; with HAS_SPECULAR the
+// albedo is the base colour times the diffuse lobe's share), on the background the
 // environment along the camera ray; added with weight 1 to the frame accumulator (a = sub-frames
 // so far). The emission seen at the sub-frame's sample goes to a separate accumulator: the
 // emission pass replaces it by a finely supersampled box filter where emitters have edges.
@@ -36,7 +37,15 @@ void main() {
     if (g.surface) {
         vec4 s = imageLoad(splat_sum, pixel);
         vec3 e = s.a > 0.0 ? s.rgb / s.a : vec3(0.0);
+#ifdef HAS_SPECULAR
+        // The cached irradiance lights the diffuse lobe alone, weighted by its share for this
+        // view direction (docs/materials.md §6); the direct pass adds the specular lobe's light.
+        vec3 to_camera = normalize(frame.camera_position.xyz - g.position);
+        float share = diffuse_share(gbuffer_material(g), dot(g.normal, to_camera));
+        vec3 indirect = g.albedo * (share * INV_PI) * e;
+#else
         vec3 indirect = g.albedo * INV_PI * e;
+#endif
         l = imageLoad(g_direct, pixel).rgb + indirect;
         emitted = g.emission;
         if (pc.debug != 0u && !any(isnan(indirect)) && !any(isinf(indirect))) {

@@ -2,7 +2,10 @@
 // Direct lighting of the cache's frame (compute, ray queries): per surface pixel, `samples`
 // one-sample-MIS estimates of the light arriving straight from emissive triangles and the
 // environment (see one_sample), plus the punctual lights once (they need no sampling). Written:
-// albedo/π × the estimate (emission itself is in the G-buffer's emission image).
+// albedo/π × the estimate (emission itself is in the G-buffer's emission image). With
+// HAS_SPECULAR (a scene with non-Lambertian materials) the estimate weighs each sample with the
+// full BRDF (one_sample_brdf), and the specular lobe's indirect light is added, path traced
+// (specular_indirect); the written value is that reflected radiance.
 //
 // Sample g of a pixel (g = sub_frame · count + k; sub-frames continue the sequence) draws its random
 // numbers from Kronecker sequences (Roberts 2018, the R_d sequences: point g is fract(shift + g·α),
@@ -76,13 +79,18 @@ const float W_ENV = 1.0;
 #else
 const float W_ENV = 0.0;
 #endif
-#ifdef DIRECT_ENV_CONSTANT
+#if defined(DIRECT_ENV_CONSTANT) || defined(HAS_SPECULAR)
+// A constant environment only BSDF sampling finds; a specular lobe, BSDF sampling finds best.
 const float W_BSDF = 1.0;
 #else
 const float W_BSDF = 0.25;
 #endif
 // Without emitters or an environment there is nothing to sample (punctual lights only).
 #if defined(MIS_EMITTERS) || defined(HAS_ENV_MAP) || defined(DIRECT_ENV_CONSTANT)
+#define HAS_SAMPLED_SOURCES
+#endif
+// A specular lobe takes a constant sky here even when the records carry it (one_sample_brdf).
+#if defined(HAS_SPECULAR) && defined(HAS_ENV_CONSTANT) && !defined(HAS_SAMPLED_SOURCES)
 #define HAS_SAMPLED_SOURCES
 #endif
 const float C_EMITTER = W_EMITTER / (W_EMITTER + W_ENV + W_BSDF);
@@ -165,6 +173,129 @@ vec3 one_sample(Surface s, vec3 origin, float u_pick, vec3 u3, vec2 u2) {
     return le * cos_s / (C_EMITTER * pdf_light + C_BSDF * pdf_bsdf);
 #endif
 }
+
+#ifdef HAS_SPECULAR
+#ifdef HAS_ANALYTIC_EMITTERS
+#error "the closed-form emitters assume Lambertian receivers (ScenePlan::analytic_emitters)"
+#endif
+// One sample of the reflected radiance Σ f·L·cos/pdf with the full BRDF: the one-sample MIS of
+// one_sample, with brdf_sample (docs/materials.md §5) as the BSDF technique; `u_pick` in the BSDF
+// technique's share of [0, 1), rescaled, chooses its lobe.
+vec3 one_sample_brdf(Surface s, Bsdf f, vec3 origin, float u_pick, vec3 u3, vec2 u2) {
+#ifdef MIS_EMITTERS
+    if (u_pick < C_EMITTER) {
+        vec3 dir, le;
+        float dist, pdf;
+        if (!sample_emitter(s.position, u3, dir, dist, le, pdf)) {
+            return vec3(0.0);
+        }
+        vec3 fc = bsdf_f_cos(f, s, dir);
+        if (all(equal(fc, vec3(0.0))) || !unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+            return vec3(0.0);
+        }
+        return le * fc / (C_EMITTER * pdf + C_BSDF * bsdf_pdf_dir(f, dir));
+    }
+#endif
+#ifdef HAS_ENV_MAP
+    if (u_pick < C_EMITTER + C_ENV) {
+        vec3 dir, le;
+        float pdf;
+        if (!sample_environment(u3, dir, le, pdf)) {
+            return vec3(0.0);
+        }
+        vec3 fc = bsdf_f_cos(f, s, dir);
+        if (all(equal(fc, vec3(0.0))) || !unoccluded(origin, dir, 1e30)) {
+            return vec3(0.0);
+        }
+        return direct_environment(dir) * fc / (C_ENV * pdf + C_BSDF * bsdf_pdf_dir(f, dir));
+    }
+#endif
+    float u_lobe = min((u_pick - (C_EMITTER + C_ENV)) / C_BSDF, ONE_MINUS_EPS);
+    BrdfSample bs = brdf_sample(f.m, f.v, vec3(u2, max(u_lobe, 0.0)));
+    vec3 dir = bsdf_world(f, bs.l);
+    if (bs.pdf <= 0.0 || dot(dir, s.geometric_normal) <= 0.0) {
+        return vec3(0.0);
+    }
+    vec3 fc = bs.weight * bs.pdf;  // f·cos
+    rays_traced++;
+    rayQueryEXT q;
+    rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, origin, 0.0, dir, 1e30);
+    while (rayQueryProceedEXT(q)) {
+    }
+    if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
+        vec3 sky = direct_environment(dir) * fc / (C_ENV * env_technique_pdf(dir) + C_BSDF * bs.pdf);
+#if defined(IC_SKY_IN_RECORDS) && defined(HAS_ENV_CONSTANT)
+        // The records carry the constant sky for the diffuse lobe (its share is applied in
+        // passes/composite.comp); the specular lobe takes it here, from the BSDF technique
+        // alone (no other technique finds the constant).
+        vec3 spec_fc = brdf_eval_lobes(f.m, f.v, bs.l).specular * bs.l.z;
+        sky += frame.environment.rgb * spec_fc / (C_BSDF * bs.pdf);
+#endif
+        return sky;
+    }
+    Surface h = surface_at(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)),
+                           uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
+                           rayQueryGetIntersectionBarycentricsEXT(q, true), dir);
+    vec3 le = material_emission(h.material, h.uv, h.front_face);
+    if (all(equal(le, vec3(0.0)))) {
+        return vec3(0.0);
+    }
+    float pdf_light = 0.0;
+#ifdef MIS_EMITTERS
+    GpuMaterial m = materials[h.material];
+    float t = rayQueryGetIntersectionTEXT(q, true);
+    float cos_l = abs(dot(h.geometric_normal, dir));
+    pdf_light = emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t / max(cos_l, 1e-8);
+#endif
+    return le * fc / (C_EMITTER * pdf_light + C_BSDF * bs.pdf);
+}
+
+// The punctual lights reflected by the full BRDF.
+vec3 punctual_brdf(Surface s, Bsdf f, vec3 origin) {
+    vec3 sum = vec3(0.0);
+#ifdef HAS_LIGHTS
+    for (uint i = 0u; i < frame.counts.y; ++i) {
+        vec3 dir;
+        float dist;
+        vec3 e = punctual_incident(lights[i], s.position, dir, dist);
+        vec3 fc = bsdf_f_cos(f, s, dir);
+        if (any(greaterThan(fc, vec3(0.0))) && any(greaterThan(e, vec3(0.0))) &&
+            unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+            sum += e * fc;
+        }
+    }
+#endif
+    return sum;
+}
+
+// The specular lobe's indirect light (path traced per pixel, unbiased; pc.specular_paths paths per
+// sub-frame, passes/direct.rs `specular_paths`): one direction
+// from the GGX visible normals, weighted by the specular lobe's f·cos/pdf, and the path that
+// continues from it with nothing counted on its first segment (the light straight from a source,
+// a constant sky in the records included, is one_sample_brdf's). The diffuse lobe's indirect
+// light is the cache's (passes/composite.comp).
+vec3 specular_indirect(Surface s, Bsdf f, vec3 origin, inout Rng rng) {
+    float alpha = alpha_from_roughness(f.m.roughness);
+    vec2 u = rng_next2(rng);
+    vec3 l = brdf_normalize_or_z(brdf_reflect(f.v, sample_ggx_vndf(alpha, f.v, u.x, u.y)));
+    float pdf = ggx_reflection_pdf(alpha, f.v, l);
+    if (l.z < COS_MIN || !(pdf > 0.0)) {
+        return vec3(0.0);
+    }
+    vec3 weight = brdf_eval_lobes(f.m, f.v, l).specular * (l.z / pdf);
+    Ray ray;
+    ray.origin = origin;
+    ray.dir = bsdf_world(f, l);
+    if (all(equal(weight, vec3(0.0))) || dot(ray.dir, s.geometric_normal) <= 0.0) {
+        return vec3(0.0);
+    }
+    PathState st = path_begin(ray, 0.0, false, 2u);
+    while (!st.done) {
+        path_step(st, rng);
+    }
+    return weight * path_radiance(st);
+}
+#endif
 
 #ifdef HAS_ANALYTIC_EMITTERS
 // The unshadowed irradiance of every emissive triangle at `origin` (normal n), in closed form
@@ -280,18 +411,40 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     }
 #endif
     vec3 sum = vec3(0.0);
+#ifdef HAS_SPECULAR
+    // Everything here is reflected radiance (the full BRDF), not irradiance.
+    Bsdf f = bsdf_at(s, gbuffer_material(g), normalize(frame.camera_position.xyz - g.position));
+#endif
 #ifdef HAS_SAMPLED_SOURCES
     for (uint k = 0u; k < n; ++k) {
         uint g = pc.sub_frame * n + k;
         // The technique from the golden-ratio sequence, so each pixel's picks are stratified too.
         float u_pick = min(fract(shift_pick + float(g) * 0.6180339887), ONE_MINUS_EPS);
+#ifdef HAS_SPECULAR
+        vec3 e = one_sample_brdf(s, f, origin, u_pick, kronecker3(g, shift_light),
+                                 kronecker2(g, shift_bsdf));
+#else
         vec3 e = one_sample(s, origin, u_pick, kronecker3(g, shift_light), kronecker2(g, shift_bsdf));
+#endif
         if (!any(isnan(e)) && !any(isinf(e))) {
             sum += e;
         }
     }
 #endif
+#ifdef HAS_SPECULAR
+    vec3 spec = vec3(0.0);
+    uint paths = max(pc.specular_paths, 1u);
+    for (uint k = 0u; k < paths; ++k) {
+        Rng spec_rng = rng_init(index, pc.sub_frame * paths + k, pc.seed ^ 0x5bd1e995u);
+        vec3 e = specular_indirect(s, f, origin, spec_rng);
+        if (!any(isnan(e)) && !any(isinf(e))) {
+            spec += e;
+        }
+    }
+    light.rest = sum / float(n) + punctual_brdf(s, f, origin) + spec / float(paths);
+#else
     light.rest = sum / float(n) + punctual(s, origin);
+#endif
     return light;
 }
 
@@ -372,6 +525,10 @@ void main() {
     if (any(isnan(e)) || any(isinf(e))) {
         e = vec3(0.0);
     }
+#ifdef HAS_SPECULAR
+    imageStore(g_direct, pixel, vec4(e, 0.0));
+#else
     imageStore(g_direct, pixel, vec4(g.albedo * INV_PI * e, 0.0));
+#endif
     atomicAdd(ray_count, rays_traced);
 }

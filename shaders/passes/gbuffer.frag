@@ -12,6 +12,7 @@
 
 #include "../common/scene.glsl"
 #include "../common/ircache_math.glsl"
+#include "../common/gbuffer_pack.glsl"
 #include "gbuffer_push.glsl"
 
 layout(location = 0) in vec3 v_position;
@@ -122,6 +123,13 @@ void main() {
     o_position = vec4(position, 1.0);
     o_normal = vec4(ns, footprint);
     o_geometric = vec4(ng, float(material));
+#ifdef HAS_SPECULAR
+    Material m = material_at(material, uv);
+    o_albedo = vec4(m.base_colour, float(instance));
+    o_emission = vec4(material_emission(material, uv, front),
+                      gbuffer_pack_metallic_roughness(m.metallic, m.roughness));
+#else
     o_albedo = vec4(material_albedo(material, uv), float(instance));
     o_emission = vec4(material_emission(material, uv, front), 0.0);
+#endif
 }

@@ -22,7 +22,8 @@ struct GpuMaterial {
     vec4 emission;
     ivec4 textures;
     vec4 params;
-};  // 64 bytes
+    vec4 specular;
+};  // 80 bytes
 
 struct GpuTexture {
     uvec4 info;

@@ -12,7 +12,7 @@ struct DirectPush {
     uint samples;
     uint seed;
     uint sub_frame;
-    uint pad;
+    uint specular_paths;
 };  // 16 bytes
 
 struct GBufferPush {

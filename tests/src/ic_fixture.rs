@@ -103,7 +103,7 @@ impl Gpu {
         gpu.record_update(&ctx, &mut rec).unwrap();
         ctx.submit(rec).unwrap().wait().unwrap();
         let gbuffer = GBuffer::new(&ctx, size.0, size.1).unwrap();
-        let pass = GBufferPass::new(&ctx, &shaders).unwrap();
+        let pass = GBufferPass::new(&ctx, &shaders, &gpu).unwrap();
         Gpu {
             ctx,
             shaders,

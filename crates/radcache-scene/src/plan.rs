@@ -82,7 +82,8 @@ pub struct ScenePlan {
     pub emissive_power: f32,
     /// The cache's direct pass computes the emitters' unshadowed light in closed form and
     /// samples only their visibility (the ratio estimator, docs/cache-frame.md §8.2): at most
-    /// [`ANALYTIC_EMITTERS_MAX`] emissive triangles, none with an emissive texture.
+    /// [`ANALYTIC_EMITTERS_MAX`] emissive triangles, none with an emissive texture, and only
+    /// Lambertian materials (Lambert's formula gives irradiance, not a glossy lobe's integral).
     pub analytic_emitters: bool,
     /// Some material has a specular lobe (metallic, or a dielectric specular layer): the passes
     /// compile the full metallic-roughness BRDF (`HAS_SPECULAR`). False when every material is
@@ -129,9 +130,13 @@ impl ScenePlan {
             .iter()
             .any(|m| m.emissive_texture.is_some() && m.emissive.max_element() > 0.0);
         let count = emitters.triangles.len();
+        let specular = scene.materials.iter().any(|m| !m.is_lambertian());
         ScenePlan {
-            analytic_emitters: count > 0 && count <= ANALYTIC_EMITTERS_MAX && !textured_emission,
-            specular: scene.materials.iter().any(|m| !m.is_lambertian()),
+            analytic_emitters: count > 0
+                && count <= ANALYTIC_EMITTERS_MAX
+                && !textured_emission
+                && !specular,
+            specular,
             emissive_triangles: count,
             emissive_power: emitters.total_power,
             lights,

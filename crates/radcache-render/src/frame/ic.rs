@@ -97,7 +97,7 @@ impl IcRenderer {
             height: h,
             params,
             gbuffer: GBuffer::new(ctx, w, h)?,
-            gbuffer_pass: GBufferPass::new(ctx, shaders)?,
+            gbuffer_pass: GBufferPass::new(ctx, shaders, gpu)?,
             direct: DirectPass::new(ctx, shaders, gpu, settings.sky, settings.emitters)?,
             splat: SplatPass::new(ctx, shaders, w, h)?,
             holes: HolePass::new(ctx, shaders)?,

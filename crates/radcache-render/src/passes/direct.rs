@@ -22,9 +22,17 @@ radcache_shared::gpu_struct! {
         pub seed: u32 => "uint",
         /// Sub-frame (its samples continue the previous sub-frames' sequences).
         pub sub_frame: u32 => "uint",
-        /// Padding.
-        pub pad: u32 => "uint",
+        /// Paths of the specular lobe's indirect light per pixel (scenes with specular
+        /// materials; [`specular_paths`]).
+        pub specular_paths: u32 => "uint",
     }
+}
+
+/// Paths per pixel and sub-frame that trace the specular lobe's indirect light (scenes with
+/// specular materials): a quarter of the direct samples, at least one. A path costs a few rays
+/// (a gather path's length), a direct sample one.
+pub fn specular_paths(direct_samples: u32) -> u32 {
+    (direct_samples / 4).max(1)
 }
 
 /// The direct-lighting pipeline and its ray counter.
@@ -95,7 +103,7 @@ impl DirectPass {
             samples: samples.max(1),
             seed,
             sub_frame,
-            pad: 0,
+            specular_paths: specular_paths(samples),
         };
         let (w, h) = (gbuffer.width, gbuffer.height);
         rec.pass("direct", |rec| {

@@ -47,10 +47,11 @@ impl std::fmt::Debug for GBufferPass {
 }
 
 impl GBufferPass {
-    /// Compiles the pass.
-    pub fn new(ctx: &Context, shaders: &ShaderCompiler) -> Result<GBufferPass> {
+    /// Compiles the pass for `scene`'s materials (the fragment stage stores metallic and
+    /// roughness only where some material is not Lambertian).
+    pub fn new(ctx: &Context, shaders: &ShaderCompiler, scene: &GpuScene) -> Result<GBufferPass> {
         let vertex = shaders.compile("passes/gbuffer.vert", &[])?;
-        let fragment = shaders.compile("passes/gbuffer.frag", &[])?;
+        let fragment = shaders.compile("passes/gbuffer.frag", &scene.material_defines())?;
         let pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc {

@@ -68,10 +68,16 @@ pub(crate) fn pack_materials(scene: &Scene) -> (Vec<GpuMaterial>, Vec<GpuTexture
             textures: [
                 m.base_color_texture.map_or(-1, |t| t.texture as i32),
                 m.emissive_texture.map_or(-1, |t| t.texture as i32),
-                m.metallic_roughness_texture.map_or(-1, |t| t.texture as i32),
+                m.metallic_roughness_texture
+                    .map_or(-1, |t| t.texture as i32),
                 -1,
             ],
-            params: [m.metallic, m.roughness, radcache_scene::luminance(*e), m.ior],
+            params: [
+                m.metallic,
+                m.roughness,
+                radcache_scene::luminance(*e),
+                m.ior,
+            ],
             specular: [
                 m.specular_color.x,
                 m.specular_color.y,

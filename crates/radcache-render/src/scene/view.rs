@@ -54,9 +54,20 @@ impl GpuScene {
         &self.constants
     }
 
-    /// Shader defines that compile in only the light sources the scene has.
+    /// Shader defines of the scene's materials: `HAS_SPECULAR` when some material is not
+    /// Lambertian (`ScenePlan::specular`), which compiles in the full metallic-roughness BRDF.
+    pub fn material_defines(&self) -> Vec<(&'static str, &'static str)> {
+        if self.plan.specular {
+            vec![("HAS_SPECULAR", "1")]
+        } else {
+            Vec::new()
+        }
+    }
+
+    /// Shader defines that compile in only the light sources and material features the scene
+    /// has.
     pub fn defines(&self) -> Vec<(&'static str, &'static str)> {
-        let mut d = Vec::new();
+        let mut d = self.material_defines();
         if self.plan.has_emissive() {
             d.push(("HAS_EMITTERS", "1"));
         }
