@@ -3,6 +3,7 @@
 mod assets;
 mod bench;
 mod codegen;
+mod gallery;
 mod refs;
 mod shaders;
 mod stiff;
@@ -20,6 +21,9 @@ Tasks:
   shaders           compile every shader in shaders/ and run spirv-val on the output
   codegen [--check] write shaders/shared/*.glsl from the Rust layouts (--check: fail if stale)
   assets [--check]  write the bundled glTF scenes into assets/ (--check: fail if they differ)
+  gallery [--size N] [--spp N] [--models a,b] [--out F]
+                    the Khronos sample models of ../shared/models under an environment: cache
+                    frame against the path tracer, tiled into docs/gallery.png
   refs              render the path-traced references of the cache tests into tests/refs/
   bench rays        raw ray-query throughput and BLAS/TLAS build times on the chosen device
   bench ic          the cache on the Cornell box: time, records, rays, error, speed-up over the path tracer
@@ -63,6 +67,7 @@ fn try_main() -> Result<()> {
         }
         ["bench", rest @ ..] => bench::run(rest),
         ["refs", rest @ ..] => refs::run(rest),
+        ["gallery", rest @ ..] => gallery::run(rest),
         ["stiff", rest @ ..] => stiff::run(rest),
         [] | ["help"] | ["--help"] | ["-h"] => {
             print!("{HELP}");

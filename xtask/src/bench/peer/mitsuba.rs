@@ -8,8 +8,9 @@
 //!   (instance, material), with the scene's per-vertex normals (transformed by the inverse
 //!   transpose) on non-emissive groups; the winding is reversed under a mirroring transform so that
 //!   the counter-clockwise side stays the front, as radcache keeps it;
-//! - materials: Lambertian with the diffuse albedo (`base_colour × (1 − metallic)`), reflecting on
-//!   both sides (`twosided`) as radcache's surfaces do;
+//! - materials: Lambertian ones as `diffuse` with their albedo, white metals as GGX
+//!   `roughconductor` (see [`bsdf`]; other specular materials are refused), reflecting on both
+//!   sides (`twosided`) as radcache's surfaces do;
 //! - emission: an `area` emitter on the emissive groups, which are written without vertex normals
 //!   so that Mitsuba's front side is the geometric normal's, the side radcache emits from (front face
 //!   only);
@@ -260,6 +261,38 @@ fn v3(v: Vec3) -> String {
 }
 
 /// The XML scene and its meshes (file name, mesh).
+/// The Mitsuba BSDF of a material: `diffuse` for a Lambertian one; for a white metal (metallic
+/// 1, base colour 1, untextured) `roughconductor` with the GGX distribution, α = roughness²
+/// (floored at the BRDF's `ALPHA_MIN`), `material="none"` (Fresnel 1, as Schlick's with F0 = 1)
+/// and visible-normal sampling. Mitsuba's microfacet model uses the separable Smith term
+/// G1(v)·G1(l), glTF's the height-correlated one, which is larger: a white glTF metal reflects a
+/// little more (docs/materials.md §10). Anything else (a dielectric's specular layer, a coloured
+/// or partly metallic one) has no equivalent there and is refused.
+fn bsdf(m: &radcache_scene::Material) -> Result<String> {
+    if m.is_lambertian() {
+        return Ok(format!(
+            "<bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"{}\"/></bsdf>",
+            v3(m.diffuse_albedo())
+        ));
+    }
+    let white = m.base_color.truncate() == Vec3::ONE;
+    if m.metallic == 1.0 && white && m.metallic_roughness_texture.is_none() {
+        let alpha = (m.roughness * m.roughness).max(radcache_shared::consts::ALPHA_MIN);
+        return Ok(format!(
+            "<bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"ggx\"/><float \
+             name=\"alpha\" value=\"{alpha}\"/><string name=\"material\" value=\"none\"/><boolean \
+             name=\"sample_visible\" value=\"true\"/></bsdf>"
+        ));
+    }
+    bail!(
+        "not Lambertian and not a white untextured metal (metallic {}, base colour {}, specular \
+         factor {}); the Mitsuba export has no equivalent BSDF",
+        m.metallic,
+        v3(m.base_color.truncate()),
+        m.specular_factor
+    )
+}
+
 fn build(
     scene: &Scene,
     t: f32,
@@ -293,9 +326,8 @@ fn build(
             bail!("bench peer: {name}: material {i} is a double-sided emitter; the export has only one-sided area lights");
         }
         x += &format!(
-            "  <bsdf type=\"twosided\" id=\"m{i}\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" \
-             value=\"{}\"/></bsdf></bsdf>\n",
-            v3(m.diffuse_albedo())
+            "  <bsdf type=\"twosided\" id=\"m{i}\">{}</bsdf>\n",
+            bsdf(m).with_context(|| format!("bench peer: {name}: material {i}"))?
         );
     }
     match &scene.environment {
@@ -444,6 +476,26 @@ mod tests {
             assert_eq!(m.normals.len(), m.positions.len());
             assert!(m.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-4));
         }
+    }
+
+    #[test]
+    fn white_metals_become_ggx_conductors_and_dielectrics_are_refused() {
+        let mut m = cornell().materials[0].clone();
+        assert!(m.is_lambertian());
+        assert!(bsdf(&m).unwrap().contains("type=\"diffuse\""));
+        m.metallic = 1.0;
+        m.base_color = glam::Vec4::ONE;
+        m.roughness = 0.5;
+        let x = bsdf(&m).unwrap();
+        assert!(x.contains("roughconductor") && x.contains("value=\"0.25\""), "{x}");
+        m.roughness = 0.0;
+        assert!(bsdf(&m).unwrap().contains("value=\"0.001\""));
+        m.base_color = glam::Vec4::new(0.9, 0.6, 0.3, 1.0);
+        assert!(bsdf(&m).is_err(), "a coloured metal's Schlick Fresnel has no Mitsuba twin");
+        m.base_color = glam::Vec4::ONE;
+        m.metallic = 0.0;
+        m.specular_factor = 1.0;
+        assert!(bsdf(&m).is_err(), "a dielectric's specular layer has no Mitsuba twin");
     }
 
     #[test]
