@@ -130,6 +130,36 @@ fn info_prints_the_plan() {
 }
 
 #[test]
+fn info_names_the_material_model_and_unused_occlusion_once() {
+    let out = radcache(&["info", &cornell()]);
+    assert_ok(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("materials: lambertian only (no specular code compiled)"),
+        "{stdout}"
+    );
+    assert!(!stdout.contains("occlusion"), "{stdout}");
+
+    let helmet = common::shared_model("DamagedHelmet/glTF-Binary/DamagedHelmet.glb");
+    let out = radcache(&["info", &text(&helmet), "--env-radiance", "1,1,1"]);
+    assert_ok(&out);
+    let all = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        all.contains("materials: metallic-roughness BRDF (specular lobes compiled in)"),
+        "{all}"
+    );
+    assert_eq!(occurrences(&all, "occlusion textures"), 1, "{all}");
+    assert!(
+        all.contains("occlusion textures: not used (1 material; a global-illumination renderer computes occlusion itself)"),
+        "{all}"
+    );
+}
+
+#[test]
 fn bad_input_is_one_clear_error() {
     let dir = out_dir("bad");
     let missing = dir.join("nope.gltf");

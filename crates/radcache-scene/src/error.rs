@@ -47,12 +47,14 @@ pub enum Error {
         reason: &'static str,
     },
     /// `extensionsRequired` names an extension this loader does not implement.
-    #[error("{path}: unsupported required extension {name:?}")]
+    #[error("{path}: the file requires the glTF extension {name:?} (extensionsRequired), which radcache does not support: {reason}")]
     UnsupportedExtension {
         /// The glTF file.
         path: PathBuf,
         /// The extension name.
         name: String,
+        /// What the extension needs that radcache lacks.
+        reason: String,
     },
     /// A buffer's file is missing or unreadable, or its data URI cannot be decoded.
     #[error("{path}: {element}: cannot load buffer data from {uri:?}: {reason}")]
@@ -162,7 +164,8 @@ pub enum WarningKind {
     GeneratedNormals,
     /// Alpha MASK/BLEND material treated as opaque.
     AlphaModeIgnored,
-    /// A texture uses a texCoord set other than 0, or an unsupported image format.
+    /// A texture uses a texCoord set other than 0 or an unsupported image format, or sits in a
+    /// slot radcache does not sample (KHR_materials_specular's textures: the factors are used).
     TextureIgnored,
     /// Skins or morph targets are ignored (rest pose is used).
     SkinOrMorphIgnored,
@@ -174,6 +177,9 @@ pub enum WarningKind {
     MatrixNodeAnimated,
     /// Two animation channels target the same node property; the later one wins.
     DuplicateChannel,
+    /// Materials use an extension radcache does not implement (e.g. KHR_materials_transmission):
+    /// they render with the core metallic-roughness model; `count` says how many materials.
+    MaterialExtensionIgnored,
     /// The scene has no light source at all (no emitter, no punctual light, no environment):
     /// it renders black.
     NoLight,

@@ -32,7 +32,9 @@
 //! non-TRIANGLES primitives, primitives without POSITION. Features outside the renderer's model are
 //! loaded with a documented fallback and a warning: alpha MASK/BLEND (opaque), skins and morph
 //! targets (rest pose), texCoord sets other than 0 (texture ignored), missing normals (flat), a
-//! negative `emissiveStrength` (not emissive).
+//! negative `emissiveStrength` (not emissive), KHR_materials_specular textures (factors used),
+//! material extensions other than emissive strength, ior and specular (core model; named once
+//! each, with a count, in the warnings and the summary).
 //!
 //! The [`writer`] module builds valid glTF files (used by tests and by [`assets`], which generates
 //! the bundled Cornell box, furnace and animated scenes).
@@ -68,7 +70,7 @@ pub use environment::{direction_to_equirect, equirect_to_direction, EnvOverride,
 pub use error::{Error, Result, Warning, WarningKind};
 pub use light::{LightInstance, LightKind, LightSample, PunctualLight, WorldLight};
 pub use load::LoadOptions;
-pub use material::{emitted_radiance, Material};
+pub use material::{emitted_radiance, Material, MaterialNotes, IOR_INFINITE};
 pub use math::{luminance, Aabb, Trs};
 pub use mesh::{Mesh, PrimitiveRange};
 pub use node::{LocalTransform, Node};

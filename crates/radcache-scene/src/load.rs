@@ -47,7 +47,7 @@ impl Scene {
         let order = traversal_order(&src, &mut nodes, &roots)?;
 
         let mut textures = TextureLoader::default();
-        let mut materials = load_materials(&src, &mut textures, &mut w)?;
+        let (mut materials, material_notes) = load_materials(&src, &mut textures, &mut w)?;
         let default_index = materials.len() as u32;
         let mut default_used = false;
         let mut material_of = |m: Option<usize>| match m {
@@ -109,6 +109,7 @@ impl Scene {
             order,
             meshes,
             materials,
+            material_notes,
             material_emission,
             textures: textures.textures,
             images: textures.images,

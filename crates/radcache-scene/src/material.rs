@@ -11,9 +11,21 @@
 //! to (flipped for instances whose transform has a negative determinant, per the glTF spec) — or
 //! from both faces when the material is `doubleSided`. See [`emitted_radiance`].
 //!
+//! **Extensions.** `KHR_materials_ior` gives `ior` (values below 1 are clamped to 1; 0 is the
+//! extension's specular-glossiness compatibility mode, an infinite ior, stored as [`IOR_INFINITE`]).
+//! `KHR_materials_specular` gives `specular_factor` and `specular_color`; its two textures are not
+//! sampled (warning; the factors are used). A material without `KHR_materials_specular` has the
+//! specification's specular layer (F0 0.04): only `specularFactor` 0 with metallic 0 is exactly
+//! Lambertian. Other material extensions (transmission, volume, clearcoat, sheen, ...) and
+//! KHR_texture_transform are not implemented: such materials render with the core model, and
+//! the file's [`MaterialNotes`] name each extension once (warning and `radcache info`).
+//! Occlusion textures are not used: a global-illumination renderer computes occlusion itself.
+//!
 //! Alpha modes MASK and BLEND are rendered opaque (warning). Primitives without a material use
-//! [`Material::default_material`]: a grey diffuse (base colour 0.8, metallic 0, roughness 1). This
-//! deviates from the spec's default (metallic 1), which would be black in a diffuse-only renderer.
+//! [`Material::default_material`], the specification's default: base colour 1, metallic 1,
+//! roughness 1.
+
+use std::collections::BTreeMap;
 
 use glam::{Vec3, Vec4};
 
@@ -36,13 +48,14 @@ pub struct Material {
     pub roughness: f32,
     /// Metallic-roughness texture (linear; B = metallic, G = roughness).
     pub metallic_roughness_texture: Option<TextureRef>,
-    /// Index of refraction of the dielectric layer (`KHR_materials_ior`, default 1.5), ≥ 1.
+    /// Index of refraction of the dielectric layer (`KHR_materials_ior`, default 1.5), ≥ 1;
+    /// [`IOR_INFINITE`] for the extension's `ior: 0`.
     pub ior: f32,
     /// Strength of the dielectric's specular layer (`KHR_materials_specular.specularFactor`,
     /// default 1) in `[0, 1]`. 0 with metallic 0 makes the material exactly Lambertian.
     pub specular_factor: f32,
     /// Colour of the dielectric's F0 (`KHR_materials_specular.specularColorFactor`, linear,
-    /// default 1).
+    /// default 1), ≥ 0; may exceed 1 (the BRDF clamps F0 to 1).
     pub specular_color: Vec3,
     /// Emitted radiance W/(sr·m²): emissive factor × emissive strength.
     pub emissive: Vec3,
@@ -52,14 +65,38 @@ pub struct Material {
     pub double_sided: bool,
 }
 
+/// The `ior` that stands for `KHR_materials_ior`'s `ior: 0` (an infinite index of refraction,
+/// Fresnel term 1): large enough that `((ior − 1)/(ior + 1))²` is exactly 1 in f32, small enough
+/// that `1/ior` stays a normal f32.
+pub const IOR_INFINITE: f32 = 1e9;
+
+/// Material extensions the loader reads. Any other extension on a material or on one of its
+/// texture references (e.g. KHR_texture_transform) is reported in [`MaterialNotes`].
+pub const IMPLEMENTED_MATERIAL_EXTENSIONS: &[&str] = &[
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_specular",
+];
+
+/// What the file's materials ask for that radcache does not render (summary and `radcache info`).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct MaterialNotes {
+    /// Extensions used by materials that radcache does not implement, sorted by name, each with
+    /// the number of materials using it.
+    pub unsupported_extensions: Vec<(String, usize)>,
+    /// Number of materials with an occlusion texture (not used: occlusion is computed).
+    pub occlusion_textures: usize,
+}
+
 impl Material {
-    /// The material of primitives that have none (see module docs).
+    /// The material of primitives that have none: the glTF specification's default (base colour
+    /// 1, metallic 1, roughness 1, no emission), a rough white metal.
     pub fn default_material() -> Material {
         Material {
             name: Some("default".into()),
-            base_color: Vec4::new(0.8, 0.8, 0.8, 1.0),
+            base_color: Vec4::ONE,
             base_color_texture: None,
-            metallic: 0.0,
+            metallic: 1.0,
             roughness: 1.0,
             metallic_roughness_texture: None,
             ior: 1.5,
@@ -102,17 +139,29 @@ pub fn emitted_radiance(normal: Vec3, radiance: Vec3, double_sided: bool, dir: V
     }
 }
 
-/// Loads all glTF materials in order (the default material is appended by the caller if used).
+/// Loads all glTF materials in order (the default material is appended by the caller if used),
+/// and notes what they use that is not rendered.
 pub(crate) fn load_materials(
     src: &Source,
     textures: &mut TextureLoader,
     warnings: &mut Warnings,
-) -> Result<Vec<Material>> {
+) -> Result<(Vec<Material>, MaterialNotes)> {
     let mut out = Vec::new();
+    let file = src.path.display();
+    // Unsupported extension → labels of the materials using it.
+    let mut unsupported: BTreeMap<&str, Vec<String>> = BTreeMap::new();
+    let mut occlusion_textures = 0;
     for m in src.doc.materials() {
         let index = m.index().unwrap_or(out.len());
         let user = label("material", index, m.name());
-        let file = src.path.display();
+        for name in src.material_extensions.get(index).into_iter().flatten() {
+            if !IMPLEMENTED_MATERIAL_EXTENSIONS.contains(&name.as_str()) {
+                unsupported.entry(name).or_default().push(user.clone());
+            }
+        }
+        if m.occlusion_texture().is_some() {
+            occlusion_textures += 1;
+        }
         match m.alpha_mode() {
             gltf::material::AlphaMode::Opaque => {}
             mode => {
@@ -131,30 +180,66 @@ pub(crate) fn load_materials(
         }
         let emissive = Vec3::from(m.emissive_factor()) * strength;
         let base_color = Vec4::from(pbr.base_color_factor());
-        let mut sane = |v: f32, what: &str, lo: f32, hi: f32| -> f32 {
+        // Clamps `v` to `[lo, hi]`; a non-finite `v` becomes `fallback` with a warning.
+        let mut sane = |v: f32, what: &str, lo: f32, hi: f32, fallback: f32| -> f32 {
             if v.is_finite() {
                 v.clamp(lo, hi)
             } else {
                 warnings.push(
                     WarningKind::Other,
                     1,
-                    format!("{file}: {user}: non-finite {what}; using {lo}"),
+                    format!("{file}: {user}: non-finite {what}; using {fallback}"),
                 );
-                lo
+                fallback
             }
         };
         let base_color = Vec4::from_array(
             base_color
                 .to_array()
-                .map(|c| sane(c, "base colour", 0.0, 1.0)),
+                .map(|c| sane(c, "base colour", 0.0, 1.0, 0.0)),
         );
         let emissive = Vec3::from_array(
             emissive
                 .to_array()
-                .map(|c| sane(c, "emission", 0.0, f32::MAX)),
+                .map(|c| sane(c, "emission", 0.0, f32::MAX, 0.0)),
         );
-        let metallic = sane(pbr.metallic_factor(), "metallic factor", 0.0, 1.0);
-        let roughness = sane(pbr.roughness_factor(), "roughness factor", 0.0, 1.0);
+        let metallic = sane(pbr.metallic_factor(), "metallic factor", 0.0, 1.0, 0.0);
+        let roughness = sane(pbr.roughness_factor(), "roughness factor", 0.0, 1.0, 0.0);
+        let ior = match m.ior() {
+            None => 1.5,
+            Some(0.0) => IOR_INFINITE,
+            Some(v) => sane(v, "ior", 1.0, IOR_INFINITE, 1.5),
+        };
+        let specular = m.specular();
+        let (specular_factor, specular_color) = match &specular {
+            None => (1.0, Vec3::ONE),
+            Some(sp) => (
+                sane(sp.specular_factor(), "specularFactor", 0.0, 1.0, 1.0),
+                Vec3::from_array(
+                    sp.specular_color_factor()
+                        .map(|c| sane(c, "specularColorFactor", 0.0, f32::MAX, 1.0)),
+                ),
+            ),
+        };
+        if let Some(sp) = &specular {
+            let ignored: Vec<&str> = [
+                ("specularTexture", sp.specular_texture().is_some()),
+                (
+                    "specularColorTexture",
+                    sp.specular_color_texture().is_some(),
+                ),
+            ]
+            .into_iter()
+            .filter_map(|(name, present)| present.then_some(name))
+            .collect();
+            if !ignored.is_empty() {
+                let msg = format!(
+                    "{file}: {user}: KHR_materials_specular {} not supported; using the factors",
+                    ignored.join(" and ")
+                );
+                warnings.push(WarningKind::TextureIgnored, 1, msg);
+            }
+        }
         out.push(Material {
             name: m.name().map(str::to_string),
             base_color,
@@ -174,15 +259,36 @@ pub(crate) fn load_materials(
                 &user,
                 warnings,
             )?,
-            ior: 1.5,
-            specular_factor: 1.0,
-            specular_color: Vec3::ONE,
+            ior,
+            specular_factor,
+            specular_color,
             emissive,
             emissive_texture: textures.get(src, m.emissive_texture(), true, &user, warnings)?,
             double_sided: m.double_sided(),
         });
     }
-    Ok(out)
+    for (name, users) in &unsupported {
+        let n = users.len();
+        let effect = if *name == "KHR_texture_transform" {
+            "their textures are sampled without the transform"
+        } else {
+            "they render with the core metallic-roughness model"
+        };
+        let msg = format!(
+            "{file}: extension {name} is not implemented ({n} material{}: {}); {effect}",
+            if n == 1 { "" } else { "s" },
+            users.join(", ")
+        );
+        warnings.push(WarningKind::MaterialExtensionIgnored, n, msg);
+    }
+    let notes = MaterialNotes {
+        unsupported_extensions: unsupported
+            .into_iter()
+            .map(|(name, users)| (name.to_string(), users.len()))
+            .collect(),
+        occlusion_textures,
+    };
+    Ok((out, notes))
 }
 
 #[cfg(test)]

@@ -1,7 +1,8 @@
 //! [`ScenePlan`]: what a scene needs from the renderer, derived once after loading.
 //!
 //! Later passes consult it instead of re-inspecting the scene: whether to build the emitter
-//! sampling table, which punctual light kinds exist, which environment is used, whether textures
+//! sampling table, whether the full metallic-roughness BRDF is needed or every material is
+//! Lambertian, which punctual light kinds exist, which environment is used, whether textures
 //! must be bound, and how the scene animates (nothing, camera only, lights only, or geometry —
 //! the latter needing TLAS refits) over which time range.
 
@@ -231,6 +232,15 @@ impl fmt::Display for ScenePlan {
             EnvironmentKind::Map => "map",
         };
         writeln!(f, "  environment: {env}")?;
+        writeln!(
+            f,
+            "  materials: {}",
+            if self.specular {
+                "metallic-roughness BRDF (specular lobes compiled in)"
+            } else {
+                "lambertian only (no specular code compiled)"
+            }
+        )?;
         writeln!(
             f,
             "  textures: {}",

@@ -33,6 +33,10 @@ pub(crate) struct Source {
     pub(crate) doc: gltf::Document,
     /// Buffer contents, index-aligned with `doc.buffers()`; each is at least `byteLength` long.
     pub(crate) buffers: Vec<gltf::buffer::Data>,
+    /// Per material (index-aligned with `doc.materials()`): the names of the extensions it uses,
+    /// on the material itself or on its texture references, read from the raw JSON (the gltf
+    /// crate drops extensions it does not know).
+    pub(crate) material_extensions: Vec<Vec<String>>,
 }
 
 impl Source {
@@ -52,22 +56,27 @@ impl Source {
         })?;
         let gltf::Gltf { document, blob } =
             gltf::Gltf::from_slice_without_validation(&bytes).map_err(parse_err)?;
-        let root = document.into_json();
+        let mut root = document.into_json();
         check_version(path, &root.asset)?;
         for name in &root.extensions_required {
             if !SUPPORTED_REQUIRED.contains(&name.as_str()) {
                 return Err(Error::UnsupportedExtension {
                     path: path.to_path_buf(),
                     name: name.clone(),
+                    reason: unsupported_reason(name).into(),
                 });
             }
         }
+        // Checked above. The gltf crate's own check would refuse KHR_materials_specular, which
+        // gltf-json 1.4 parses but leaves out of its list of enabled extensions.
+        root.extensions_required.clear();
         precheck(path, &root)?;
         let doc = gltf::Document::from_json(root).map_err(parse_err)?;
         let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
         let mut source = Source {
             path: path.to_path_buf(),
             base,
+            material_extensions: material_extensions(&bytes, doc.materials().len()),
             doc,
             buffers: Vec::new(),
         };
@@ -275,7 +284,70 @@ fn check_glb_header(bytes: &[u8]) -> std::result::Result<(), String> {
 }
 
 /// Required extensions this loader implements.
-const SUPPORTED_REQUIRED: &[&str] = &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+const SUPPORTED_REQUIRED: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_specular",
+];
+
+/// Why a required extension cannot be honoured, for the error message.
+fn unsupported_reason(name: &str) -> &'static str {
+    match name {
+        "KHR_draco_mesh_compression" => "Draco-compressed meshes cannot be decoded",
+        "EXT_meshopt_compression" => "meshopt-compressed buffers cannot be decoded",
+        "KHR_mesh_quantization" => {
+            "quantized (integer) positions, normals and texture coordinates cannot be read"
+        }
+        "KHR_texture_basisu" => "KTX2 / Basis Universal textures cannot be decoded",
+        "EXT_texture_webp" => "WebP textures cannot be decoded",
+        "EXT_texture_avif" => "AVIF textures cannot be decoded",
+        "MSFT_texture_dds" => "DDS textures cannot be decoded",
+        "KHR_texture_transform" => "texture coordinate transforms are not implemented",
+        _ => "the file declares that it cannot be displayed without it",
+    }
+}
+
+/// Texture references of a material object, by JSON path.
+const TEXTURE_SLOTS: &[&[&str]] = &[
+    &["pbrMetallicRoughness", "baseColorTexture"],
+    &["pbrMetallicRoughness", "metallicRoughnessTexture"],
+    &["normalTexture"],
+    &["occlusionTexture"],
+    &["emissiveTexture"],
+];
+
+/// The extension names each of the first `count` materials uses (see
+/// [`Source::material_extensions`]), from the JSON text or the GLB JSON chunk in `bytes`.
+fn material_extensions(bytes: &[u8], count: usize) -> Vec<Vec<String>> {
+    let json = if bytes.starts_with(b"glTF") {
+        gltf::Glb::from_slice(bytes).ok().map(|glb| glb.json)
+    } else {
+        Some(std::borrow::Cow::Borrowed(bytes))
+    };
+    let root: serde_json::Value = json
+        .and_then(|j| serde_json::from_slice(&j).ok())
+        .unwrap_or_default();
+    let keys = |v: Option<&serde_json::Value>| -> Vec<String> {
+        v.and_then(|v| v.get("extensions"))
+            .and_then(|e| e.as_object())
+            .map(|e| e.keys().cloned().collect())
+            .unwrap_or_default()
+    };
+    (0..count)
+        .map(|i| {
+            let m = root.get("materials").and_then(|list| list.get(i));
+            let mut names = keys(m);
+            for slot in TEXTURE_SLOTS {
+                let info = slot.iter().fold(m, |v, key| v.and_then(|v| v.get(key)));
+                names.extend(keys(info));
+            }
+            names.sort();
+            names.dedup();
+            names
+        })
+        .collect()
+}
 
 /// Turns a relative, percent-encoded URI into a path; rejects other URI schemes.
 fn relative_path(uri: &str) -> std::result::Result<PathBuf, String> {

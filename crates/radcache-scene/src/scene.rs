@@ -13,7 +13,7 @@ use crate::camera::{Camera, CameraView};
 use crate::emissive::{EmissiveTriangle, EmitterTable};
 use crate::environment::Environment;
 use crate::light::{LightInstance, PunctualLight, WorldLight};
-use crate::material::Material;
+use crate::material::{Material, MaterialNotes};
 use crate::math::{Aabb, Trs};
 use crate::mesh::Mesh;
 use crate::node::{LocalTransform, Node};
@@ -45,6 +45,9 @@ pub struct Scene {
     pub meshes: Vec<Mesh>,
     /// Materials; the default material is appended last when a primitive has none.
     pub materials: Vec<Material>,
+    /// What the materials use that radcache does not render (unsupported extensions, occlusion
+    /// textures); printed by the summary.
+    pub material_notes: MaterialNotes,
     /// Mean emitted radiance per material (emissive × mean emissive texture), for sampling weights.
     pub material_emission: Vec<Vec3>,
     /// Textures used by materials.

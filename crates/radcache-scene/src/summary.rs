@@ -1,6 +1,8 @@
 //! Human-readable scene summary (`radcache info scene.gltf` prints exactly this): counts of nodes,
 //! meshes, triangles, materials, textures, lights by kind, animations and time range, world bounds
 //! at the start time and over the animation range, the camera, the environment, then the plan.
+//! Material extensions that radcache does not implement are named once each, with the number of
+//! materials using them, and unused occlusion textures are mentioned once.
 
 use std::fmt;
 
@@ -62,6 +64,27 @@ impl fmt::Display for Scene {
             self.textures.len(),
             self.images.len()
         )?;
+        let notes = &self.material_notes;
+        if !notes.unsupported_extensions.is_empty() {
+            let list: Vec<String> = notes
+                .unsupported_extensions
+                .iter()
+                .map(|(name, n)| format!("{name} ({n} material{})", if *n == 1 { "" } else { "s" }))
+                .collect();
+            writeln!(
+                f,
+                "  material extensions not implemented (ignored; the core metallic-roughness model is used): {}",
+                list.join(", ")
+            )?;
+        }
+        if notes.occlusion_textures > 0 {
+            writeln!(
+                f,
+                "  occlusion textures: not used ({} material{}; a global-illumination renderer computes occlusion itself)",
+                notes.occlusion_textures,
+                if notes.occlusion_textures == 1 { "" } else { "s" }
+            )?;
+        }
         let count = |k: fn(&LightKind) -> bool| {
             self.light_instances
                 .iter()

@@ -50,3 +50,18 @@ pub fn fresh_dir(tag: &str, name: &str) -> PathBuf {
 pub fn text(p: &Path) -> String {
     p.display().to_string()
 }
+
+/// `shared/models/<rel>`: the Khronos sample models kept beside the checkout (`../shared/models`
+/// from the repository root in CI; a git worktree finds it in a folder further up). Panics,
+/// naming where it looked, when the file is absent.
+pub fn shared_model(rel: &str) -> PathBuf {
+    let root = repo().canonicalize().unwrap_or_else(|_| repo());
+    let candidates: Vec<PathBuf> = root
+        .ancestors()
+        .map(|dir| dir.join("shared/models").join(rel))
+        .collect();
+    match candidates.iter().find(|p| p.is_file()) {
+        Some(p) => p.clone(),
+        None => panic!("shared model {rel} not found; looked for {candidates:?}"),
+    }
+}

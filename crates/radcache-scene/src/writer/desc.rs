@@ -36,12 +36,21 @@ pub struct MaterialDesc {
     pub base_color_texture: Option<usize>,
     /// Emissive texture index.
     pub emissive_texture: Option<usize>,
+    /// Metallic-roughness texture index (linear; G = roughness, B = metallic).
+    pub metallic_roughness_texture: Option<usize>,
+    /// `KHR_materials_specular.specularFactor`: 0 makes a metallic-0 material exactly Lambertian;
+    /// 1 (the specification's default, F0 0.04 at ior 1.5) writes no extension.
+    pub specular: f32,
+    /// `KHR_materials_ior.ior`, written when set (the default is 1.5).
+    pub ior: Option<f32>,
     /// `alphaMode` other than OPAQUE (e.g. `"BLEND"`), for tests.
     pub alpha_mode: Option<String>,
 }
 
 impl MaterialDesc {
-    /// A diffuse (metallic 0, roughness 1) material of linear albedo `rgb`.
+    /// A Lambertian material of linear albedo `rgb`: metallic 0, roughness 1 and specular 0
+    /// (written as `KHR_materials_specular.specularFactor` 0, without which glTF has a specular
+    /// layer).
     pub fn diffuse(name: &str, rgb: [f32; 3]) -> MaterialDesc {
         MaterialDesc {
             name: name.into(),
@@ -52,11 +61,25 @@ impl MaterialDesc {
             double_sided: false,
             base_color_texture: None,
             emissive_texture: None,
+            metallic_roughness_texture: None,
+            specular: 0.0,
+            ior: None,
             alpha_mode: None,
         }
     }
 
-    /// A diffuse material that also emits `radiance`.
+    /// A metallic-roughness material with the specification's specular layer (specular 1, no
+    /// extension written).
+    pub fn metal_rough(name: &str, rgb: [f32; 3], metallic: f32, roughness: f32) -> MaterialDesc {
+        MaterialDesc {
+            metallic,
+            roughness,
+            specular: 1.0,
+            ..MaterialDesc::diffuse(name, rgb)
+        }
+    }
+
+    /// A Lambertian material that also emits `radiance`.
     pub fn emitter(name: &str, rgb: [f32; 3], radiance: [f32; 3]) -> MaterialDesc {
         MaterialDesc {
             emissive: radiance,

@@ -4,7 +4,9 @@
 //! `add_*` returns the glTF index), then [`GltfBuilder::write`] a `.gltf` with either an external
 //! `.bin` next to it or an embedded base64 data URI ([`BufferLayout`]). Every accessor gets its own
 //! 4-byte-aligned buffer view; float accessors carry `min`/`max`. Emission is given as radiance and
-//! split into `emissiveFactor` × `KHR_materials_emissive_strength` when it exceeds 1. The JSON is
+//! split into `emissiveFactor` × `KHR_materials_emissive_strength` when it exceeds 1; a specular
+//! factor other than 1 (0 for the Lambertian [`MaterialDesc::diffuse`]) is written as
+//! `KHR_materials_specular`, an ior as `KHR_materials_ior`. The JSON is
 //! written with serde_json; [`GltfBuilder::to_json`] exposes it so tests can mutate it.
 
 mod desc;
@@ -139,17 +141,34 @@ impl GltfBuilder {
         if let Some(t) = m.base_color_texture {
             pbr["baseColorTexture"] = json!({"index": t});
         }
+        if let Some(t) = m.metallic_roughness_texture {
+            pbr["metallicRoughnessTexture"] = json!({"index": t});
+        }
         let mut v = json!({"name": m.name, "pbrMetallicRoughness": pbr});
+        let mut extensions = Map::new();
         let peak = m.emissive.iter().copied().fold(0.0f32, f32::max);
         if peak > 0.0 {
             let strength = peak.max(1.0);
             v["emissiveFactor"] = nums(&m.emissive.map(|e| e / strength));
             if strength > 1.0 {
-                v["extensions"] =
-                    json!({"KHR_materials_emissive_strength": {"emissiveStrength": num(strength)}});
-                self.extensions_used
-                    .insert("KHR_materials_emissive_strength".into());
+                extensions.insert(
+                    "KHR_materials_emissive_strength".into(),
+                    json!({"emissiveStrength": num(strength)}),
+                );
             }
+        }
+        if m.specular != 1.0 {
+            extensions.insert(
+                "KHR_materials_specular".into(),
+                json!({"specularFactor": num(m.specular)}),
+            );
+        }
+        if let Some(ior) = m.ior {
+            extensions.insert("KHR_materials_ior".into(), json!({"ior": num(ior)}));
+        }
+        if !extensions.is_empty() {
+            self.extensions_used.extend(extensions.keys().cloned());
+            v["extensions"] = Value::Object(extensions);
         }
         if let Some(t) = m.emissive_texture {
             v["emissiveTexture"] = json!({"index": t});

@@ -116,3 +116,19 @@ pub fn glb_bytes(root: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
     }
     glb
 }
+
+/// `shared/models/<rel>`: the Khronos sample models kept beside the checkout (CI has `shared/`
+/// next to the clone, i.e. `../shared/models` from the repository root; a git worktree finds it
+/// in a folder further up). Panics, naming where it looked, when the file is absent.
+pub fn shared_model(rel: &str) -> PathBuf {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let repo = repo.canonicalize().unwrap_or(repo);
+    let candidates: Vec<PathBuf> = repo
+        .ancestors()
+        .map(|dir| dir.join("shared/models").join(rel))
+        .collect();
+    match candidates.iter().find(|p| p.is_file()) {
+        Some(p) => p.clone(),
+        None => panic!("shared model {rel} not found; looked for {candidates:?}"),
+    }
+}
