@@ -156,11 +156,7 @@ fn metal_plane_under_a_uniform_sky_reflects_its_directional_albedo() {
     for roughness in [0.25f32, 0.6, 1.0] {
         // Views between 35° and 50° from the plane, and near the normal.
         for (pitch, yfov) in [(0.75f32, 0.4f32), (1.35, 0.3)] {
-            let desc = MaterialDesc {
-                metallic: 1.0,
-                roughness,
-                ..MaterialDesc::diffuse("metal", [1.0, 1.0, 1.0])
-            };
+            let desc = MaterialDesc::metal_rough("metal", [1.0, 1.0, 1.0], 1.0, roughness);
             let tag = format!("metal-furnace-{roughness}-{pitch}");
             let scene = sky_plane(&tag, &desc, pitch, yfov);
             assert!(scene.plan().specular, "a metal needs the specular code");
@@ -236,11 +232,7 @@ fn a_mirror_reflects_two_emitters_with_schlick_fresnel() {
     let (bright, dim) = (2.0f32, 0.5f32);
     let (ey, ez) = (3.0f32, [-60.0f32, 10.0]);
     let mut b = GltfBuilder::new();
-    let mirror = b.add_material(&MaterialDesc {
-        metallic: 1.0,
-        roughness: 0.0,
-        ..MaterialDesc::diffuse("mirror", base)
-    });
+    let mirror = b.add_material(&MaterialDesc::metal_rough("mirror", base, 1.0, 0.0));
     let mut lamp = |name: &str, le: f32| {
         b.add_material(&MaterialDesc {
             double_sided: true,
@@ -280,7 +272,8 @@ fn a_mirror_reflects_two_emitters_with_schlick_fresnel() {
     let ctx = context();
     let shaders = shaders();
     let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
-    let out = render(&ctx, &shaders, &scene, &mut gpu, size, 64, 11);
+    let spp = 256u32;
+    let out = render(&ctx, &shaders, &scene, &mut gpu, size, spp, 11);
     drop(gpu);
     finish(ctx);
 
@@ -295,6 +288,7 @@ fn a_mirror_reflects_two_emitters_with_schlick_fresnel() {
         Some(if q.x < 0.0 { bright } else { dim })
     };
     let (mut n_bright, mut n_dim) = (0, 0);
+    let (mut ratio_sum, mut ratios) = (0.0f64, 0u32);
     for py in 0..size.1 {
         for px in 0..size.0 {
             let (x, y) = (f64::from(px), f64::from(py));
@@ -314,26 +308,31 @@ fn a_mirror_reflects_two_emitters_with_schlick_fresnel() {
             let w = (1.0 - mu).powi(5);
             for c in 0..3 {
                 let expected = le * (base[c] + (1.0 - base[c]) * w);
-                if std::env::var("MIRROR_DEBUG").is_ok() {
-                    eprintln!(
-                        "({px},{py}) c{c} mu {mu:.4} le {le} ratio {:.5}",
-                        got[c] / expected
-                    );
-                    continue;
-                }
+                let ratio = f64::from(got[c] / expected);
+                // A BRDF sample in GGX's tail meets a light-sampling pdf as large as its own
+                // there: its MIS weight is small and the light samples that carry the rest are
+                // rare, so a pixel can lack a few samples' worth (1/spp each) while the mean
+                // stays exact.
                 assert!(
-                    (got[c] - expected).abs() <= 2e-3 * expected,
+                    (ratio - 1.0).abs() <= 4.0 / f64::from(spp),
                     "mirror pixel ({px}, {py}) channel {c}: {}, expected {expected} (n·v {mu})",
                     got[c]
                 );
+                ratio_sum += ratio;
+                ratios += 1;
             }
         }
     }
-    eprintln!("mirror: {n_bright} pixels reflect the bright emitter, {n_dim} the dim one");
+    let mean = ratio_sum / f64::from(ratios);
+    eprintln!(
+        "mirror: {n_bright} pixels reflect the bright emitter, {n_dim} the dim one; mean of \
+         rendered/expected {mean:.5}"
+    );
     assert!(
         n_bright >= 60 && n_dim >= 60,
         "bright {n_bright}, dim {n_dim}"
     );
+    assert!((mean - 1.0).abs() <= 1e-3, "mean ratio {mean}");
 }
 
 /// A closed white room (2 × 2 × 2, walls Lambertian) lit by a square emitter under its ceiling,
@@ -348,16 +347,8 @@ fn spheres_room(tag: &str) -> Scene {
         double_sided: true,
         ..MaterialDesc::emitter("light", [0.0; 3], [12.0; 3])
     });
-    let gold = b.add_material(&MaterialDesc {
-        metallic: 1.0,
-        roughness: 0.35,
-        ..MaterialDesc::diffuse("gold", [0.95, 0.7, 0.35])
-    });
-    let blue = b.add_material(&MaterialDesc {
-        metallic: 0.0,
-        roughness: 0.3,
-        ..MaterialDesc::diffuse("blue", [0.15, 0.3, 0.7])
-    });
+    let gold = b.add_material(&MaterialDesc::metal_rough("gold", [0.95, 0.7, 0.35], 1.0, 0.35));
+    let blue = b.add_material(&MaterialDesc::metal_rough("blue", [0.15, 0.3, 0.7], 0.0, 0.3));
     let tri = |m: &radcache_tests::geometry::Mesh, material: usize, smooth: Option<Vec3>| {
         PrimitiveDesc::triangles(
             m.positions.iter().map(|p| p.to_array()).collect(),
@@ -414,6 +405,8 @@ fn spheres_room(tag: &str) -> Scene {
 fn the_cache_frame_matches_the_path_tracer_on_metal_and_dielectric_spheres() {
     let scene = spheres_room("spheres_room");
     assert!(scene.plan().specular);
+    let blue = scene.materials.iter().find(|m| m.name.as_deref() == Some("blue"));
+    assert!(blue.is_some_and(|m| m.specular_factor == 1.0 && m.metallic == 0.0));
     let size = (48u32, 48u32);
     let ctx = context();
     let shaders = shaders();
