@@ -127,6 +127,8 @@ impl Scene {
             vec3(&mut h, m.emissive);
             texture_ref(&mut h, m.emissive_texture);
             h.u32(u32::from(m.double_sided));
+            h.u32(m.alpha_mode as u32);
+            h.f32(m.alpha_cutoff);
         }
         h.usize(self.textures.len());
         for t in &self.textures {

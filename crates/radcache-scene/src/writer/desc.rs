@@ -38,6 +38,8 @@ pub struct MaterialDesc {
     pub emissive_texture: Option<usize>,
     /// `alphaMode` other than OPAQUE (e.g. `"BLEND"`), for tests.
     pub alpha_mode: Option<String>,
+    /// `alphaCutoff` (written when set).
+    pub alpha_cutoff: Option<f32>,
 }
 
 impl MaterialDesc {
@@ -53,6 +55,7 @@ impl MaterialDesc {
             base_color_texture: None,
             emissive_texture: None,
             alpha_mode: None,
+            alpha_cutoff: None,
         }
     }
 
