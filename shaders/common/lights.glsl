@@ -129,6 +129,11 @@ bool sample_emitter(vec3 p, vec3 u, out vec3 dir, out float dist, out vec3 radia
     }
     vec2 uv = (1.0 - b.x - b.y) * e.uvs.xy + b.x * e.uvs.zw + b.y * e.uv2_material.xy;
     radiance = material_emission(uint(e.uv2_material.z), uv, cos_l > 0.0);
+#ifdef HAS_ALPHA
+    // Where an alpha-tested emitter is missing it emits nothing: its mean coverage there (MASK 0
+    // or 1, BLEND alpha, the mean of what BSDF-sampled hits find).
+    radiance *= material_coverage(uint(e.uv2_material.z), uv);
+#endif
     float pdf_area = emitter_alias[t].pmf / (0.5 * area2);
     pdf = pdf_area * d2 / max(abs(cos_l), 1e-8);
     return pdf > 0.0 && abs(cos_l) > 0.0;
@@ -175,10 +180,7 @@ uint rays_traced = 0u;
 bool unoccluded(vec3 origin, vec3 dir, float tmax) {
     rays_traced++;
     rayQueryEXT q;
-    rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT | gl_RayFlagsTerminateOnFirstHitEXT, 0xFF,
-                          origin, 0.0, dir, tmax);
-    while (rayQueryProceedEXT(q)) {
-    }
+    scene_trace(q, gl_RayFlagsTerminateOnFirstHitEXT, origin, dir, tmax);
     return rayQueryGetIntersectionTypeEXT(q, true) == gl_RayQueryCommittedIntersectionNoneEXT;
 }
 

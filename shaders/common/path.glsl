@@ -210,9 +210,7 @@ void path_step(inout PathState st, inout Rng rng) {
     bool count_sources = st.depth > 0u || st.count_first;
     rays_traced++;
     rayQueryEXT q;
-    rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, st.ray.origin, 0.0, st.ray.dir, 1e30);
-    while (rayQueryProceedEXT(q)) {
-    }
+    scene_trace(q, 0u, st.ray.origin, st.ray.dir, 1e30);
     if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
         if (count_sources) {
             vec3 le = environment_radiance(st.ray.dir);

@@ -1,6 +1,7 @@
 // common/scene.glsl — Rust: crates/radcache-render/src/scene/mod.rs
 // The scene as every scene-reading pass sees it: bindings 0-15 (see shared/bindings.glsl),
-// surface reconstruction at a ray-query hit, materials, textures and emission.
+// surface reconstruction at a ray-query hit, materials, textures and emission, and the traversal
+// every ray query of the passes goes through (scene_trace, with the alpha test under HAS_ALPHA).
 #ifndef RADCACHE_SCENE_GLSL
 #define RADCACHE_SCENE_GLSL
 
@@ -178,6 +179,118 @@ Material material_at(uint m, vec2 uv) {
                     max(mat.specular.rgb, vec3(0.0)));
 }
 #endif
+
+#ifdef HAS_ALPHA
+#include "hash.glsl"
+
+// The alpha test of a material (GpuMaterial.textures.w; crates/radcache-render/src/scene/pack.rs).
+const int ALPHA_NONE = 0;
+const int ALPHA_MASK = 1;
+const int ALPHA_BLEND = 2;
+
+// Alpha of material `mat` at uv: base colour factor alpha × base colour texture alpha (bilinear).
+float material_alpha(GpuMaterial mat, vec2 uv) {
+    float a = mat.base_color.a;
+    if (mat.textures.x >= 0) {
+        a *= texture_sample(mat.textures.x, uv).a;
+    }
+    return a;
+}
+
+// Whether the point at uv of material m, on primitive `prim` of instance `instance`, is there for
+// the ray or fragment that `seed` names (docs/materials.md §11): MASK when alpha ≥ the cutoff;
+// BLEND when a uniform number hashed from the seed, the instance and the primitive is below alpha
+// (probability alpha; the same answer every time the same ray meets the same triangle).
+bool alpha_keep(uint m, vec2 uv, uint instance, uint prim, uint seed) {
+    GpuMaterial mat = materials[m];
+    if (mat.textures.w == ALPHA_NONE) {
+        return true;
+    }
+    float a = material_alpha(mat, uv);
+    if (mat.textures.w == ALPHA_MASK) {
+        return a >= mat.alpha.x;
+    }
+    return uint_to_unit_float(pcg_hash(seed ^ pcg_hash(prim ^ pcg_hash(instance)))) < a;
+}
+
+// The expected coverage of material m at uv: MASK 0 or 1, BLEND alpha, 1 without an alpha test
+// (what light sampling of an emitter weighs its radiance by: the mean of what hits see).
+float material_coverage(uint m, vec2 uv) {
+    GpuMaterial mat = materials[m];
+    if (mat.textures.w == ALPHA_NONE) {
+        return 1.0;
+    }
+    float a = material_alpha(mat, uv);
+    if (mat.textures.w == ALPHA_MASK) {
+        return a >= mat.alpha.x ? 1.0 : 0.0;
+    }
+    return clamp(a, 0.0, 1.0);
+}
+
+// The seed of a ray's BLEND tests: a hash of its origin and direction, so it is new for every
+// sample's ray and the same for the same ray.
+uint alpha_ray_seed(vec3 origin, vec3 dir) {
+    uint h = pcg_hash(floatBitsToUint(origin.x));
+    h = pcg_hash(h ^ floatBitsToUint(origin.y));
+    h = pcg_hash(h ^ floatBitsToUint(origin.z));
+    h = pcg_hash(h ^ floatBitsToUint(dir.x));
+    h = pcg_hash(h ^ floatBitsToUint(dir.y));
+    return pcg_hash(h ^ floatBitsToUint(dir.z));
+}
+
+// The alpha test of a candidate triangle hit of instance `instance` (custom index), primitive
+// `prim`, barycentrics `bary`, for the ray that `seed` names.
+bool alpha_passes(uint instance, uint prim, vec2 bary, uint seed) {
+    uvec4 mesh = instances[instance].mesh;
+    uint m = tri_materials[mesh.w + prim];
+    if (materials[m].textures.w == ALPHA_NONE) {
+        return true;  // an opaque material in a mesh that also has alpha-tested ones
+    }
+    uint first_index = mesh.z + 3u * prim;
+    GpuVertex v0 = vertices[indices[first_index] + mesh.y];
+    GpuVertex v1 = vertices[indices[first_index + 1u] + mesh.y];
+    GpuVertex v2 = vertices[indices[first_index + 2u] + mesh.y];
+    vec2 uv = (1.0 - bary.x - bary.y) * vec2(v0.position_u.w, v0.normal_v.w) +
+              bary.x * vec2(v1.position_u.w, v1.normal_v.w) +
+              bary.y * vec2(v2.position_u.w, v2.normal_v.w);
+    return alpha_keep(m, uv, instance, prim, seed);
+}
+
+// Without an alpha-tested material every ray query is opaque; with one, each BLAS geometry's own
+// flag decides (crates/radcache-vk/src/accel.rs) and the non-opaque ones' candidates are tested.
+const uint SCENE_RAY_FLAGS = gl_RayFlagsNoneEXT;
+#else
+const uint SCENE_RAY_FLAGS = gl_RayFlagsOpaqueEXT;
+#endif
+
+// Traces ray query q through the scene from `origin` along unit `dir` over [0, tmax], with ray
+// flags SCENE_RAY_FLAGS | `flags`, to the end of its traversal. With HAS_ALPHA each candidate
+// triangle is committed when it passes alpha_passes for `seed`. (A ray query parameter refers to
+// the caller's object.)
+void scene_trace_seeded(rayQueryEXT q, uint flags, vec3 origin, vec3 dir, float tmax, uint seed) {
+    rayQueryInitializeEXT(q, tlas, SCENE_RAY_FLAGS | flags, 0xFF, origin, 0.0, dir, tmax);
+    while (rayQueryProceedEXT(q)) {
+#ifdef HAS_ALPHA
+        uint kind = rayQueryGetIntersectionTypeEXT(q, false);
+        if (kind == gl_RayQueryCandidateIntersectionTriangleEXT &&
+            alpha_passes(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, false)),
+                         uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, false)),
+                         rayQueryGetIntersectionBarycentricsEXT(q, false), seed)) {
+            rayQueryConfirmIntersectionEXT(q);
+        }
+#endif
+    }
+}
+
+// scene_trace_seeded with the ray's own seed (alpha_ray_seed).
+void scene_trace(rayQueryEXT q, uint flags, vec3 origin, vec3 dir, float tmax) {
+#ifdef HAS_ALPHA
+    uint seed = alpha_ray_seed(origin, dir);
+#else
+    uint seed = 0u;
+#endif
+    scene_trace_seeded(q, flags, origin, dir, tmax, seed);
+}
 
 // Emitted radiance toward the viewer: front face only, or both when double-sided.
 vec3 material_emission(uint m, vec2 uv, bool front_face) {

@@ -33,9 +33,7 @@ void main() {
         vec3 origin = frame.camera_position.xyz;
         vec3 dir = normalize(near_p.xyz / near_p.w - origin);
         rayQueryEXT q;
-        rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, origin, 0.0, dir, 1e30);
-        while (rayQueryProceedEXT(q)) {
-        }
+        scene_trace(q, 0u, origin, dir, 1e30);
         if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
             continue;
         }

@@ -146,9 +146,7 @@ vec3 one_sample(Surface s, vec3 origin, float u_pick, vec3 u3, vec2 u2) {
     float pdf_bsdf = cos_s * INV_PI;
     rays_traced++;
     rayQueryEXT q;
-    rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, origin, 0.0, dir, 1e30);
-    while (rayQueryProceedEXT(q)) {
-    }
+    scene_trace(q, 0u, origin, dir, 1e30);
     if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
         return direct_environment(dir) * cos_s /
                (C_ENV * env_technique_pdf(dir) + C_BSDF * pdf_bsdf);
@@ -219,9 +217,7 @@ vec3 one_sample_brdf(Surface s, Bsdf f, vec3 origin, float u_pick, vec3 u3, vec2
     vec3 fc = bs.weight * bs.pdf;  // f·cos
     rays_traced++;
     rayQueryEXT q;
-    rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, origin, 0.0, dir, 1e30);
-    while (rayQueryProceedEXT(q)) {
-    }
+    scene_trace(q, 0u, origin, dir, 1e30);
     if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
         vec3 sky = direct_environment(dir) * fc / (C_ENV * env_technique_pdf(dir) + C_BSDF * bs.pdf);
 #if defined(IC_SKY_IN_RECORDS) && defined(HAS_ENV_CONSTANT)

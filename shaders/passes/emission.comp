@@ -55,9 +55,7 @@ void main() {
             Ray r = camera_ray(uvec2(pixel), jitter);
             rays_traced++;
             rayQueryEXT q;
-            rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, r.origin, 0.0, r.dir, 1e30);
-            while (rayQueryProceedEXT(q)) {
-            }
+            scene_trace(q, 0u, r.origin, r.dir, 1e30);
             if (rayQueryGetIntersectionTypeEXT(q, true) == gl_RayQueryCommittedIntersectionTriangleEXT) {
                 Surface s = surface_at(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)),
                                        uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),

@@ -6,7 +6,9 @@
 // `pixel_footprint` of ircache_math.glsl (its cosine clamp keeps grazing surfaces bounded, where
 // screen-space derivatives would grow without limit). Each fragment checks with one ray query
 // that nothing stands between it and the camera (`occluder`): rasterization's edge snapping must
-// not let a sample see through the seam of a zero-thickness wall.
+// not let a sample see through the seam of a zero-thickness wall. With HAS_ALPHA a fragment where
+// its material is missing (alpha_keep: MASK below the cutoff, BLEND by its stochastic coverage) is
+// discarded, and the occluder ray skips such points with the same test.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -33,17 +35,15 @@ layout(location = 4) out vec4 o_emission;
 // (measured: the `two_rooms` scene of the stiff suite, 0.8 mm behind the wall at 2.8 m, lit by
 // the other room's lights). The ray stops 1e-5 of the distance short of the fragment (relative,
 // so any scene scale works); a hit there is the surface the camera really sees.
-bool occluder(vec3 to_fragment, out Surface s, out uint instance) {
+// `alpha_seed` is the fragment's (gbuffer_alpha_seed).
+bool occluder(vec3 to_fragment, uint alpha_seed, out Surface s, out uint instance) {
     float dist = length(to_fragment);
     if (!(dist > 0.0)) {
         return false;
     }
     vec3 dir = to_fragment / dist;
     rayQueryEXT q;
-    rayQueryInitializeEXT(q, tlas, gl_RayFlagsOpaqueEXT, 0xFF, frame.camera_position.xyz, 0.0, dir,
-                          dist * (1.0 - 1e-5));
-    while (rayQueryProceedEXT(q)) {
-    }
+    scene_trace_seeded(q, 0u, frame.camera_position.xyz, dir, dist * (1.0 - 1e-5), alpha_seed);
     if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
         return false;
     }
@@ -54,8 +54,31 @@ bool occluder(vec3 to_fragment, out Surface s, out uint instance) {
     return true;
 }
 
+#ifdef HAS_ALPHA
+// The seed of this pixel's BLEND tests in this sub-frame: the pixel, the sub-frame's jitter, the
+// frame's seed and number. Every fragment of the pixel and its occluder ray draw the same number
+// for the same triangle, so a blended surface the rasterizer dropped is dropped by the ray too.
+uint gbuffer_alpha_seed() {
+    uvec2 p = uvec2(gl_FragCoord.xy);
+    uint h = pcg_hash(frame.resolution.w ^ pcg_hash(frame.resolution.z));
+    h = pcg_hash(h ^ floatBitsToUint(pc.jitter.x));
+    h = pcg_hash(h ^ floatBitsToUint(pc.jitter.y));
+    h = pcg_hash(h ^ p.x);
+    return pcg_hash(h ^ p.y);
+}
+#endif
+
 void main() {
     GpuInstance inst = instances[pc.instance];
+    uint material = tri_materials[inst.mesh.w + v_triangle];
+#ifdef HAS_ALPHA
+    uint alpha_seed = gbuffer_alpha_seed();
+    if (!alpha_keep(material, v_uv, pc.instance, v_triangle, alpha_seed)) {
+        discard;
+    }
+#else
+    uint alpha_seed = 0u;
+#endif
     uint first = inst.mesh.z + 3u * v_triangle;
     vec3 p0 = vertices[indices[first] + inst.mesh.y].position_u.xyz;
     vec3 p1 = vertices[indices[first + 1u] + inst.mesh.y].position_u.xyz;
@@ -83,13 +106,12 @@ void main() {
     if (dot(ns, ng) <= 0.0) {
         ns = ng;
     }
-    uint material = tri_materials[inst.mesh.w + v_triangle];
     vec2 uv = v_uv;
     float view_depth = 1.0 / gl_FragCoord.w;
     Surface hit;
     uint instance = pc.instance;
     uint hit_instance;
-    if (occluder(-to_camera, hit, hit_instance)) {
+    if (occluder(-to_camera, alpha_seed, hit, hit_instance)) {
         instance = hit_instance;
         // Same ray: the view depth scales with the distance along it.
         view_depth *= length(frame.camera_position.xyz - hit.position) / max(length(to_camera), 1e-30);

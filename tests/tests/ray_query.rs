@@ -132,6 +132,7 @@ fn ray_queries_match_cpu_reference() {
             indices: &ibuf,
             index_offset: 0,
             triangle_count: mesh.triangle_count() as u32,
+            opaque: true,
         }])
         .unwrap();
     assert!(

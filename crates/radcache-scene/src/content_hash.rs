@@ -124,9 +124,14 @@ impl Scene {
             h.f32(m.metallic);
             h.f32(m.roughness);
             texture_ref(&mut h, m.metallic_roughness_texture);
+            h.f32(m.ior);
+            h.f32(m.specular_factor);
+            vec3(&mut h, m.specular_color);
             vec3(&mut h, m.emissive);
             texture_ref(&mut h, m.emissive_texture);
             h.u32(u32::from(m.double_sided));
+            h.u32(m.alpha_mode as u32);
+            h.f32(m.alpha_cutoff);
         }
         h.usize(self.textures.len());
         for t in &self.textures {

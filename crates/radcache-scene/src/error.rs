@@ -3,7 +3,7 @@
 //! Every [`Error`] names the glTF file and the element at fault (buffer, accessor, mesh/primitive,
 //! node, camera, animation, image), with index and name where known, so that a user can find it in
 //! the JSON. Bad input never panics: it becomes an `Error`, or a [`Warning`] when the loader can
-//! carry on with a documented fallback (e.g. alpha-blended materials rendered opaque).
+//! carry on with a documented fallback (e.g. skins rendered in their rest pose).
 //!
 //! A variant that wraps an I/O error returns it from [`std::error::Error::source`] and does not
 //! repeat it in its own message, so a chain printed cause by cause (anyhow's `{:#}`) names each
@@ -162,8 +162,6 @@ pub enum WarningKind {
     DegenerateTriangles,
     /// A primitive had no (or unusable) normals; flat normals were generated.
     GeneratedNormals,
-    /// Alpha MASK/BLEND material treated as opaque.
-    AlphaModeIgnored,
     /// A texture uses a texCoord set other than 0 or an unsupported image format, or sits in a
     /// slot radcache does not sample (KHR_materials_specular's textures: the factors are used).
     TextureIgnored,

@@ -30,11 +30,11 @@
 //! values, unsupported required extensions, orthographic cameras, broken hierarchies. Droppable
 //! elements are dropped with a [`Warning`] that carries a count: degenerate triangles,
 //! non-TRIANGLES primitives, primitives without POSITION. Features outside the renderer's model are
-//! loaded with a documented fallback and a warning: alpha MASK/BLEND (opaque), skins and morph
-//! targets (rest pose), texCoord sets other than 0 (texture ignored), missing normals (flat), a
-//! negative `emissiveStrength` (not emissive), KHR_materials_specular textures (factors used),
-//! material extensions other than emissive strength, ior and specular (core model; named once
-//! each, with a count, in the warnings and the summary).
+//! loaded with a documented fallback and a warning: skins and morph targets (rest pose), texCoord
+//! sets other than 0 (texture ignored), missing normals (flat), a negative `emissiveStrength` (not
+//! emissive), KHR_materials_specular textures (factors used), material extensions other than
+//! emissive strength, ior and specular (core model; named once each, with a count, in the
+//! warnings and the summary).
 //!
 //! The [`writer`] module builds valid glTF files (used by tests and by [`assets`], which generates
 //! the bundled Cornell box, furnace and animated scenes).
@@ -70,7 +70,7 @@ pub use environment::{direction_to_equirect, equirect_to_direction, EnvOverride,
 pub use error::{Error, Result, Warning, WarningKind};
 pub use light::{LightInstance, LightKind, LightSample, PunctualLight, WorldLight};
 pub use load::LoadOptions;
-pub use material::{emitted_radiance, Material, MaterialNotes, IOR_INFINITE};
+pub use material::{emitted_radiance, AlphaMode, Material, MaterialNotes, IOR_INFINITE};
 pub use math::{luminance, Aabb, Trs};
 pub use mesh::{Mesh, PrimitiveRange};
 pub use node::{LocalTransform, Node};

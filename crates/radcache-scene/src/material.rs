@@ -21,7 +21,9 @@
 //! the file's [`MaterialNotes`] name each extension once (warning and `radcache info`).
 //! Occlusion textures are not used: a global-illumination renderer computes occlusion itself.
 //!
-//! Alpha modes MASK and BLEND are rendered opaque (warning). Primitives without a material use
+//! Alpha modes (docs/materials.md §11): MASK keeps a point whose alpha (base colour factor alpha ×
+//! base colour texture alpha) is at least `alphaCutoff` (default 0.5); BLEND keeps it with
+//! probability alpha (stochastic coverage). Primitives without a material use
 //! [`Material::default_material`], the specification's default: base colour 1, metallic 1,
 //! roughness 1.
 
@@ -63,6 +65,23 @@ pub struct Material {
     pub emissive_texture: Option<TextureRef>,
     /// Whether both faces are shaded and (if emissive) emit.
     pub double_sided: bool,
+    /// glTF `alphaMode`.
+    pub alpha_mode: AlphaMode,
+    /// glTF `alphaCutoff` (MASK only; default 0.5).
+    pub alpha_cutoff: f32,
+}
+
+/// glTF `alphaMode`: how the alpha of the base colour (factor × texture) makes a surface point
+/// present or missing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AlphaMode {
+    /// Every point is there (alpha ignored).
+    #[default]
+    Opaque,
+    /// A point is there when its alpha is at least the cutoff.
+    Mask,
+    /// A point is there with probability alpha (stochastic coverage).
+    Blend,
 }
 
 /// The `ior` that stands for `KHR_materials_ior`'s `ior: 0` (an infinite index of refraction,
@@ -105,6 +124,8 @@ impl Material {
             emissive: Vec3::ZERO,
             emissive_texture: None,
             double_sided: false,
+            alpha_mode: AlphaMode::Opaque,
+            alpha_cutoff: 0.5,
         }
     }
 
@@ -119,6 +140,20 @@ impl Material {
     /// specular code (`ScenePlan::specular`).
     pub fn is_lambertian(&self) -> bool {
         self.metallic == 0.0 && self.specular_factor == 0.0
+    }
+
+    /// True when some point of the surface may be missing: alpha mode MASK or BLEND, unless the
+    /// alpha is the constant factor (no base colour texture) and keeps every point (MASK with
+    /// factor ≥ cutoff, BLEND with factor 1). Such materials need the alpha test in every ray
+    /// query and the G-buffer (`ScenePlan::alpha`); the others are opaque.
+    pub fn has_alpha(&self) -> bool {
+        let a = self.base_color.w;
+        let textured = self.base_color_texture.is_some();
+        match self.alpha_mode {
+            AlphaMode::Opaque => false,
+            AlphaMode::Mask => textured || a < self.alpha_cutoff,
+            AlphaMode::Blend => textured || a < 1.0,
+        }
     }
 
     /// True when the material emits light (non-zero `emissive`).
@@ -161,13 +196,6 @@ pub(crate) fn load_materials(
         }
         if m.occlusion_texture().is_some() {
             occlusion_textures += 1;
-        }
-        match m.alpha_mode() {
-            gltf::material::AlphaMode::Opaque => {}
-            mode => {
-                let msg = format!("{file}: {user}: alpha mode {mode:?} rendered opaque");
-                warnings.push(WarningKind::AlphaModeIgnored, 1, msg);
-            }
         }
         let pbr = m.pbr_metallic_roughness();
         let mut strength = m.emissive_strength().unwrap_or(1.0);
@@ -265,6 +293,12 @@ pub(crate) fn load_materials(
             emissive,
             emissive_texture: textures.get(src, m.emissive_texture(), true, &user, warnings)?,
             double_sided: m.double_sided(),
+            alpha_mode: match m.alpha_mode() {
+                gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+                gltf::material::AlphaMode::Mask => AlphaMode::Mask,
+                gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+            },
+            alpha_cutoff: m.alpha_cutoff().unwrap_or(0.5),
         });
     }
     for (name, users) in &unsupported {

@@ -83,13 +83,19 @@ pub struct ScenePlan {
     pub emissive_power: f32,
     /// The cache's direct pass computes the emitters' unshadowed light in closed form and
     /// samples only their visibility (the ratio estimator, docs/cache-frame.md §8.2): at most
-    /// [`ANALYTIC_EMITTERS_MAX`] emissive triangles, none with an emissive texture, and only
-    /// Lambertian materials (Lambert's formula gives irradiance, not a glossy lobe's integral).
+    /// [`ANALYTIC_EMITTERS_MAX`] emissive triangles, none with an emissive texture or an alpha
+    /// test (the closed form takes the whole triangle), and only Lambertian materials (Lambert's
+    /// formula gives irradiance, not a glossy lobe's integral).
     pub analytic_emitters: bool,
     /// Some material has a specular lobe (metallic, or a dielectric specular layer): the passes
     /// compile the full metallic-roughness BRDF (`HAS_SPECULAR`). False when every material is
     /// Lambertian ([`Material::is_lambertian`](crate::Material::is_lambertian)).
     pub specular: bool,
+    /// Some material's surface may be missing in places (alpha mode MASK or BLEND,
+    /// [`Material::has_alpha`](crate::Material::has_alpha)): the passes compile the alpha test
+    /// (`HAS_ALPHA`) into every ray query and the G-buffer, and the geometry of those materials is
+    /// built non-opaque. False: every ray query keeps the opaque fast path.
+    pub alpha: bool,
     /// Punctual light instances by kind.
     pub lights: LightCounts,
     /// Environment kind.
@@ -129,15 +135,17 @@ impl ScenePlan {
         let textured_emission = scene
             .materials
             .iter()
-            .any(|m| m.emissive_texture.is_some() && m.emissive.max_element() > 0.0);
+            .any(|m| (m.emissive_texture.is_some() || m.has_alpha()) && m.is_emissive());
         let count = emitters.triangles.len();
         let specular = scene.materials.iter().any(|m| !m.is_lambertian());
+        let alpha = scene.materials.iter().any(|m| m.has_alpha());
         ScenePlan {
             analytic_emitters: count > 0
                 && count <= ANALYTIC_EMITTERS_MAX
                 && !textured_emission
                 && !specular,
             specular,
+            alpha,
             emissive_triangles: count,
             emissive_power: emitters.total_power,
             lights,
@@ -245,6 +253,15 @@ impl fmt::Display for ScenePlan {
             f,
             "  textures: {}",
             if self.textures > 0 { "yes" } else { "no" }
+        )?;
+        writeln!(
+            f,
+            "  alpha: {}",
+            if self.alpha {
+                "masked or blended materials (alpha-tested ray queries and G-buffer)"
+            } else {
+                "none (opaque ray queries)"
+            }
         )?;
         let a = &self.animation;
         let kind = match a.kind {

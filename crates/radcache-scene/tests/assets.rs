@@ -301,6 +301,12 @@ fn the_content_hash_follows_materials_geometry_and_lights() {
     s.materials[1].base_color.x += 1e-3;
     assert_ne!(s.content_hash(), hash, "a material's colour");
     let mut s = base.clone();
+    s.materials[1].specular_factor = 1.0;
+    assert_ne!(s.content_hash(), hash, "a material's specular layer");
+    let mut s = base.clone();
+    s.materials[1].ior = 1.6;
+    assert_ne!(s.content_hash(), hash, "a material's index of refraction");
+    let mut s = base.clone();
     s.meshes[0].positions[0].y += 1e-4;
     assert_ne!(s.content_hash(), hash, "a vertex");
     let mut s = base.clone();

@@ -1,6 +1,6 @@
 //! Loader features and fallbacks: buffer layouts (external, data URI, GLB), skipped primitive
-//! modes, generated normals, default material, alpha modes, textures, camera selection, default
-//! camera, environment sources, ignored weights channels.
+//! modes, generated normals, default material, alpha modes and cutoffs, textures, camera
+//! selection, default camera, environment sources, ignored weights channels.
 
 mod common;
 
@@ -10,7 +10,7 @@ use radcache_scene::writer::{
     write_files, BufferLayout, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc,
 };
 use radcache_scene::{
-    EnvOverride, Environment, EnvironmentKind, LoadOptions, Scene, WarningKind, WrapMode,
+    AlphaMode, EnvOverride, Environment, EnvironmentKind, LoadOptions, Scene, WarningKind, WrapMode,
 };
 use serde_json::json;
 
@@ -101,7 +101,7 @@ fn merged_primitives_keep_per_triangle_materials() {
 }
 
 #[test]
-fn alpha_modes_are_opaque_with_a_warning_and_textures_decode_srgb() {
+fn alpha_modes_load_and_textures_decode_srgb() {
     let mut b = GltfBuilder::new();
     // sRGB 188 ≈ linear 0.5029; alpha 128 stays linear.
     let tex = b
@@ -111,6 +111,16 @@ fn alpha_modes_are_opaque_with_a_warning_and_textures_decode_srgb() {
     m.alpha_mode = Some("BLEND".into());
     m.base_color_texture = Some(tex);
     let mat = b.add_material(&m);
+    let mut mask = MaterialDesc::diffuse("leaf", [1.0, 1.0, 1.0]);
+    mask.alpha_mode = Some("MASK".into());
+    mask.alpha_cutoff = Some(0.25);
+    mask.base_color[3] = 0.2;
+    b.add_material(&mask);
+    // MASK with the default cutoff 0.5 and an untextured alpha that passes it: opaque.
+    let mut solid = MaterialDesc::diffuse("solid", [1.0, 1.0, 1.0]);
+    solid.alpha_mode = Some("MASK".into());
+    solid.base_color[3] = 0.6;
+    b.add_material(&solid);
     let b = {
         let mut b = b;
         let mut prim = PrimitiveDesc::triangles(
@@ -129,7 +139,20 @@ fn alpha_modes_are_opaque_with_a_warning_and_textures_decode_srgb() {
         b
     };
     let (s, w) = load(&write(&b, &temp_dir("tex"), "t"));
-    assert_eq!(warnings_of(&w, WarningKind::AlphaModeIgnored).0, 1);
+    assert!(!w.iter().any(|w| w.message.contains("alpha")), "{w:?}");
+    let modes: Vec<_> = s.materials[..3]
+        .iter()
+        .map(|m| (m.alpha_mode, m.alpha_cutoff, m.has_alpha()))
+        .collect();
+    assert_eq!(
+        modes,
+        [
+            (AlphaMode::Blend, 0.5, true),
+            (AlphaMode::Mask, 0.25, true),
+            (AlphaMode::Mask, 0.5, false),
+        ]
+    );
+    assert!(s.plan().alpha);
     assert_eq!(s.textures.len(), 1);
     assert_eq!(s.textures[0].wrap_s, WrapMode::MirroredRepeat);
     let img = &s.images[s.textures[0].image];

@@ -116,6 +116,7 @@ fn animated_camera_and_plan_text() {
         "punctual lights: 0 point, 1 spot, 0 directional",
         "environment: none",
         "textures: no",
+        "alpha: none (opaque ray queries)",
         "animation: camera only (camera yes, lights no, geometry no), time range [0.500, 2.500] s",
         "cache across frames: records kept",
     ] {

@@ -41,7 +41,8 @@ gpu_struct! {
         pub base_color: [f32; 4] => "vec4",
         /// Emitted radiance (rgb, factor × strength) and double-sidedness (w: 1 or 0).
         pub emission: [f32; 4] => "vec4",
-        /// Texture indices: base colour, emissive, metallic-roughness (−1 for none), unused.
+        /// Texture indices: base colour, emissive, metallic-roughness (−1 for none); the alpha
+        /// test (w): 0 none (opaque), 1 MASK, 2 BLEND (`ALPHA_*` in shaders/common/scene.glsl).
         pub textures: [i32; 4] => "ivec4",
         /// Metallic, roughness, luminance of the mean emitted radiance (texture mean included; the
         /// emitter sampling table is built from it, so light-sampling pdfs use it), index of
@@ -49,6 +50,8 @@ gpu_struct! {
         pub params: [f32; 4] => "vec4",
         /// The dielectric's specular colour (rgb, `KHR_materials_specular`) and specular factor (w).
         pub specular: [f32; 4] => "vec4",
+        /// The MASK alpha cutoff (x); unused (yzw).
+        pub alpha: [f32; 4] => "vec4",
     }
 }
 

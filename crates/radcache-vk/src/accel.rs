@@ -124,6 +124,10 @@ pub struct BlasGeometry<'a> {
     pub index_offset: u64,
     /// Number of triangles.
     pub triangle_count: u32,
+    /// Flag the geometry `OPAQUE`: ray queries commit its hits without reporting them as
+    /// candidates. False for geometry that shaders alpha-test in their traversal loop (a
+    /// candidate may then be reported more than once, so the test must be deterministic).
+    pub opaque: bool,
 }
 
 /// Figures of a BLAS build.
@@ -191,7 +195,11 @@ fn triangles<'a>(g: &BlasGeometry<'_>) -> Result<vk::AccelerationStructureGeomet
     Ok(vk::AccelerationStructureGeometryKHR::default()
         .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
         .geometry(vk::AccelerationStructureGeometryDataKHR { triangles: tri })
-        .flags(vk::GeometryFlagsKHR::OPAQUE))
+        .flags(if g.opaque {
+            vk::GeometryFlagsKHR::OPAQUE
+        } else {
+            vk::GeometryFlagsKHR::empty()
+        }))
 }
 
 pub(crate) fn scratch(ctx: &Context, name: &str, size: u64) -> Result<Buffer> {

@@ -226,6 +226,7 @@ fn measure(ctx: &Context, compiler: &ShaderCompiler, n: usize) -> Result<Measure
         indices: ib,
         index_offset: 0,
         triangle_count: m.triangle_count() as u32,
+        opaque: true,
     };
     let wall = std::time::Instant::now();
     let (blases, stats) = ctx.build_blases(&[

@@ -45,6 +45,7 @@ pub fn incoherent_rate_in(ctx: &Context, compiler: &ShaderCompiler, scene: &Scen
         indices: &ib,
         index_offset: 0,
         triangle_count: tris.len() as u32,
+        opaque: true,
     }])?;
     let mut tlas = Tlas::new(ctx, "bench.scene_tlas", 1)?;
     let identity = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];

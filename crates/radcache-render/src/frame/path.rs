@@ -137,7 +137,7 @@ fn path_setup(
     let mut tracer = PathTracer::new(ctx, shaders, gpu, w, h)?;
     clock.lap("pipelines");
     let aov_pass = if settings.aovs {
-        Some(AovPass::new(ctx, shaders, w, h)?)
+        Some(AovPass::new(ctx, shaders, gpu, w, h)?)
     } else {
         None
     };

@@ -43,14 +43,16 @@ impl std::fmt::Debug for AovPass {
 }
 
 impl AovPass {
-    /// Compiles the pass and allocates its outputs.
+    /// Compiles the pass for `scene`'s materials (the alpha test where the plan has it) and
+    /// allocates its outputs.
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
+        scene: &GpuScene,
         width: u32,
         height: u32,
     ) -> Result<AovPass> {
-        let spirv = shaders.compile(SHADER, &[])?;
+        let spirv = shaders.compile(SHADER, &scene.material_defines())?;
         let bindings = b::layout();
         let pipeline = Pipeline::compute(ctx, "aov", &spirv, &bindings, 0)?;
         let pixels = u64::from(width) * u64::from(height);
@@ -121,7 +123,7 @@ pub fn render_aovs(
     width: u32,
     height: u32,
 ) -> Result<Aovs> {
-    let pass = AovPass::new(ctx, shaders, width, height)?;
+    let pass = AovPass::new(ctx, shaders, scene, width, height)?;
     let mut rec = ctx.begin("aov")?;
     pass.record(&mut rec, scene)?;
     ctx.submit(rec)?.wait()?;

@@ -21,7 +21,7 @@ use radcache_vk::{
 use crate::error::Result;
 use crate::scene::env_map::{gpu_alias, EnvMap};
 use crate::scene::lights::{gpu_emitters, gpu_lights};
-use crate::scene::pack::{pack_geometry, pack_materials, PackedGeometry};
+use crate::scene::pack::{mesh_is_opaque, pack_geometry, pack_materials, PackedGeometry};
 use crate::scene::upload::{cols, host_buffer, rows3x4, storage};
 
 pub(crate) mod env_map;
@@ -161,7 +161,8 @@ impl GpuScene {
             bytemuck::cast_slice(&env_alias),
         )?;
 
-        // One BLAS per mesh with triangles.
+        // One BLAS per mesh with triangles, one geometry holding all of its primitives (so several
+        // materials): non-opaque when any of its triangles' materials is alpha-tested.
         let geoms: Vec<(usize, BlasGeometry<'_>)> = scene
             .meshes
             .iter()
@@ -180,6 +181,7 @@ impl GpuScene {
                         indices: &index_buf,
                         index_offset: u64::from(r[1]) * 4,
                         triangle_count: m.triangle_count() as u32,
+                        opaque: mesh_is_opaque(scene, &m.triangle_materials),
                     },
                 )
             })

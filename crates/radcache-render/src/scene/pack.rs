@@ -1,7 +1,7 @@
 //! Packing of the scene's geometry and materials into the flat GPU layouts.
 
 use glam::Vec3;
-use radcache_scene::{Scene, WrapMode};
+use radcache_scene::{AlphaMode, Material, Scene, WrapMode};
 use radcache_shared::gpu::{GpuMaterial, GpuMesh, GpuTexture, GpuVertex};
 
 /// Geometry of every mesh in shared buffers.
@@ -51,6 +51,27 @@ pub(crate) fn pack_geometry(scene: &Scene) -> PackedGeometry {
     }
 }
 
+/// The alpha test of `m` in `GpuMaterial::textures.w`: 0 none (every point there: opaque, or an
+/// untextured alpha that keeps every point), 1 MASK, 2 BLEND.
+fn alpha_test(m: &Material) -> i32 {
+    if !m.has_alpha() {
+        return 0;
+    }
+    match m.alpha_mode {
+        AlphaMode::Opaque => 0,
+        AlphaMode::Mask => 1,
+        AlphaMode::Blend => 2,
+    }
+}
+
+/// Whether every triangle of a mesh with per-triangle materials `triangle_materials` is opaque
+/// (no alpha test): its BLAS geometry can then be flagged opaque.
+pub(crate) fn mesh_is_opaque(scene: &Scene, triangle_materials: &[u32]) -> bool {
+    !triangle_materials
+        .iter()
+        .any(|&m| scene.materials[m as usize].has_alpha())
+}
+
 /// Materials, texture descriptors and the shared RGBA8 texel array.
 pub(crate) fn pack_materials(scene: &Scene) -> (Vec<GpuMaterial>, Vec<GpuTexture>, Vec<u32>) {
     let materials: Vec<GpuMaterial> = scene
@@ -70,7 +91,7 @@ pub(crate) fn pack_materials(scene: &Scene) -> (Vec<GpuMaterial>, Vec<GpuTexture
                 m.emissive_texture.map_or(-1, |t| t.texture as i32),
                 m.metallic_roughness_texture
                     .map_or(-1, |t| t.texture as i32),
-                -1,
+                alpha_test(m),
             ],
             params: [
                 m.metallic,
@@ -84,6 +105,7 @@ pub(crate) fn pack_materials(scene: &Scene) -> (Vec<GpuMaterial>, Vec<GpuTexture
                 m.specular_color.z,
                 m.specular_factor,
             ],
+            alpha: [m.alpha_cutoff, 0.0, 0.0, 0.0],
         })
         .collect();
     let mut texels: Vec<u32> = Vec::new();

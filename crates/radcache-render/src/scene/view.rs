@@ -55,13 +55,18 @@ impl GpuScene {
     }
 
     /// Shader defines of the scene's materials: `HAS_SPECULAR` when some material is not
-    /// Lambertian (`ScenePlan::specular`), which compiles in the full metallic-roughness BRDF.
+    /// Lambertian (`ScenePlan::specular`), which compiles in the full metallic-roughness BRDF;
+    /// `HAS_ALPHA` when some material is alpha-tested (`ScenePlan::alpha`), which compiles the
+    /// alpha test into every ray query and the G-buffer.
     pub fn material_defines(&self) -> Vec<(&'static str, &'static str)> {
+        let mut d = Vec::new();
         if self.plan.specular {
-            vec![("HAS_SPECULAR", "1")]
-        } else {
-            Vec::new()
+            d.push(("HAS_SPECULAR", "1"));
         }
+        if self.plan.alpha {
+            d.push(("HAS_ALPHA", "1"));
+        }
+        d
     }
 
     /// Shader defines that compile in only the light sources and material features the scene

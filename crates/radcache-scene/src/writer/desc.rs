@@ -45,6 +45,8 @@ pub struct MaterialDesc {
     pub ior: Option<f32>,
     /// `alphaMode` other than OPAQUE (e.g. `"BLEND"`), for tests.
     pub alpha_mode: Option<String>,
+    /// `alphaCutoff` (written when set).
+    pub alpha_cutoff: Option<f32>,
 }
 
 impl MaterialDesc {
@@ -65,6 +67,7 @@ impl MaterialDesc {
             specular: 0.0,
             ior: None,
             alpha_mode: None,
+            alpha_cutoff: None,
         }
     }
 

@@ -179,6 +179,9 @@ impl GltfBuilder {
         if let Some(mode) = &m.alpha_mode {
             v["alphaMode"] = json!(mode);
         }
+        if let Some(c) = m.alpha_cutoff {
+            v["alphaCutoff"] = num(c);
+        }
         push(&mut self.materials, v)
     }
 
