@@ -1,5 +1,6 @@
 //! glTF alpha modes (issue 17; docs/materials.md §11) on lavapipe, against closed forms. Every
-//! material is made Lambertian (see `lambertian`) so the closed forms are those of ρ/π.
+//! material is Lambertian (the writer's `specularFactor` 0, checked by `lambertian`) so the
+//! closed forms are those of ρ/π.
 //!
 //! - A MASK quad textured with a 4 × 4 checkerboard of alpha 0 and 1, under a uniform sky, in
 //!   front of a black emissive backdrop: every pixel wholly inside an opaque cell is the quad's
@@ -164,15 +165,24 @@ fn check_pixels(
     (counts, worst)
 }
 
-/// `scene` with every material Lambertian: the glTF default dielectric has a specular layer
-/// (F0 = 0.04), which `specularFactor` 0 (`KHR_materials_specular`) removes; set here on the
-/// loaded materials, so the closed forms below are those of ρ/π.
-fn lambertian(mut scene: Scene) -> Scene {
-    for m in &mut scene.materials {
-        assert_eq!(m.metallic, 0.0);
-        m.specular_factor = 0.0;
+/// `scene`, checked to have only Lambertian materials: the glTF default dielectric has a
+/// specular layer (F0 = 0.04), which the writer's `specularFactor` 0 (`KHR_materials_specular`)
+/// removes, so the closed forms below are those of ρ/π.
+fn lambertian(scene: Scene) -> Scene {
+    for m in &scene.materials {
+        assert_eq!((m.metallic, m.specular_factor), (0.0, 0.0));
     }
     assert!(!scene.plan().specular);
+    scene
+}
+
+/// `scene` with the glTF default dielectric's specular layer (`specularFactor` 1) on every
+/// material.
+fn glossy(mut scene: Scene) -> Scene {
+    for m in &mut scene.materials {
+        m.specular_factor = 1.0;
+    }
+    assert!(scene.plan().specular);
     scene
 }
 
@@ -281,9 +291,8 @@ fn cells(origin: Vec3, a: Vec3, b: Vec3) -> Vec<([Vec3; 4], bool)> {
 
 #[test]
 fn a_masked_quad_shows_its_checkerboard_in_the_path_tracer_and_the_cache_frame() {
-    let glossy = mask_scene("alpha-mask");
-    assert!(glossy.plan().specular);
-    let scene = lambertian(glossy.clone());
+    let scene = lambertian(mask_scene("alpha-mask"));
+    let glossy = glossy(scene.clone());
     assert!(scene.plan().alpha);
     assert!(scene
         .plan()

@@ -324,7 +324,14 @@ fn repository_assets_are_up_to_date() {
     let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets");
     let fresh = temp_dir("fresh");
     write_bundled_assets(&fresh).unwrap();
-    for name in ["cornell", "furnace", "animated", "cornell_fly", "courtyard"] {
+    for name in [
+        "cornell",
+        "furnace",
+        "animated",
+        "cornell_fly",
+        "courtyard",
+        "metal_spheres",
+    ] {
         for ext in ["gltf", "bin"] {
             let rel = format!("{name}/{name}.{ext}");
             let committed = std::fs::read(repo.join(&rel)).unwrap_or_else(|e| {

@@ -441,10 +441,9 @@ fn damaged_helmet_needs_the_full_brdf_and_has_an_unused_occlusion_map() {
 fn bundled_scenes_are_lambertian() {
     let files = write_bundled_assets(&temp_dir("lambert")).unwrap();
     assert!(files.len() >= 5);
-    for path in files
-        .iter()
-        .filter(|p| p.extension().is_some_and(|e| e == "gltf"))
-    {
+    for path in files.iter().filter(|p| {
+        p.extension().is_some_and(|e| e == "gltf") && !p.ends_with("metal_spheres.gltf")
+    }) {
         let (s, _) = load(path);
         for m in &s.materials {
             assert!(m.is_lambertian(), "{}: {m:?}", path.display());
@@ -459,6 +458,11 @@ fn bundled_scenes_are_lambertian() {
             .to_string()
             .contains("materials: lambertian only (no specular code compiled)"));
     }
+    // The one bundled scene with specular materials.
+    let spheres = files.iter().find(|p| p.ends_with("metal_spheres.gltf"));
+    let (s, _) = load(spheres.expect("metal_spheres is bundled"));
+    assert!(s.plan().specular);
+    assert_eq!(s.materials.iter().filter(|m| m.metallic == 1.0).count(), 2);
     // Cornell box, as bundled in the repository.
     let cornell =
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/cornell/cornell.gltf");

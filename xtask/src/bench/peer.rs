@@ -37,12 +37,13 @@ use super::harness::{Bench, Figure};
 use mitsuba::{Mitsuba, PeerBudget};
 
 /// The bundled scenes and the time of their frame.
-const SCENES: [(&str, f32); 5] = [
+const SCENES: [(&str, f32); 6] = [
     ("cornell", 0.0),
     ("cornell_fly", 1.0),
     ("animated", 2.5),
     ("furnace", 0.0),
     ("courtyard", 0.0),
+    ("metal_spheres", 0.0),
 ];
 
 /// Samples per pixel per pass of Mitsuba's equal-time render and of its reference.

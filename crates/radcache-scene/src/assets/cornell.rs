@@ -22,7 +22,7 @@ use glam::Vec3;
 use super::{write_named, yaw, QuadSoup};
 use crate::animation::{Interpolation, Property};
 use crate::error::Result;
-use crate::writer::{ChannelDesc, GltfBuilder, MaterialDesc, NodeDesc};
+use crate::writer::{ChannelDesc, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
 
 /// Vertical field of view of the published camera: 2·atan(0.0125 / 0.035).
 pub const CORNELL_YFOV: f32 = 0.686_047_9;
@@ -324,4 +324,60 @@ pub fn cornell_fly_builder() -> GltfBuilder {
 /// Writes `dir/cornell_fly/cornell_fly.gltf` (+ `.bin`).
 pub fn write_cornell_fly(dir: &Path) -> Result<PathBuf> {
     write_named(&cornell_fly_builder(), dir, "cornell_fly")
+}
+
+/// The Cornell room (its tall block, no short block) with two white metal spheres in front:
+/// GGX roughness 0.3 on the left and 0.6 on the right, radius 0.1 m, resting on the floor. The
+/// test scene of the metallic-roughness BRDF against an independent renderer (`cargo xtask bench
+/// peer --scenes metal_spheres`: a white glTF metal is Mitsuba's GGX `roughconductor` with
+/// `material="none"`, up to the shadowing term).
+pub fn metal_spheres_builder() -> GltfBuilder {
+    let mut b = GltfBuilder::new();
+    let m = add_materials(&mut b);
+    let mut roots = add_room(&mut b, m);
+    for (name, roughness, centre) in [
+        ("sphere_rough_0.3", 0.3f32, Vec3::new(0.40, 0.1, 0.16)),
+        ("sphere_rough_0.6", 0.6, Vec3::new(0.17, 0.1, 0.14)),
+    ] {
+        let material =
+            b.add_material(&MaterialDesc::metal_rough(name, [1.0, 1.0, 1.0], 1.0, roughness));
+        let mesh = b.add_mesh(name, &[uv_sphere(centre, 0.1, 32, 64, material)]);
+        roots.push(node(&mut b, name, mesh));
+    }
+    roots.push(add_camera(&mut b, "camera"));
+    b.add_scene("metal_spheres", &roots, None);
+    b
+}
+
+/// Writes `dir/metal_spheres/metal_spheres.gltf` (+ `.bin`).
+pub fn write_metal_spheres(dir: &Path) -> Result<PathBuf> {
+    write_named(&metal_spheres_builder(), dir, "metal_spheres")
+}
+
+/// A UV sphere of `rings` × `segments` quads (triangle fans at the poles) with smooth normals,
+/// counter-clockwise seen from outside.
+fn uv_sphere(centre: Vec3, r: f32, rings: u32, segments: u32, material: usize) -> PrimitiveDesc {
+    let (mut positions, mut normals, mut indices) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..=rings {
+        let theta = std::f32::consts::PI * i as f32 / rings as f32;
+        for j in 0..=segments {
+            let phi = std::f32::consts::TAU * j as f32 / segments as f32;
+            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            positions.push((centre + r * n).to_array());
+            normals.push(n.to_array());
+        }
+    }
+    let row = segments + 1;
+    for i in 0..rings {
+        for j in 0..segments {
+            let (a, b, c, d) = (i * row + j, i * row + j + 1, (i + 1) * row + j, (i + 1) * row + j + 1);
+            if i != 0 {
+                indices.extend([a, b, c]);
+            }
+            if i != rings - 1 {
+                indices.extend([b, d, c]);
+            }
+        }
+    }
+    PrimitiveDesc::triangles(positions, Some(normals), indices, Some(material))
 }

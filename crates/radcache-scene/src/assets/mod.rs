@@ -9,6 +9,8 @@
 //!   9 materials, foliage, a sun and a sky, a 5 s camera fly-through; see `courtyard.rs`).
 //! - `cornell_fly/cornell_fly.gltf`: the Cornell box with a 2 s camera path and nothing else
 //!   moving (the static fly-through of `radcache cache build`).
+//! - `metal_spheres/metal_spheres.gltf`: the Cornell room with two white GGX metal spheres
+//!   (roughness 0.3 and 0.6), the metallic-roughness BRDF's scene for `bench peer`.
 //!
 //! All are written with [`GltfBuilder`] (`.gltf` + `.bin`), so they are reproducible.
 
@@ -26,8 +28,8 @@ use crate::writer::{BufferLayout, GltfBuilder, MaterialDesc, NodeDesc, Primitive
 
 pub use animated::{animated_builder, write_animated, ANIMATED_DURATION};
 pub use cornell::{
-    cornell_builder, cornell_fly_builder, cornell_scaled_builder, write_cornell, write_cornell_fly,
-    CORNELL_FLY_DURATION, CORNELL_YFOV,
+    cornell_builder, cornell_fly_builder, cornell_scaled_builder, metal_spheres_builder,
+    write_cornell, write_cornell_fly, write_metal_spheres, CORNELL_FLY_DURATION, CORNELL_YFOV,
 };
 pub use courtyard::{courtyard_builder, write_courtyard, COURTYARD_DURATION};
 
@@ -147,7 +149,7 @@ pub fn write_furnace(dir: &Path, albedo: f32, emission: f32) -> Result<PathBuf> 
 }
 
 /// Writes the bundled assets under `dir` and returns their `.gltf` paths
-/// (cornell, furnace, animated, cornell_fly, courtyard).
+/// (cornell, furnace, animated, cornell_fly, courtyard, metal_spheres).
 pub fn write_bundled_assets(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(vec![
         write_cornell(dir)?,
@@ -155,5 +157,6 @@ pub fn write_bundled_assets(dir: &Path) -> Result<Vec<PathBuf>> {
         write_animated(dir)?,
         write_cornell_fly(dir)?,
         write_courtyard(dir)?,
+        write_metal_spheres(dir)?,
     ])
 }
