@@ -23,7 +23,8 @@ struct GpuMaterial {
     ivec4 textures;
     vec4 params;
     vec4 specular;
-};  // 80 bytes
+    vec4 normal_map;
+};  // 96 bytes
 
 struct GpuTexture {
     uvec4 info;

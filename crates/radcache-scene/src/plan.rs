@@ -89,6 +89,10 @@ pub struct ScenePlan {
     /// compile the full metallic-roughness BRDF (`HAS_SPECULAR`). False when every material is
     /// Lambertian ([`Material::is_lambertian`](crate::Material::is_lambertian)).
     pub specular: bool,
+    /// Some primitive has a normal-mapped material and the tangents it needs (docs/materials.md
+    /// §12): the passes compile the normal-map code (`HAS_NORMAL_MAPS`) and upload a tangent per
+    /// vertex. False otherwise: no tangent memory, no normal-map code.
+    pub normal_maps: bool,
     /// Punctual light instances by kind.
     pub lights: LightCounts,
     /// Environment kind.
@@ -137,6 +141,7 @@ impl ScenePlan {
                 && !textured_emission
                 && !specular,
             specular,
+            normal_maps: scene.meshes.iter().any(|m| !m.tangents.is_empty()),
             emissive_triangles: count,
             emissive_power: emitters.total_power,
             lights,
@@ -231,6 +236,15 @@ impl fmt::Display for ScenePlan {
             EnvironmentKind::Map => "map",
         };
         writeln!(f, "  environment: {env}")?;
+        writeln!(
+            f,
+            "  normal maps: {}",
+            if self.normal_maps {
+                "yes (a tangent per vertex)"
+            } else {
+                "none"
+            }
+        )?;
         writeln!(
             f,
             "  textures: {}",

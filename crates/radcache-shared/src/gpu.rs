@@ -49,6 +49,9 @@ gpu_struct! {
         pub params: [f32; 4] => "vec4",
         /// The dielectric's specular colour (rgb, `KHR_materials_specular`) and specular factor (w).
         pub specular: [f32; 4] => "vec4",
+        /// Normal map: texture index as a float (x, −1 for none), `normalTexture.scale` (y),
+        /// unused (z, w).
+        pub normal_map: [f32; 4] => "vec4",
     }
 }
 

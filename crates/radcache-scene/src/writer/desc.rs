@@ -36,6 +36,8 @@ pub struct MaterialDesc {
     pub base_color_texture: Option<usize>,
     /// Emissive texture index.
     pub emissive_texture: Option<usize>,
+    /// Normal texture index and its `scale`.
+    pub normal_texture: Option<(usize, f32)>,
     /// `alphaMode` other than OPAQUE (e.g. `"BLEND"`), for tests.
     pub alpha_mode: Option<String>,
 }
@@ -52,6 +54,7 @@ impl MaterialDesc {
             double_sided: false,
             base_color_texture: None,
             emissive_texture: None,
+            normal_texture: None,
             alpha_mode: None,
         }
     }
@@ -74,6 +77,8 @@ pub struct PrimitiveDesc {
     pub normals: Option<Vec<[f32; 3]>>,
     /// TEXCOORD_0 (optional).
     pub texcoords: Option<Vec<[f32; 2]>>,
+    /// TANGENT (optional).
+    pub tangents: Option<Vec<[f32; 4]>>,
     /// Indices (optional: non-indexed).
     pub indices: Option<Vec<u32>>,
     /// Index component type.
@@ -96,6 +101,7 @@ impl PrimitiveDesc {
             positions,
             normals,
             texcoords: None,
+            tangents: None,
             indices: Some(indices),
             index_format: IndexFormat::Auto,
             material,
