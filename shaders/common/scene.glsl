@@ -1,7 +1,8 @@
 // common/scene.glsl — Rust: crates/radcache-render/src/scene/mod.rs
 // The scene as every scene-reading pass sees it: bindings 0-15 (see shared/bindings.glsl),
 // surface reconstruction at a ray-query hit, materials, textures and emission, and the traversal
-// every ray query of the passes goes through (scene_trace, with the alpha test under HAS_ALPHA).
+// every ray query of the passes goes through (scene_trace, with the alpha test under HAS_ALPHA). With
+// HAS_NORMAL_MAPS, the vertex tangents and the normal maps (common/normal_map.glsl).
 #ifndef RADCACHE_SCENE_GLSL
 #define RADCACHE_SCENE_GLSL
 
@@ -26,6 +27,31 @@ layout(binding = B_EMITTER_ALIAS, std430) readonly buffer EmitterAlias { GpuAlia
 layout(binding = B_LIGHTS, std430) readonly buffer Lights { GpuLight lights[]; };
 layout(binding = B_ENV_TEXELS, std430) readonly buffer EnvTexels { vec4 env_texels[]; };
 layout(binding = B_ENV_ALIAS, std430) readonly buffer EnvAlias { GpuAlias env_alias[]; };
+#ifdef HAS_NORMAL_MAPS
+#include "normal_map.glsl"
+layout(binding = B_TANGENTS, std430) readonly buffer Tangents { vec4 tangents[]; };
+
+vec4 texture_sample(int index, vec2 uv);
+
+// An object-space tangent in world space: xyz by the instance's linear part, w (handedness)
+// flipped by a mirroring transform, as the bitangent n × t is.
+vec4 world_tangent(GpuInstance inst, vec4 t) {
+    vec3 xyz = (inst.world_from_object * vec4(t.xyz, 0.0)).xyz;
+    return vec4(xyz, inst.normal_to_world[3][3] < 0.0 ? -t.w : t.w);
+}
+
+// The shading normal of material m at uv (docs/materials.md §12) from the unit interpolated
+// normal n, the unit geometric normal ng (both outward) and the world tangent: n itself where the
+// material has no normal map or the primitive no tangents (w = 0).
+vec3 material_shading_normal(uint m, vec2 uv, vec4 tangent, vec3 n, vec3 ng) {
+    vec4 map = materials[m].normal_map;
+    if (map.x < 0.0 || tangent.w == 0.0) {
+        return n;
+    }
+    vec3 texel = texture_sample(int(map.x), uv).rgb;
+    return normal_map_normal(n, ng, tangent, texel, map.y);
+}
+#endif
 
 // A reconstructed surface point.
 struct Surface {
@@ -91,15 +117,22 @@ Surface surface_at(uint instance, uint prim, vec2 bary, vec3 dir) {
     vec3 ns = (inst.normal_to_world * vec4(n_obj, 0.0)).xyz;
     float ns_len = length(ns);
     ns = (ns_len > 0.0 && !isnan(ns_len)) ? ns / ns_len : ng;
+    s.uv = w.x * vec2(v0.position_u.w, v0.normal_v.w) + w.y * vec2(v1.position_u.w, v1.normal_v.w) +
+           w.z * vec2(v2.position_u.w, v2.normal_v.w);
+    s.material = tri_materials[inst.mesh.w + prim];
+#ifdef HAS_NORMAL_MAPS
+    // The map acts on the outward normals (the flip below turns its result with them); the
+    // handedness is the first corner's, as the G-buffer's flat varying has it.
+    vec3 t_obj = w.x * tangents[i0].xyz + w.y * tangents[i1].xyz + w.z * tangents[i2].xyz;
+    vec4 tangent = world_tangent(inst, vec4(t_obj, tangents[i0].w));
+    ns = material_shading_normal(s.material, s.uv, tangent, ns, ng);
+#endif
     if (!s.front_face) {
         ns = -ns;
     }
     // A shading normal on the far side of the geometric one (inward-facing vertex normals, or
     // interpolation across a crease) would send rays into the surface: fall back.
     s.shading_normal = dot(ns, s.geometric_normal) > 0.0 ? ns : s.geometric_normal;
-    s.uv = w.x * vec2(v0.position_u.w, v0.normal_v.w) + w.y * vec2(v1.position_u.w, v1.normal_v.w) +
-           w.z * vec2(v2.position_u.w, v2.normal_v.w);
-    s.material = tri_materials[inst.mesh.w + prim];
     return s;
 }
 

@@ -1,7 +1,8 @@
 // passes/gbuffer.frag — Rust: crates/radcache-render/src/passes/gbuffer.rs
 // G-buffer rasterization, fragment stage: the five attachments of shaders/common/gbuffer.glsl.
 // The geometric normal comes from the triangle's world-space corners (mirroring instances flip
-// it, as glTF's winding rule says); both normals are turned toward the camera, and the front
+// it, as glTF's winding rule says); the normal map (HAS_NORMAL_MAPS) bends the shading normal as
+// surface_at does; both normals are turned toward the camera, and the front
 // face (for the emission rule) is the side the camera sees. The pixel footprint is the pinhole
 // `pixel_footprint` of ircache_math.glsl (its cosine clamp keeps grazing surfaces bounded, where
 // screen-space derivatives would grow without limit). Each fragment checks with one ray query
@@ -21,6 +22,10 @@ layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec2 v_uv;
 layout(location = 3) flat in uint v_triangle;
+#ifdef HAS_NORMAL_MAPS
+layout(location = 4) in vec3 v_tangent;
+layout(location = 5) flat in float v_tangent_w;
+#endif
 
 layout(location = 0) out vec4 o_position;
 layout(location = 1) out vec4 o_normal;
@@ -100,13 +105,18 @@ void main() {
     vec3 ns = v_normal;
     float ns_len = length(ns);
     ns = (ns_len > 0.0 && !isnan(ns_len)) ? ns / ns_len : ng;
+    vec2 uv = v_uv;
+#ifdef HAS_NORMAL_MAPS
+    // On the outward normals, as surface_at does; the flip below turns the result with them.
+    ns = material_shading_normal(material, uv, vec4(v_tangent, v_tangent_w), ns,
+                                 front ? ng : -ng);
+#endif
     if (!front) {
         ns = -ns;
     }
     if (dot(ns, ng) <= 0.0) {
         ns = ng;
     }
-    vec2 uv = v_uv;
     float view_depth = 1.0 / gl_FragCoord.w;
     Surface hit;
     uint instance = pc.instance;

@@ -17,6 +17,11 @@ layout(location = 0) out vec3 v_position;
 layout(location = 1) out vec3 v_normal;
 layout(location = 2) out vec2 v_uv;
 layout(location = 3) flat out uint v_triangle;
+#ifdef HAS_NORMAL_MAPS
+// World tangent (xyz) and handedness (the provoking, first, corner's: surface_at uses it too).
+layout(location = 4) out vec3 v_tangent;
+layout(location = 5) flat out float v_tangent_w;
+#endif
 
 void main() {
     GpuInstance inst = instances[pc.instance];
@@ -27,6 +32,11 @@ void main() {
     v_normal = (inst.normal_to_world * vec4(v.normal_v.xyz, 0.0)).xyz;
     v_uv = vec2(v.position_u.w, v.normal_v.w);
     v_triangle = uint(gl_VertexIndex) / 3u;
+#ifdef HAS_NORMAL_MAPS
+    vec4 t = world_tangent(inst, tangents[index]);
+    v_tangent = t.xyz;
+    v_tangent_w = t.w;
+#endif
     vec4 clip = frame.clip_from_world * world;
     clip.xy -= 2.0 * pc.jitter / vec2(frame.resolution.xy) * clip.w;
     gl_Position = clip;

@@ -68,6 +68,7 @@ const float SCHLICK_MEAN_C1 = 0.00201882;
 const float SCHLICK_MEAN_C2 = 0.00931768;
 const float SCHLICK_MEAN_C3 = 0.00777722;
 const float SCHLICK_MEAN_C4 = 0.00896681;
+const float NORMAL_MAP_COS_MIN = 0.05;
 
 const uint BRDF_TWIN_TERMS = 0u;
 const uint BRDF_TWIN_BRDF = 1u;

@@ -24,7 +24,8 @@ struct GpuMaterial {
     vec4 params;
     vec4 specular;
     vec4 alpha;
-};  // 96 bytes
+    vec4 normal_map;
+};  // 112 bytes
 
 struct GpuTexture {
     uvec4 info;

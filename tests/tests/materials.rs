@@ -347,8 +347,18 @@ fn spheres_room(tag: &str) -> Scene {
         double_sided: true,
         ..MaterialDesc::emitter("light", [0.0; 3], [12.0; 3])
     });
-    let gold = b.add_material(&MaterialDesc::metal_rough("gold", [0.95, 0.7, 0.35], 1.0, 0.35));
-    let blue = b.add_material(&MaterialDesc::metal_rough("blue", [0.15, 0.3, 0.7], 0.0, 0.3));
+    let gold = b.add_material(&MaterialDesc::metal_rough(
+        "gold",
+        [0.95, 0.7, 0.35],
+        1.0,
+        0.35,
+    ));
+    let blue = b.add_material(&MaterialDesc::metal_rough(
+        "blue",
+        [0.15, 0.3, 0.7],
+        0.0,
+        0.3,
+    ));
     let tri = |m: &radcache_tests::geometry::Mesh, material: usize, smooth: Option<Vec3>| {
         PrimitiveDesc::triangles(
             m.positions.iter().map(|p| p.to_array()).collect(),
@@ -405,7 +415,10 @@ fn spheres_room(tag: &str) -> Scene {
 fn the_cache_frame_matches_the_path_tracer_on_metal_and_dielectric_spheres() {
     let scene = spheres_room("spheres_room");
     assert!(scene.plan().specular);
-    let blue = scene.materials.iter().find(|m| m.name.as_deref() == Some("blue"));
+    let blue = scene
+        .materials
+        .iter()
+        .find(|m| m.name.as_deref() == Some("blue"));
     assert!(blue.is_some_and(|m| m.specular_factor == 1.0 && m.metallic == 0.0));
     let size = (48u32, 48u32);
     let ctx = context();

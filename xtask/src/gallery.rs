@@ -17,7 +17,10 @@ use radcache_vk::{Context, ShaderCompiler};
 
 /// The models: a name and its path under `../shared/models/`.
 const MODELS: &[(&str, &str)] = &[
-    ("DamagedHelmet", "DamagedHelmet/glTF-Binary/DamagedHelmet.glb"),
+    (
+        "DamagedHelmet",
+        "DamagedHelmet/glTF-Binary/DamagedHelmet.glb",
+    ),
     ("Suzanne", "Suzanne/glTF/Suzanne.gltf"),
 ];
 
@@ -33,7 +36,10 @@ pub fn run(args: &[&str]) -> Result<()> {
     let mut out = crate::root().join("docs/gallery.png");
     let mut it = args.iter();
     while let Some(a) = it.next() {
-        let mut value = || it.next().with_context(|| format!("{a} needs a value; {USAGE}"));
+        let mut value = || {
+            it.next()
+                .with_context(|| format!("{a} needs a value; {USAGE}"))
+        };
         match *a {
             "--size" => size = value()?.parse()?,
             "--spp" => spp = value()?.parse()?,
@@ -63,8 +69,8 @@ pub fn run(args: &[&str]) -> Result<()> {
             },
             ..LoadOptions::default()
         };
-        let (scene, _) = Scene::load(&path, &opts)
-            .with_context(|| format!("gallery: {}", path.display()))?;
+        let (scene, _) =
+            Scene::load(&path, &opts).with_context(|| format!("gallery: {}", path.display()))?;
         let mut gpu = GpuScene::new(&ctx, &scene, None)?;
         let settings = IcSettings {
             width: size,

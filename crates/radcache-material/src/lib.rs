@@ -12,9 +12,11 @@
 //! | [`brdf`] | [`Material`], the BRDF (diffuse and specular lobes), the diffuse share | §1, §4, §6 |
 //! | [`sampling`] | cosine and GGX visible-normal sampling, lobe choice, the mixture pdf | §5 |
 //! | [`polygon`] | the irradiance of a uniformly emitting triangle on a Lambertian receiver (Lambert's formula, horizon-clipped) | §7 |
+//! | [`normal_map`] | the shading normal from a normal-map texel, kept on the geometric side | §12 |
 //!
-//! **GLSL twin.** `shaders/common/brdf.glsl` mirrors the functions one to one (checked by
-//! `tests/glsl.rs`; values compared on lavapipe by `tests/tests/brdf_glsl.rs`): plain
+//! **GLSL twin.** `shaders/common/brdf.glsl` (`polygon.glsl`, `normal_map.glsl` for those
+//! modules) mirrors the functions one to one (checked by `tests/glsl.rs`; values compared on
+//! lavapipe by `tests/tests/brdf_glsl.rs` and `tests/tests/normal_maps.rs`): plain
 //! `f32` / `Vec3` arguments (a [`Material`] becomes a GLSL `struct` with the same fields), no
 //! traits or generics in the math, functions returning several values return a small struct.
 //!
@@ -28,8 +30,10 @@
 pub mod brdf;
 pub mod fresnel;
 pub mod ggx;
+pub mod normal_map;
 pub mod polygon;
 pub mod sampling;
 
 pub use brdf::{brdf_eval, brdf_eval_lobes, diffuse_share, BrdfLobes, Material};
+pub use normal_map::normal_map_normal;
 pub use sampling::{brdf_pdf, brdf_sample, BrdfSample};

@@ -37,6 +37,11 @@ fn polygon_glsl_path() -> PathBuf {
     crate_dir().join("../../shaders/common/polygon.glsl")
 }
 
+/// The twin of `src/normal_map.rs`.
+fn normal_map_glsl_path() -> PathBuf {
+    crate_dir().join("../../shaders/common/normal_map.glsl")
+}
+
 fn arity(args: &str) -> usize {
     args.split(',').filter(|a| !a.trim().is_empty()).count()
 }
@@ -71,7 +76,14 @@ fn every_rust_function_has_a_glsl_twin() {
             .starts_with("// common/polygon.glsl — Rust: crates/radcache-material/src/polygon.rs"),
         "polygon.glsl must name its CPU twin on its first line"
     );
-    let text = format!("{brdf}\n{polygon}");
+    let normal_map = std::fs::read_to_string(normal_map_glsl_path()).expect("normal_map.glsl");
+    assert!(
+        normal_map.starts_with(
+            "// common/normal_map.glsl — Rust: crates/radcache-material/src/normal_map.rs"
+        ),
+        "normal_map.glsl must name its CPU twin on its first line"
+    );
+    let text = format!("{brdf}\n{polygon}\n{normal_map}");
     let types = [
         "float",
         "vec3",
@@ -134,6 +146,19 @@ fn constants_are_generated_not_copied() {
     }
     assert_eq!(radcache_material::ggx::ALPHA_MIN, 1.0e-3);
     assert_eq!(radcache_material::brdf::COS_MIN, 1.0e-6);
+}
+
+#[test]
+fn normal_map_glsl_compiles_and_uses_the_generated_limit() {
+    let text = std::fs::read_to_string(normal_map_glsl_path()).unwrap();
+    assert_constants_generated("normal_map.glsl", &text, &["NORMAL_MAP_COS_MIN"]);
+    assert!(text.contains("NORMAL_MAP_COS_MIN"));
+    assert_compiles_with_glslang(
+        normal_map_glsl_path().parent().unwrap(),
+        "normal_map.glsl",
+        "o.v[0] = vec4(normal_map_normal(vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, 1.0), \
+         vec4(1.0, 0.0, 0.0, 1.0), vec3(0.6, 0.5, 0.9), 1.0), 0.0);",
+    );
 }
 
 #[test]

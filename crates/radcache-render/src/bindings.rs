@@ -1,7 +1,7 @@
-//! The one owner of binding numbers and kinds. Bindings 0–15 are the scene's (every pass that
-//! reads the scene pushes the same table); the G-buffer's six images follow at [`PASS_BASE`]
-//! in the passes that read it; each pass's own bindings come next, declared once here by
-//! [`pass_bindings!`] as a named table. `cargo xtask codegen` writes every number to
+//! The one owner of binding numbers and kinds. Bindings 0–15 are the scene's (0–14 used; every
+//! pass that reads the scene pushes the same table); the G-buffer's six images follow at
+//! [`PASS_BASE`] in the passes that read it; each pass's own bindings come next, declared once
+//! here by [`pass_bindings!`] as a named table. `cargo xtask codegen` writes every number to
 //! `shaders/shared/bindings.glsl` as `B_<PASS>_<NAME>` (a test fails when it is stale), so no
 //! shader writes a binding number; `radcache-vk` checks at record time that each binding pushed
 //! has the declared kind and that none was left out.
@@ -36,11 +36,14 @@ pub const LIGHTS: u32 = 11;
 pub const ENV_TEXELS: u32 = 12;
 /// Alias table over environment texels (`GpuAlias[]`).
 pub const ENV_ALIAS: u32 = 13;
+/// Vertex tangents (`vec4[]`, parallel to the vertices; w = ±1 handedness, 0 where no normal map
+/// applies). A 16-byte placeholder unless the plan has normal maps.
+pub const TANGENTS: u32 = 14;
 /// First binding of a pass's own resources.
 pub const PASS_BASE: u32 = 16;
 
 /// The scene's binding table (prefix of every scene-reading pass's table).
-pub const SCENE: [BindingLayout; 14] = [
+pub const SCENE: [BindingLayout; 15] = [
     BindingLayout::new(FRAME, BindingKind::UniformBuffer),
     BindingLayout::new(TLAS, BindingKind::AccelerationStructure),
     BindingLayout::new(VERTICES, BindingKind::StorageBuffer),
@@ -55,6 +58,7 @@ pub const SCENE: [BindingLayout; 14] = [
     BindingLayout::new(LIGHTS, BindingKind::StorageBuffer),
     BindingLayout::new(ENV_TEXELS, BindingKind::StorageBuffer),
     BindingLayout::new(ENV_ALIAS, BindingKind::StorageBuffer),
+    BindingLayout::new(TANGENTS, BindingKind::StorageBuffer),
 ];
 
 /// One named binding of a table.
@@ -330,6 +334,7 @@ pub fn generated_glsl() -> String {
         ("LIGHTS", LIGHTS),
         ("ENV_TEXELS", ENV_TEXELS),
         ("ENV_ALIAS", ENV_ALIAS),
+        ("TANGENTS", TANGENTS),
         ("PASS_BASE", PASS_BASE),
         ("GBUFFER_END", GBUFFER_END),
     ];

@@ -11,7 +11,8 @@
 //! intensities in the KHR_lights_punctual units (cd, lx) used as radiometric values.
 //!
 //! **For a GPU uploader.** Geometry: `scene.meshes[m]` holds `positions`, `normals`,
-//! `texcoords` (one entry per vertex), `indices` (3 per triangle, CCW front faces) and
+//! `texcoords` (one entry per vertex; `tangents` too where a material has a normal map),
+//! `indices` (3 per triangle, CCW front faces) and
 //! `triangle_materials` (one per triangle), plus per-primitive [`PrimitiveRange`]s. Placement:
 //! `scene.instances[i].mesh` with `scene.instance_transforms(t)[i]` (`world_from_object`; a negative
 //! determinant makes the clockwise side the front, per the glTF spec); `Instance::dynamic` says
@@ -34,7 +35,8 @@
 //! sets other than 0 (texture ignored), missing normals (flat), a negative `emissiveStrength` (not
 //! emissive), KHR_materials_specular textures (factors used), material extensions other than
 //! emissive strength, ior and specular (core model; named once each, with a count, in the
-//! warnings and the summary).
+//! warnings and the summary), a normal map on a primitive without normals or TEXCOORD_0
+//! (ignored).
 //!
 //! The [`writer`] module builds valid glTF files (used by tests and by [`assets`], which generates
 //! the bundled Cornell box, furnace and animated scenes).
@@ -58,6 +60,7 @@ pub mod plan;
 mod resources;
 mod scene;
 mod summary;
+pub mod tangent;
 pub mod texture;
 pub mod writer;
 

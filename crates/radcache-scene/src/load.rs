@@ -57,9 +57,20 @@ impl Scene {
                 default_index
             }
         };
+        let normal_mapped = |i: u32| {
+            materials
+                .get(i as usize)
+                .is_some_and(|m| m.normal_texture.is_some())
+        };
         let mut meshes = Vec::new();
         for m in src.doc.meshes() {
-            meshes.push(load_mesh(&src, &m, &mut material_of, &mut w)?);
+            meshes.push(load_mesh(
+                &src,
+                &m,
+                &mut material_of,
+                &normal_mapped,
+                &mut w,
+            )?);
         }
         if default_used {
             materials.push(Material::default_material());

@@ -63,6 +63,10 @@ pub struct Material {
     pub emissive: Vec3,
     /// Emissive texture (sRGB), multiplied with `emissive`.
     pub emissive_texture: Option<TextureRef>,
+    /// Tangent-space normal map (linear; glTF `normalTexture`, docs/materials.md §12).
+    pub normal_texture: Option<TextureRef>,
+    /// `normalTexture.scale` (default 1): scales the map's x and y.
+    pub normal_scale: f32,
     /// Whether both faces are shaded and (if emissive) emit.
     pub double_sided: bool,
     /// glTF `alphaMode`.
@@ -123,6 +127,8 @@ impl Material {
             specular_color: Vec3::ONE,
             emissive: Vec3::ZERO,
             emissive_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
             double_sided: false,
             alpha_mode: AlphaMode::Opaque,
             alpha_cutoff: 0.5,
@@ -292,6 +298,8 @@ pub(crate) fn load_materials(
             specular_color,
             emissive,
             emissive_texture: textures.get(src, m.emissive_texture(), true, &user, warnings)?,
+            normal_texture: textures.get_normal(src, m.normal_texture(), &user, warnings)?,
+            normal_scale: m.normal_texture().map_or(1.0, |t| t.scale()),
             double_sided: m.double_sided(),
             alpha_mode: match m.alpha_mode() {
                 gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,

@@ -10,15 +10,19 @@
 //! - degenerate triangles (repeated index, or `|e1 × e2| <= 1e-6 |e1| |e2|`) are dropped, with a count;
 //! - a primitive without normals, or with a zero-length normal, gets flat normals: its vertices are
 //!   de-indexed so that each triangle has its own three vertices carrying the face normal.
+//! - a primitive whose material has a normal map gets tangents: its `TANGENT` attribute, else
+//!   MikkTSpace tangents (its vertices split where they need two); without normals or TEXCOORD_0
+//!   its normal map is ignored (zero tangents).
 //!
-//! NaN/Inf in positions, normals or texcoords and indices out of range are errors.
+//! NaN/Inf in positions, normals, texcoords or tangents and indices out of range are errors.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 use crate::accessor;
 use crate::error::{label, Error, Result, WarningKind, Warnings};
 use crate::math::{triangle_cross, Aabb};
 use crate::resources::Source;
+use crate::tangent::{generate_tangents, sanitize_tangent};
 
 /// A triangle mesh in its local (object) space.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -31,6 +35,10 @@ pub struct Mesh {
     pub normals: Vec<Vec3>,
     /// TEXCOORD_0, same length as `positions` (zero where the primitive had none).
     pub texcoords: Vec<Vec2>,
+    /// Tangents (xyz, and w = ±1: bitangent = w · normal × tangent; see [`crate::tangent`]): same
+    /// length as `positions` when some primitive's material has a normal map, else empty. Zero
+    /// on the vertices of primitives that use no normal map.
+    pub tangents: Vec<Vec4>,
     /// Three indices per triangle into the vertex arrays, counter-clockwise front faces.
     pub indices: Vec<u32>,
     /// Material index (into `Scene::materials`) of each triangle.
@@ -92,6 +100,7 @@ struct PrimData {
     positions: Vec<Vec3>,
     normals: Option<Vec<Vec3>>,
     texcoords: Option<Vec<Vec2>>,
+    tangents: Option<Vec<Vec4>>,
     indices: Vec<u32>,
 }
 
@@ -111,11 +120,13 @@ fn check_finite<T: Copy>(
     }
 }
 
-/// Loads glTF mesh `m`. `material_of` maps a primitive's material (None = default) to an index.
+/// Loads glTF mesh `m`. `material_of` maps a primitive's material (None = default) to an index;
+/// `normal_mapped` says whether glTF material `i` has a normal map.
 pub(crate) fn load_mesh(
     src: &Source,
     m: &gltf::Mesh<'_>,
     material_of: &mut dyn FnMut(Option<usize>) -> u32,
+    normal_mapped: &dyn Fn(u32) -> bool,
     warnings: &mut Warnings,
 ) -> Result<Mesh> {
     let mesh_label = label("mesh", m.index(), m.name());
@@ -148,7 +159,12 @@ pub(crate) fn load_mesh(
                 ),
             );
         }
-        let Some(data) = read_primitive(src, &prim, &user, warnings)? else {
+        // The default material (no glTF material) has no normal map.
+        let want_tangents = prim
+            .material()
+            .index()
+            .is_some_and(|i| normal_mapped(i as u32));
+        let Some(data) = read_primitive(src, &prim, want_tangents, &user, warnings)? else {
             continue;
         };
         let material = material_of(prim.material().index());
@@ -162,15 +178,22 @@ pub(crate) fn load_mesh(
             warnings,
         )?;
     }
+    if !mesh.tangents.is_empty() {
+        mesh.tangents.resize(mesh.positions.len(), Vec4::ZERO);
+    }
     for &p in &mesh.positions {
         mesh.bounds.extend(p);
     }
     Ok(mesh)
 }
 
+/// Reads a primitive's attributes; `TANGENT` only when `want_tangents` (a normal-mapped
+/// material), else `tangents` is `None`. With `want_tangents` and no `TANGENT`, `tangents` is an
+/// empty list: generate them.
 fn read_primitive(
     src: &Source,
     prim: &gltf::Primitive<'_>,
+    want_tangents: bool,
     user: &str,
     warnings: &mut Warnings,
 ) -> Result<Option<PrimData>> {
@@ -227,6 +250,23 @@ fn read_primitive(
         }
         None => None,
     };
+    let tangents = match prim
+        .get(&gltf::Semantic::Tangents)
+        .filter(|_| want_tangents)
+    {
+        Some(acc) => {
+            let u = format!("{user} TANGENT");
+            let v = accessor::read_any_vec(src, &acc, &u, 4)?;
+            check_finite(src, accessor::element_label(&acc, &u), &v, |v| {
+                v.is_finite()
+            })?;
+            if v.len() != n {
+                return Err(count_err(&acc, "TANGENT", v.len()));
+            }
+            Some(v)
+        }
+        None => want_tangents.then(Vec::new),
+    };
     let mut indices = match prim.indices() {
         Some(acc) => {
             let u = format!("{user} indices");
@@ -267,6 +307,7 @@ fn read_primitive(
         positions,
         normals,
         texcoords,
+        tangents,
         indices,
     }))
 }
@@ -284,6 +325,7 @@ fn append_primitive(
         positions,
         normals,
         texcoords,
+        tangents,
         indices,
     } = data;
     let mut kept: Vec<[u32; 3]> = Vec::with_capacity(indices.len() / 3);
@@ -314,18 +356,51 @@ fn append_primitive(
         reason: "mesh exceeds 2^32 vertices".into(),
     };
     let tc = |i: u32| texcoords.as_ref().map_or(Vec2::ZERO, |t| t[i as usize]);
+    let ignored = |why: &str| {
+        format!(
+            "{}: {user}: {why}; its material's normal map is ignored",
+            src.path.display()
+        )
+    };
+    let mut prim_tangents = None;
     match usable_normals {
         Some(ns) => {
+            let mut ns: Vec<Vec3> = ns.iter().map(|n| n.normalize()).collect();
+            let mut uvs: Vec<Vec2> = (0..positions.len() as u32).map(tc).collect();
+            let mut positions = positions;
+            match (tangents, texcoords.is_some()) {
+                (None, _) => {}
+                (Some(_), false) => {
+                    let msg = ignored("no TEXCOORD_0");
+                    warnings.push(WarningKind::TextureIgnored, 1, msg);
+                }
+                (Some(file), true) if !file.is_empty() => {
+                    let t = file.iter().zip(&ns).map(|(&t, &n)| sanitize_tangent(t, n));
+                    prim_tangents = Some(t.collect());
+                }
+                (Some(_), true) => {
+                    let g = generate_tangents(&positions, &ns, &uvs, &kept);
+                    positions = g.source.iter().map(|&v| positions[v as usize]).collect();
+                    ns = g.source.iter().map(|&v| ns[v as usize]).collect();
+                    uvs = g.source.iter().map(|&v| uvs[v as usize]).collect();
+                    kept = g.triangles;
+                    prim_tangents = Some(g.tangents);
+                }
+            }
             let base = u32::try_from(first_vertex).map_err(|_| too_big())?;
             u32::try_from(first_vertex + positions.len()).map_err(|_| too_big())?;
-            mesh.normals.extend(ns.iter().map(|n| n.normalize()));
-            mesh.texcoords.extend((0..positions.len() as u32).map(tc));
+            mesh.normals.extend(ns);
+            mesh.texcoords.extend(uvs);
             mesh.positions.extend_from_slice(&positions);
             for t in &kept {
                 mesh.indices.extend(t.iter().map(|&i| base + i));
             }
         }
         None => {
+            if tangents.is_some() {
+                let msg = ignored("no usable normals (flat normals generated)");
+                warnings.push(WarningKind::TextureIgnored, 1, msg);
+            }
             warnings.push(
                 WarningKind::GeneratedNormals,
                 1,
@@ -346,6 +421,10 @@ fn append_primitive(
                 }
             }
         }
+    }
+    if let Some(t) = prim_tangents {
+        mesh.tangents.resize(first_vertex, Vec4::ZERO);
+        mesh.tangents.extend(t);
     }
     mesh.triangle_materials
         .extend(std::iter::repeat_n(material, kept.len()));

@@ -96,6 +96,10 @@ pub struct ScenePlan {
     /// (`HAS_ALPHA`) into every ray query and the G-buffer, and the geometry of those materials is
     /// built non-opaque. False: every ray query keeps the opaque fast path.
     pub alpha: bool,
+    /// Some primitive has a normal-mapped material and the tangents it needs (docs/materials.md
+    /// §12): the passes compile the normal-map code (`HAS_NORMAL_MAPS`) and upload a tangent per
+    /// vertex. False otherwise: no tangent memory, no normal-map code.
+    pub normal_maps: bool,
     /// Punctual light instances by kind.
     pub lights: LightCounts,
     /// Environment kind.
@@ -146,6 +150,7 @@ impl ScenePlan {
                 && !specular,
             specular,
             alpha,
+            normal_maps: scene.meshes.iter().any(|m| !m.tangents.is_empty()),
             emissive_triangles: count,
             emissive_power: emitters.total_power,
             lights,
@@ -247,6 +252,15 @@ impl fmt::Display for ScenePlan {
                 "metallic-roughness BRDF (specular lobes compiled in)"
             } else {
                 "lambertian only (no specular code compiled)"
+            }
+        )?;
+        writeln!(
+            f,
+            "  normal maps: {}",
+            if self.normal_maps {
+                "yes (a tangent per vertex)"
+            } else {
+                "none"
             }
         )?;
         writeln!(

@@ -183,11 +183,34 @@ impl TextureLoader {
         warnings: &mut Warnings,
     ) -> Result<Option<TextureRef>> {
         let Some(info) = info else { return Ok(None) };
-        let tex = info.texture();
+        self.resolve(src, info.texture(), info.tex_coord(), srgb, user, warnings)
+    }
+
+    /// Resolves a material's normal texture (linear data), like [`TextureLoader::get`].
+    pub(crate) fn get_normal(
+        &mut self,
+        src: &Source,
+        info: Option<gltf::material::NormalTexture<'_>>,
+        user: &str,
+        warnings: &mut Warnings,
+    ) -> Result<Option<TextureRef>> {
+        let Some(info) = info else { return Ok(None) };
+        self.resolve(src, info.texture(), info.tex_coord(), false, user, warnings)
+    }
+
+    fn resolve(
+        &mut self,
+        src: &Source,
+        tex: gltf::Texture<'_>,
+        tex_coord: u32,
+        srgb: bool,
+        user: &str,
+        warnings: &mut Warnings,
+    ) -> Result<Option<TextureRef>> {
         let tex_label = label("texture", tex.index(), tex.name());
         let file = src.path.display();
-        if info.tex_coord() != 0 {
-            let msg = format!("{file}: {user} {tex_label}: texCoord {} unsupported (only TEXCOORD_0); texture ignored", info.tex_coord());
+        if tex_coord != 0 {
+            let msg = format!("{file}: {user} {tex_label}: texCoord {tex_coord} unsupported (only TEXCOORD_0); texture ignored");
             warnings.push(WarningKind::TextureIgnored, 1, msg);
             return Ok(None);
         }

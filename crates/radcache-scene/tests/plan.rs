@@ -115,6 +115,7 @@ fn animated_camera_and_plan_text() {
         "emissive triangles: none",
         "punctual lights: 0 point, 1 spot, 0 directional",
         "environment: none",
+        "normal maps: none",
         "textures: no",
         "alpha: none (opaque ray queries)",
         "animation: camera only (camera yes, lights no, geometry no), time range [0.500, 2.500] s",

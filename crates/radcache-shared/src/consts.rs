@@ -208,6 +208,9 @@ gpu_consts! {
     pub const SCHLICK_MEAN_C3: f32 = 7.77722e-3;
     /// See [`SCHLICK_MEAN_C0`].
     pub const SCHLICK_MEAN_C4: f32 = 8.96681e-3;
+    /// Smallest cosine between a normal-mapped shading normal and the geometric normal: a map
+    /// texel that tilts the normal further is bent back to this cosine (docs/materials.md §12).
+    pub const NORMAL_MAP_COS_MIN: f32 = 0.05;
 }
 
 gpu_enum! {

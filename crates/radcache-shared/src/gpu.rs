@@ -52,6 +52,9 @@ gpu_struct! {
         pub specular: [f32; 4] => "vec4",
         /// The MASK alpha cutoff (x); unused (yzw).
         pub alpha: [f32; 4] => "vec4",
+        /// Normal map: texture index as a float (x, −1 for none), `normalTexture.scale` (y),
+        /// unused (z, w).
+        pub normal_map: [f32; 4] => "vec4",
     }
 }
 

@@ -2,9 +2,10 @@
 //!
 //! Each triangle `(p0, p1, p2)` is split into `n²` congruent sub-triangles on the barycentric grid
 //! of step `1/n`: grid vertex `(i, j)` (`i + j <= n`) has the weights `((n−i−j)/n, i/n, j/n)`, and
-//! its position, normal (renormalised) and texcoord are those weights applied to the corners'.
-//! Sub-triangles keep the parent's material and winding, so the surface, its shading normals and
-//! its texture mapping are unchanged: a render of the tessellated scene differs only by noise.
+//! its position, normal (renormalised), texcoord and tangent (the first corner's handedness) are
+//! those weights applied to the corners'. Sub-triangles keep the parent's material and winding,
+//! so the surface, its shading normals and its texture mapping are unchanged: a render of the
+//! tessellated scene differs only by noise.
 //!
 //! Every weight is an integer divided by `n` in `f32`, and a vertex is the plain sum `Σ w_k p_k`,
 //! so the vertices two neighbours place on their shared edge are bitwise equal (no cracks).
@@ -76,6 +77,11 @@ pub fn subdivide_mesh(mesh: &Mesh, n: u32) -> Result<Mesh> {
         positions: Vec::with_capacity(vertex_total),
         normals: Vec::with_capacity(vertex_total),
         texcoords: Vec::with_capacity(vertex_total),
+        tangents: Vec::with_capacity(if mesh.tangents.is_empty() {
+            0
+        } else {
+            vertex_total
+        }),
         indices: Vec::with_capacity(tris * pattern.len() * 3),
         triangle_materials: Vec::with_capacity(tris * pattern.len()),
         primitives: Vec::with_capacity(mesh.primitives.len()),
@@ -86,6 +92,7 @@ pub fn subdivide_mesh(mesh: &Mesh, n: u32) -> Result<Mesh> {
         let p = idx.map(|i| mesh.positions[i]);
         let nrm = idx.map(|i| mesh.normals[i]);
         let uv = idx.map(|i| mesh.texcoords[i]);
+        let tan = idx.map(|i| mesh.tangents.get(i).copied().unwrap_or_default());
         let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(Vec3::Z);
         let base = out.positions.len() as u32;
         for w in &weights {
@@ -94,6 +101,12 @@ pub fn subdivide_mesh(mesh: &Mesh, n: u32) -> Result<Mesh> {
                 .push((nrm[0] * w[0] + nrm[1] * w[1] + nrm[2] * w[2]).normalize_or(face));
             out.texcoords
                 .push(uv[0] * w[0] + uv[1] * w[1] + uv[2] * w[2]);
+            if !mesh.tangents.is_empty() {
+                // The handedness of the first corner (a triangle's corners share it).
+                let t =
+                    tan[0].truncate() * w[0] + tan[1].truncate() * w[1] + tan[2].truncate() * w[2];
+                out.tangents.push(t.extend(tan[0].w));
+            }
         }
         for tri in &pattern {
             out.indices.extend(tri.iter().map(|&k| base + k));
@@ -177,6 +190,7 @@ mod tests {
             positions,
             normals,
             texcoords,
+            tangents: Vec::new(),
             indices: vec![0, 1, 2, 2, 1, 3],
             triangle_materials: vec![3, 5],
             primitives: vec![prim(0, 3), prim(1, 5)],

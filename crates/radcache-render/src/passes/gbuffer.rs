@@ -4,7 +4,7 @@
 //!
 //! Writes the five attachments of `shaders/common/gbuffer.glsl` (position, shading normal +
 //! footprint, geometric normal + material, albedo, emission), zero on the background, and clears
-//! the direct-light image. Reads the scene bindings 0–13 (vertex and fragment stages; nothing is
+//! the direct-light image. Reads the scene bindings 0–14 (vertex and fragment stages; nothing is
 //! written from the vertex stage). Each fragment traces one ray query from the camera to itself:
 //! a surface hit before it (rasterization snapped a zero-thickness wall's edge away from the
 //! sample, so the sample sees the floor behind the wall) replaces it, so the G-buffer never holds
@@ -48,9 +48,10 @@ impl std::fmt::Debug for GBufferPass {
 
 impl GBufferPass {
     /// Compiles the pass for `scene`'s materials (the fragment stage stores metallic and
-    /// roughness only where some material is not Lambertian).
+    /// roughness only where some material is not Lambertian; both stages carry tangents only
+    /// where some primitive has a normal map).
     pub fn new(ctx: &Context, shaders: &ShaderCompiler, scene: &GpuScene) -> Result<GBufferPass> {
-        let vertex = shaders.compile("passes/gbuffer.vert", &[])?;
+        let vertex = shaders.compile("passes/gbuffer.vert", &scene.material_defines())?;
         let fragment = shaders.compile("passes/gbuffer.frag", &scene.material_defines())?;
         let pipeline = Pipeline::graphics(
             ctx,

@@ -49,6 +49,7 @@ pub struct GpuScene {
     plan: ScenePlan,
     frame: Buffer,
     vertices: Buffer,
+    tangents: Buffer,
     indices: Buffer,
     instances: Buffer,
     tri_materials: Buffer,
@@ -98,10 +99,11 @@ impl GpuScene {
         let mut stats = UploadStats::default();
         let PackedGeometry {
             vertices,
+            tangents,
             indices,
             tri_materials,
             meshes,
-        } = pack_geometry(scene);
+        } = pack_geometry(scene, plan.normal_maps);
         let geometry_usage = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
             | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
         let none = vk::BufferUsageFlags::empty();
@@ -123,6 +125,8 @@ impl GpuScene {
             none,
             bytemuck::cast_slice(&tri_materials),
         )?;
+        // Empty without normal maps: `storage` then makes a 16-byte placeholder.
+        let tangent_buf = storage(ctx, "scene.tangents", none, bytemuck::cast_slice(&tangents))?;
 
         let (materials, textures, texels) = pack_materials(scene);
         let material_buf = storage(
@@ -243,6 +247,7 @@ impl GpuScene {
         )?;
         stats.buffer_bytes = [
             &vertex_buf,
+            &tangent_buf,
             &index_buf,
             &tri_mat_buf,
             &material_buf,
@@ -268,6 +273,7 @@ impl GpuScene {
             plan,
             frame,
             vertices: vertex_buf,
+            tangents: tangent_buf,
             indices: index_buf,
             instances,
             tri_materials: tri_mat_buf,

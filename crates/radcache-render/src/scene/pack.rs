@@ -9,6 +9,9 @@ use radcache_shared::gpu::{GpuMaterial, GpuMesh, GpuTexture, GpuVertex};
 pub(crate) struct PackedGeometry {
     /// All vertices (position + u, normal + v).
     pub vertices: Vec<GpuVertex>,
+    /// A tangent per vertex when `normal_maps` was asked for (zero where a mesh has none), else
+    /// empty.
+    pub tangents: Vec<[f32; 4]>,
     /// Mesh-local indices of all meshes.
     pub indices: Vec<u32>,
     /// Material of every triangle.
@@ -17,9 +20,10 @@ pub(crate) struct PackedGeometry {
     pub meshes: Vec<GpuMesh>,
 }
 
-/// Packs every mesh of `scene`.
-pub(crate) fn pack_geometry(scene: &Scene) -> PackedGeometry {
+/// Packs every mesh of `scene`, with tangents when `normal_maps` (`ScenePlan::normal_maps`).
+pub(crate) fn pack_geometry(scene: &Scene, normal_maps: bool) -> PackedGeometry {
     let mut vertices = Vec::new();
+    let mut tangents = Vec::new();
     let mut indices = Vec::new();
     let mut tri_materials = Vec::new();
     let mut meshes = Vec::with_capacity(scene.meshes.len());
@@ -40,11 +44,16 @@ pub(crate) fn pack_geometry(scene: &Scene) -> PackedGeometry {
                 normal_v: [n.x, n.y, n.z, uv.y],
             });
         }
+        if normal_maps {
+            let t = |i: usize| mesh.tangents.get(i).map_or([0.0; 4], |t| t.to_array());
+            tangents.extend((0..mesh.positions.len()).map(t));
+        }
         indices.extend_from_slice(&mesh.indices);
         tri_materials.extend_from_slice(&mesh.triangle_materials);
     }
     PackedGeometry {
         vertices,
+        tangents,
         indices,
         tri_materials,
         meshes,
@@ -106,6 +115,12 @@ pub(crate) fn pack_materials(scene: &Scene) -> (Vec<GpuMaterial>, Vec<GpuTexture
                 m.specular_factor,
             ],
             alpha: [m.alpha_cutoff, 0.0, 0.0, 0.0],
+            normal_map: [
+                m.normal_texture.map_or(-1.0, |t| t.texture as f32),
+                m.normal_scale,
+                0.0,
+                0.0,
+            ],
         })
         .collect();
     let mut texels: Vec<u32> = Vec::new();

@@ -57,7 +57,8 @@ impl GpuScene {
     /// Shader defines of the scene's materials: `HAS_SPECULAR` when some material is not
     /// Lambertian (`ScenePlan::specular`), which compiles in the full metallic-roughness BRDF;
     /// `HAS_ALPHA` when some material is alpha-tested (`ScenePlan::alpha`), which compiles the
-    /// alpha test into every ray query and the G-buffer.
+    /// alpha test into every ray query and the G-buffer; `HAS_NORMAL_MAPS` when some primitive has a normal map (`ScenePlan::normal_maps`), which
+    /// compiles in the tangent binding and the normal-map code.
     pub fn material_defines(&self) -> Vec<(&'static str, &'static str)> {
         let mut d = Vec::new();
         if self.plan.specular {
@@ -65,6 +66,9 @@ impl GpuScene {
         }
         if self.plan.alpha {
             d.push(("HAS_ALPHA", "1"));
+        }
+        if self.plan.normal_maps {
+            d.push(("HAS_NORMAL_MAPS", "1"));
         }
         d
     }
@@ -88,7 +92,7 @@ impl GpuScene {
         d
     }
 
-    /// The scene's binding table (bindings 0–13), to prefix a pass's own bindings.
+    /// The scene's binding table (bindings 0–14), to prefix a pass's own bindings.
     pub fn bindings(&self) -> Vec<(u32, Resource<'_>)> {
         vec![
             (b::FRAME, Resource::Buffer(&self.frame)),
@@ -105,6 +109,7 @@ impl GpuScene {
             (b::LIGHTS, Resource::Buffer(&self.lights)),
             (b::ENV_TEXELS, Resource::Buffer(&self.env_texels)),
             (b::ENV_ALIAS, Resource::Buffer(&self.env_alias)),
+            (b::TANGENTS, Resource::Buffer(&self.tangents)),
         ]
     }
 }

@@ -339,8 +339,12 @@ pub fn metal_spheres_builder() -> GltfBuilder {
         ("sphere_rough_0.3", 0.3f32, Vec3::new(0.40, 0.1, 0.16)),
         ("sphere_rough_0.6", 0.6, Vec3::new(0.17, 0.1, 0.14)),
     ] {
-        let material =
-            b.add_material(&MaterialDesc::metal_rough(name, [1.0, 1.0, 1.0], 1.0, roughness));
+        let material = b.add_material(&MaterialDesc::metal_rough(
+            name,
+            [1.0, 1.0, 1.0],
+            1.0,
+            roughness,
+        ));
         let mesh = b.add_mesh(name, &[uv_sphere(centre, 0.1, 32, 64, material)]);
         roots.push(node(&mut b, name, mesh));
     }
@@ -362,7 +366,11 @@ fn uv_sphere(centre: Vec3, r: f32, rings: u32, segments: u32, material: usize) -
         let theta = std::f32::consts::PI * i as f32 / rings as f32;
         for j in 0..=segments {
             let phi = std::f32::consts::TAU * j as f32 / segments as f32;
-            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            let n = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
             positions.push((centre + r * n).to_array());
             normals.push(n.to_array());
         }
@@ -370,7 +378,12 @@ fn uv_sphere(centre: Vec3, r: f32, rings: u32, segments: u32, material: usize) -
     let row = segments + 1;
     for i in 0..rings {
         for j in 0..segments {
-            let (a, b, c, d) = (i * row + j, i * row + j + 1, (i + 1) * row + j, (i + 1) * row + j + 1);
+            let (a, b, c, d) = (
+                i * row + j,
+                i * row + j + 1,
+                (i + 1) * row + j,
+                (i + 1) * row + j + 1,
+            );
             if i != 0 {
                 indices.extend([a, b, c]);
             }

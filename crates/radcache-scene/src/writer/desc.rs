@@ -43,6 +43,8 @@ pub struct MaterialDesc {
     pub specular: f32,
     /// `KHR_materials_ior.ior`, written when set (the default is 1.5).
     pub ior: Option<f32>,
+    /// Normal texture index and its `scale`.
+    pub normal_texture: Option<(usize, f32)>,
     /// `alphaMode` other than OPAQUE (e.g. `"BLEND"`), for tests.
     pub alpha_mode: Option<String>,
     /// `alphaCutoff` (written when set).
@@ -66,6 +68,7 @@ impl MaterialDesc {
             metallic_roughness_texture: None,
             specular: 0.0,
             ior: None,
+            normal_texture: None,
             alpha_mode: None,
             alpha_cutoff: None,
         }
@@ -100,6 +103,8 @@ pub struct PrimitiveDesc {
     pub normals: Option<Vec<[f32; 3]>>,
     /// TEXCOORD_0 (optional).
     pub texcoords: Option<Vec<[f32; 2]>>,
+    /// TANGENT (optional).
+    pub tangents: Option<Vec<[f32; 4]>>,
     /// Indices (optional: non-indexed).
     pub indices: Option<Vec<u32>>,
     /// Index component type.
@@ -122,6 +127,7 @@ impl PrimitiveDesc {
             positions,
             normals,
             texcoords: None,
+            tangents: None,
             indices: Some(indices),
             index_format: IndexFormat::Auto,
             material,

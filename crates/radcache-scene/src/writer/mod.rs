@@ -173,6 +173,9 @@ impl GltfBuilder {
         if let Some(t) = m.emissive_texture {
             v["emissiveTexture"] = json!({"index": t});
         }
+        if let Some((t, scale)) = m.normal_texture {
+            v["normalTexture"] = json!({"index": t, "scale": num(scale)});
+        }
         if m.double_sided {
             v["doubleSided"] = json!(true);
         }
@@ -207,6 +210,13 @@ impl GltfBuilder {
                 attrs.insert(
                     "TEXCOORD_0".into(),
                     json!(self.add_float_accessor(&flat, 2, Some(34962))),
+                );
+            }
+            if let Some(t) = &p.tangents {
+                let flat: Vec<f32> = t.iter().flatten().copied().collect();
+                attrs.insert(
+                    "TANGENT".into(),
+                    json!(self.add_float_accessor(&flat, 4, Some(34962))),
                 );
             }
             let mut prim = json!({"attributes": attrs});

@@ -487,15 +487,24 @@ mod tests {
         m.base_color = glam::Vec4::ONE;
         m.roughness = 0.5;
         let x = bsdf(&m).unwrap();
-        assert!(x.contains("roughconductor") && x.contains("value=\"0.25\""), "{x}");
+        assert!(
+            x.contains("roughconductor") && x.contains("value=\"0.25\""),
+            "{x}"
+        );
         m.roughness = 0.0;
         assert!(bsdf(&m).unwrap().contains("value=\"0.001\""));
         m.base_color = glam::Vec4::new(0.9, 0.6, 0.3, 1.0);
-        assert!(bsdf(&m).is_err(), "a coloured metal's Schlick Fresnel has no Mitsuba twin");
+        assert!(
+            bsdf(&m).is_err(),
+            "a coloured metal's Schlick Fresnel has no Mitsuba twin"
+        );
         m.base_color = glam::Vec4::ONE;
         m.metallic = 0.0;
         m.specular_factor = 1.0;
-        assert!(bsdf(&m).is_err(), "a dielectric's specular layer has no Mitsuba twin");
+        assert!(
+            bsdf(&m).is_err(),
+            "a dielectric's specular layer has no Mitsuba twin"
+        );
     }
 
     #[test]
