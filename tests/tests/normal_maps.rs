@@ -183,8 +183,8 @@ fn light_toward(n: Vec3) -> Vec3 {
 /// under a mirroring node, a directional light arriving from `to_light`, and a camera above.
 fn bumpy_plane(tag: &str, texel: [u8; 4], scale: f32, mirror: bool, to_light: Vec3) -> Scene {
     let mut scene = bumpy_plane_with_layer(tag, texel, scale, mirror, to_light);
-    // Lambertian: no dielectric specular layer (glTF's default layer has factor 1; the writer
-    // does not write KHR_materials_specular).
+    // Lambertian: no dielectric specular layer (`specularFactor` 0, as KHR_materials_specular
+    // writes it).
     scene.materials[0].specular_factor = 0.0;
     assert!(scene.materials[0].is_lambertian());
     scene
@@ -202,7 +202,7 @@ fn bumpy_plane_with_layer(
     let tex = b.add_texture_rgba8(2, 2, &texel.repeat(4), 10497).unwrap();
     let mat = b.add_material(&MaterialDesc {
         normal_texture: Some((tex, scale)),
-        ..MaterialDesc::diffuse("bumpy", ALBEDO)
+        ..MaterialDesc::metal_rough("bumpy", ALBEDO, 0.0, 1.0)
     });
     let (x, z) = ([-20.0f32, 20.0], [-20.0f32, 20.0]);
     let positions = vec![
