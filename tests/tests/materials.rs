@@ -114,8 +114,8 @@ fn check_furnace(
             let mu_px = pixel_cos(scene, size, px, py);
             let expected_px = directional_albedo(m, mu_px);
             let got = out.pixels[(py * size.0 + px) as usize];
-            for c in 0..3 {
-                let g = f64::from(got[c]);
+            for (c, &value) in got.iter().enumerate().take(3) {
+                let g = f64::from(value);
                 assert!(
                     g <= 1.0 + 5.0 * se_bound,
                     "{what}: pixel ({px}, {py}) reflects {g} > the sky's 1"
