@@ -184,4 +184,22 @@ bool unoccluded(vec3 origin, vec3 dir, float tmax) {
     return rayQueryGetIntersectionTypeEXT(q, true) == gl_RayQueryCommittedIntersectionNoneEXT;
 }
 
+// Whether the point at `dist` along `dir` from surface point `p` is visible from `origin`, the
+// ray origin offset off that surface (offset_ray_origin). The shadow ray runs from `origin`
+// toward that point and stops 1e-4 of its length short: measured from `p` instead, the offset
+// (up to scene scale / 65536 near the world origin) could carry the ray past a light that is
+// close in relative terms, which then shadowed itself. `dist` ≥ 1e29 (a directional light) is a
+// ray to infinity along `dir`.
+bool unoccluded_to(vec3 origin, vec3 p, vec3 dir, float dist) {
+    if (dist >= 1e29) {
+        return unoccluded(origin, dir, 1e30);
+    }
+    vec3 d = p + dir * dist - origin;
+    float len = length(d);
+    if (!(len > 0.0)) {
+        return true;
+    }
+    return unoccluded(origin, d / len, len * (1.0 - 1e-4));
+}
+
 #endif

@@ -51,7 +51,7 @@ vec3 direct_light(Surface s, inout Rng rng) {
         if (sample_emitter(s.position, u, dir, dist, le, pdf)) {
             float cos_s = dot(s.shading_normal, dir);
             if (cos_s > 0.0 && dot(s.geometric_normal, dir) > 0.0 &&
-                unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+                unoccluded_to(origin, s.position, dir, dist)) {
                 float w = power_heuristic(pdf, cos_s * INV_PI);
                 sum += le * cos_s * w / pdf;
             }
@@ -65,7 +65,7 @@ vec3 direct_light(Surface s, inout Rng rng) {
         vec3 e = punctual_incident(lights[i], s.position, dir, dist);
         float cos_s = dot(s.shading_normal, dir);
         if (cos_s > 0.0 && dot(s.geometric_normal, dir) > 0.0 && any(greaterThan(e, vec3(0.0))) &&
-            unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+            unoccluded_to(origin, s.position, dir, dist)) {
             sum += e * cos_s;
         }
     }
@@ -138,7 +138,7 @@ vec3 direct_reflected(Surface s, Bsdf f, inout Rng rng) {
         vec3 u = vec3(rng_next(rng), rng_next2(rng));
         if (sample_emitter(s.position, u, dir, dist, le, pdf)) {
             vec3 fc = bsdf_f_cos(f, s, dir);
-            if (any(greaterThan(fc, vec3(0.0))) && unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+            if (any(greaterThan(fc, vec3(0.0))) && unoccluded_to(origin, s.position, dir, dist)) {
                 float w = power_heuristic(pdf, bsdf_pdf_dir(f, dir));
                 sum += le * fc * w / pdf;
             }
@@ -152,7 +152,7 @@ vec3 direct_reflected(Surface s, Bsdf f, inout Rng rng) {
         vec3 e = punctual_incident(lights[i], s.position, dir, dist);
         vec3 fc = bsdf_f_cos(f, s, dir);
         if (any(greaterThan(fc, vec3(0.0))) && any(greaterThan(e, vec3(0.0))) &&
-            unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+            unoccluded_to(origin, s.position, dir, dist)) {
             sum += e * fc;
         }
     }

@@ -118,7 +118,7 @@ vec3 one_sample(Surface s, vec3 origin, float u_pick, vec3 u3, vec2 u2) {
         }
         float cos_s = dot(s.shading_normal, dir);
         if (cos_s <= 0.0 || dot(s.geometric_normal, dir) <= 0.0 ||
-            !unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+            !unoccluded_to(origin, s.position, dir, dist)) {
             return vec3(0.0);
         }
         return le * cos_s / (C_EMITTER * pdf + C_BSDF * cos_s * INV_PI);
@@ -188,7 +188,7 @@ vec3 one_sample_brdf(Surface s, Bsdf f, vec3 origin, float u_pick, vec3 u3, vec2
             return vec3(0.0);
         }
         vec3 fc = bsdf_f_cos(f, s, dir);
-        if (all(equal(fc, vec3(0.0))) || !unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+        if (all(equal(fc, vec3(0.0))) || !unoccluded_to(origin, s.position, dir, dist)) {
             return vec3(0.0);
         }
         return le * fc / (C_EMITTER * pdf + C_BSDF * bsdf_pdf_dir(f, dir));
@@ -256,7 +256,7 @@ vec3 punctual_brdf(Surface s, Bsdf f, vec3 origin) {
         vec3 e = punctual_incident(lights[i], s.position, dir, dist);
         vec3 fc = bsdf_f_cos(f, s, dir);
         if (any(greaterThan(fc, vec3(0.0))) && any(greaterThan(e, vec3(0.0))) &&
-            unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+            unoccluded_to(origin, s.position, dir, dist)) {
             sum += e * fc;
         }
     }
@@ -336,7 +336,7 @@ void emitter_ratio_sums(Surface s, vec3 origin, uint first, uint count, vec3 shi
             continue;
         }
         sum_all += f;
-        if (unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+        if (unoccluded_to(origin, s.position, dir, dist)) {
             sum_visible += f;
         }
     }
@@ -353,7 +353,7 @@ vec3 punctual(Surface s, vec3 origin) {
         vec3 e = punctual_incident(lights[i], s.position, dir, dist);
         float cos_s = dot(s.shading_normal, dir);
         if (cos_s > 0.0 && dot(s.geometric_normal, dir) > 0.0 && any(greaterThan(e, vec3(0.0))) &&
-            unoccluded(origin, dir, dist * (1.0 - 1e-4))) {
+            unoccluded_to(origin, s.position, dir, dist)) {
             sum += e * cos_s;
         }
     }

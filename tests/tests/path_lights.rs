@@ -473,3 +473,96 @@ fn plane_under_a_constant_sky_reflects_albedo_times_sky() {
         "the view does not show both"
     );
 }
+
+/// A 12 m floor at y = 0 lit by a 0.5 m square emitter 2 m above the world origin. A coordinate
+/// near 0 (here every floor point's y) is offset off its surface by a fixed scene scale / 65536
+/// (2.6e-4 m here): more than the 1e-4 of the 2 m shadow ray by which it stops short of the light. Measured
+/// from the surface point, such shadow rays ended past the emitter and hit it, and the floor got
+/// about 5 % of its light. Every pixel is ρ/π · L · (the emitter's projected solid angle,
+/// Lambert's formula), path tracer and cache frame.
+#[test]
+fn a_floor_at_the_world_origin_sees_an_emitter_above_it() {
+    use radcache_material::polygon::triangle_projected_solid_angle;
+    use radcache_render::{render_ic, IcSettings};
+    let (le, half, height) = (10.0f32, 0.25f32, 2.0f32);
+    let mut b = GltfBuilder::new();
+    let floor = b.add_material(&MaterialDesc::diffuse("floor", ALBEDO));
+    let lamp = b.add_material(&MaterialDesc {
+        double_sided: true,
+        ..MaterialDesc::emitter("lamp", [0.0; 3], [le; 3])
+    });
+    let meshes = [
+        ("floor", plane_y([-6.0, 6.0], [-6.0, 6.0], 0.0, floor)),
+        ("lamp", plane_y([-half, half], [-half, half], height, lamp)),
+    ];
+    let mut roots = Vec::new();
+    for (name, prim) in meshes {
+        let mesh = b.add_mesh(name, &[prim]);
+        roots.push(b.add_node(&NodeDesc {
+            name: Some(name.into()),
+            mesh: Some(mesh),
+            ..NodeDesc::default()
+        }));
+    }
+    roots.push(camera_node(
+        &mut b,
+        Vec3::new(0.0, 1.0, 2.5),
+        Quat::from_rotation_x(-0.38),
+        0.25,
+    ));
+    b.add_scene("origin_floor", &roots, None);
+    let scene = write_and_load(&b, &temp_dir("origin_floor"), "origin_floor");
+    let lamp_tris = [
+        [
+            Vec3::new(-half, height, -half),
+            Vec3::new(-half, height, half),
+            Vec3::new(half, height, half),
+        ],
+        [
+            Vec3::new(-half, height, -half),
+            Vec3::new(half, height, half),
+            Vec3::new(half, height, -half),
+        ],
+    ];
+    let irradiance = |p: Vec3| -> f64 {
+        lamp_tris
+            .iter()
+            .map(|t| f64::from(le * triangle_projected_solid_angle(p, Vec3::Y, *t)))
+            .sum()
+    };
+    let size = (16u32, 16u32);
+    let ctx = context();
+    let shaders = shaders();
+    let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
+    let pt = render(&ctx, &shaders, &scene, &mut gpu, size, 64, 9);
+    let settings = IcSettings {
+        width: size.0,
+        height: size.1,
+        ..IcSettings::default()
+    };
+    let (ic, _) = render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {}).unwrap();
+    drop(gpu);
+    finish(ctx);
+    let view = scene.camera_at(0.0);
+    for (what, out) in [("path tracer", &pt), ("cache frame", &ic)] {
+        let (mut sum_got, mut sum_expected, mut worst) = (0.0f64, 0.0f64, 0.0f64);
+        for py in 0..size.1 {
+            for px in 0..size.0 {
+                let (e, _) = pixel_integral(&view, size, (px, py), 4, &irradiance);
+                let p = ground_hit(&view, size, f64::from(px) + 0.5, f64::from(py) + 0.5);
+                assert!(p.x.abs() < 3.0 && p.z.abs() < 3.0, "pixel ({px}, {py}) sees {p}");
+                for c in 0..3 {
+                    let expected = f64::from(ALBEDO[c]) / PI * e;
+                    let got = f64::from(out.pixels[(py * size.0 + px) as usize][c]);
+                    worst = worst.max((got / expected - 1.0).abs());
+                    sum_got += got;
+                    sum_expected += expected;
+                }
+            }
+        }
+        let ratio = sum_got / sum_expected;
+        eprintln!("{what}: image over closed form {ratio:.5}, worst pixel {worst:.4}");
+        assert!((ratio - 1.0).abs() < 0.01, "{what}: ratio {ratio}");
+        assert!(worst < 0.05, "{what}: worst pixel off by {worst}");
+    }
+}
