@@ -550,10 +550,14 @@ fn a_floor_at_the_world_origin_sees_an_emitter_above_it() {
             for px in 0..size.0 {
                 let (e, _) = pixel_integral(&view, size, (px, py), 4, &irradiance);
                 let p = ground_hit(&view, size, f64::from(px) + 0.5, f64::from(py) + 0.5);
-                assert!(p.x.abs() < 3.0 && p.z.abs() < 3.0, "pixel ({px}, {py}) sees {p}");
-                for c in 0..3 {
-                    let expected = f64::from(ALBEDO[c]) / PI * e;
-                    let got = f64::from(out.pixels[(py * size.0 + px) as usize][c]);
+                assert!(
+                    p.x.abs() < 3.0 && p.z.abs() < 3.0,
+                    "pixel ({px}, {py}) sees {p}"
+                );
+                let pixel = out.pixels[(py * size.0 + px) as usize];
+                for (&albedo, &value) in ALBEDO.iter().zip(&pixel) {
+                    let expected = f64::from(albedo) / PI * e;
+                    let got = f64::from(value);
                     worst = worst.max((got / expected - 1.0).abs());
                     sum_got += got;
                     sum_expected += expected;
