@@ -161,11 +161,17 @@ int wrap_coord(int i, int n, uint mode) {
     return ((i % n) + n) % n;
 }
 
-// Bilinear texture lookup with the texture's wrap modes.
+// Bilinear texture lookup with the texture's wrap modes; the texel uv falls in where the sampler's
+// magFilter is NEAREST (flag bit 9).
 vec4 texture_sample(int index, vec2 uv) {
     GpuTexture tex = textures[index];
     int w = int(tex.info.y);
     int h = int(tex.info.z);
+    if ((tex.info.w & 0x200u) != 0u) {
+        ivec2 t = ivec2(floor(uv * vec2(w, h)));
+        return texel_fetch(tex, wrap_coord(t.x, w, tex.info.w & 0xFu),
+                           wrap_coord(t.y, h, (tex.info.w >> 4u) & 0xFu));
+    }
     vec2 p = uv * vec2(w, h) - 0.5;
     ivec2 i = ivec2(floor(p));
     vec2 f = p - vec2(i);

@@ -5,7 +5,8 @@
 //!   counts (the estimate is unbiased at every count and its standard error shrinks), and for a
 //!   mirrored (negative-determinant) furnace box.
 //! - Planes under punctual lights and a constant sky: `path_lights.rs`.
-//! - A textured emitter seen directly: emissive factor × texel, nothing else.
+//! - A textured emitter seen directly: emissive factor × texel, nothing else; a NEAREST-filtered
+//!   one shows its texels unblended.
 //! - Seeds: different seeds give independent, equally distributed images; the same seed gives the
 //!   same image bit for bit.
 //!
@@ -169,6 +170,70 @@ fn seeds_give_independent_images_and_reproduce_exactly() {
             s.mean,
             s.se
         );
+    }
+}
+
+#[test]
+fn a_nearest_filtered_texture_shows_its_texels_unblended() {
+    // A 2 × 2 emissive texture with magFilter NEAREST on a black quad, magnified so that the
+    // image's four quadrants fall in its four texels (the texel edges run between pixels 3 and 4):
+    // every pixel is its texel exactly, where a bilinear lookup would blend the four everywhere
+    // (the view spans uv 0.39–0.61, within half a texel of the centre).
+    let texels: [[u8; 4]; 4] = [
+        [255, 0, 0, 255],
+        [0, 255, 0, 255],
+        [0, 0, 255, 255],
+        [255, 255, 255, 255],
+    ];
+    let mut b = GltfBuilder::new();
+    let tex = b
+        .add_texture_rgba8(2, 2, &texels.concat(), 33071)
+        .expect("PNG encoding");
+    b.set_mag_filter(tex, 9728);
+    let mat = b.add_material(&MaterialDesc {
+        emissive: [1.0; 3],
+        emissive_texture: Some(tex),
+        ..MaterialDesc::diffuse("pixels", [0.0; 3])
+    });
+    let mut quad = radcache_scene::writer::PrimitiveDesc::triangles(
+        vec![
+            [-5.0, -5.0, 0.0],
+            [5.0, -5.0, 0.0],
+            [5.0, 5.0, 0.0],
+            [-5.0, 5.0, 0.0],
+        ],
+        Some(vec![[0.0, 0.0, 1.0]; 4]),
+        vec![0, 1, 2, 0, 2, 3],
+        Some(mat),
+    );
+    quad.texcoords = Some(vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]);
+    let mesh = b.add_mesh("pixels", &[quad]);
+    let quad_node = b.add_node(&NodeDesc {
+        mesh: Some(mesh),
+        ..NodeDesc::default()
+    });
+    let cam = camera_node(&mut b, Vec3::new(0.0, 0.0, 3.0), Quat::IDENTITY, 0.7);
+    b.add_scene("pixels", &[quad_node, cam], None);
+    let scene = write_and_load(&b, &temp_dir("nearest"), "nearest");
+    assert!(scene.textures[0].nearest);
+
+    let ctx = context();
+    let shaders = shaders();
+    let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
+    let out = render(&ctx, &shaders, &scene, &mut gpu, (8, 8), 4, 9);
+    drop(gpu);
+    finish(ctx);
+    for (i, p) in out.pixels.iter().enumerate() {
+        let (x, y) = (i % 8, i / 8);
+        let texel = texels[usize::from(y >= 4) * 2 + usize::from(x >= 4)];
+        for c in 0..3 {
+            let expected = f32::from(texel[c]) / 255.0;
+            assert!(
+                (p[c] - expected).abs() <= 1e-5,
+                "pixel ({x}, {y}) channel {c}: {}, expected the texel's {expected}",
+                p[c]
+            );
+        }
     }
 }
 

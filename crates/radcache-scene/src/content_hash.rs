@@ -138,6 +138,7 @@ impl Scene {
             h.usize(t.image);
             h.u32(wrap(t.wrap_s));
             h.u32(wrap(t.wrap_t));
+            h.u32(u32::from(t.nearest));
         }
         h.usize(self.images.len());
         for i in &self.images {

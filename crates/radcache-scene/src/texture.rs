@@ -36,6 +36,9 @@ pub struct Texture {
     pub wrap_s: WrapMode,
     /// Wrap mode along v.
     pub wrap_t: WrapMode,
+    /// The sampler's `magFilter` is NEAREST: lookups take the texel the point falls in (at
+    /// every scale: there are no mipmaps); otherwise bilinear.
+    pub nearest: bool,
 }
 
 /// A material's reference to a texture (always sampled with TEXCOORD_0).
@@ -250,6 +253,7 @@ impl TextureLoader {
             image,
             wrap_s: wrap(sampler.wrap_s()),
             wrap_t: wrap(sampler.wrap_t()),
+            nearest: sampler.mag_filter() == Some(gltf::texture::MagFilter::Nearest),
         });
         self.texture_map
             .insert(tex.index(), self.textures.len() - 1);

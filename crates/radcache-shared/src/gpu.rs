@@ -61,7 +61,7 @@ gpu_struct! {
 gpu_struct! {
     /// A texture in the shared texel buffer (RGBA8 texels).
     pub struct GpuTexture {
-        /// First texel, width, height, flags (bits 0–3 wrap S, 4–7 wrap T, bit 8 sRGB).
+        /// First texel, width, height, flags (bits 0–3 wrap S, 4–7 wrap T, bit 8 sRGB, bit 9 nearest).
         pub info: [u32; 4] => "uvec4",
     }
 }

@@ -150,7 +150,10 @@ pub(crate) fn pack_materials(scene: &Scene) -> (Vec<GpuMaterial>, Vec<GpuTexture
                     image_offsets[t.image],
                     image.width,
                     image.height,
-                    wrap(t.wrap_s) | (wrap(t.wrap_t) << 4) | srgb,
+                    wrap(t.wrap_s)
+                        | (wrap(t.wrap_t) << 4)
+                        | srgb
+                        | if t.nearest { 0x200 } else { 0 },
                 ],
             }
         })

@@ -372,6 +372,13 @@ impl GltfBuilder {
         ))
     }
 
+    /// Sets the magnification filter (`magFilter`, e.g. 9728 NEAREST) of texture `texture`'s
+    /// sampler (one sampler per texture: [`GltfBuilder::add_texture_rgba8`]).
+    pub fn set_mag_filter(&mut self, texture: usize, filter: u32) {
+        let sampler = self.textures[texture]["sampler"].as_u64().unwrap_or(0) as usize;
+        self.samplers[sampler]["magFilter"] = json!(filter);
+    }
+
     /// Adds a scene with `roots` and optional `extras`; the first scene is the default one.
     pub fn add_scene(&mut self, name: &str, roots: &[usize], extras: Option<Value>) -> usize {
         let mut v = json!({"name": name, "nodes": roots});
