@@ -173,6 +173,36 @@ fn seeds_give_independent_images_and_reproduce_exactly() {
     }
 }
 
+/// A black 10 m quad at z = 0 facing a camera 3 m in front of it (yfov 0.7: the view spans uv
+/// 0.39–0.61), emitting `factor` × texture `tex` of `b` (u along +x, v down).
+fn emissive_quad(mut b: GltfBuilder, tex: usize, factor: [f32; 3], tag: &str) -> Scene {
+    let mat = b.add_material(&MaterialDesc {
+        emissive: factor,
+        emissive_texture: Some(tex),
+        ..MaterialDesc::diffuse(tag, [0.0; 3])
+    });
+    let mut quad = radcache_scene::writer::PrimitiveDesc::triangles(
+        vec![
+            [-5.0, -5.0, 0.0],
+            [5.0, -5.0, 0.0],
+            [5.0, 5.0, 0.0],
+            [-5.0, 5.0, 0.0],
+        ],
+        Some(vec![[0.0, 0.0, 1.0]; 4]),
+        vec![0, 1, 2, 0, 2, 3],
+        Some(mat),
+    );
+    quad.texcoords = Some(vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]);
+    let mesh = b.add_mesh(tag, &[quad]);
+    let quad_node = b.add_node(&NodeDesc {
+        mesh: Some(mesh),
+        ..NodeDesc::default()
+    });
+    let cam = camera_node(&mut b, Vec3::new(0.0, 0.0, 3.0), Quat::IDENTITY, 0.7);
+    b.add_scene(tag, &[quad_node, cam], None);
+    write_and_load(&b, &temp_dir(tag), tag)
+}
+
 #[test]
 fn a_nearest_filtered_texture_shows_its_texels_unblended() {
     // A 2 × 2 emissive texture with magFilter NEAREST on a black quad, magnified so that the
@@ -190,31 +220,7 @@ fn a_nearest_filtered_texture_shows_its_texels_unblended() {
         .add_texture_rgba8(2, 2, &texels.concat(), 33071)
         .expect("PNG encoding");
     b.set_mag_filter(tex, 9728);
-    let mat = b.add_material(&MaterialDesc {
-        emissive: [1.0; 3],
-        emissive_texture: Some(tex),
-        ..MaterialDesc::diffuse("pixels", [0.0; 3])
-    });
-    let mut quad = radcache_scene::writer::PrimitiveDesc::triangles(
-        vec![
-            [-5.0, -5.0, 0.0],
-            [5.0, -5.0, 0.0],
-            [5.0, 5.0, 0.0],
-            [-5.0, 5.0, 0.0],
-        ],
-        Some(vec![[0.0, 0.0, 1.0]; 4]),
-        vec![0, 1, 2, 0, 2, 3],
-        Some(mat),
-    );
-    quad.texcoords = Some(vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]);
-    let mesh = b.add_mesh("pixels", &[quad]);
-    let quad_node = b.add_node(&NodeDesc {
-        mesh: Some(mesh),
-        ..NodeDesc::default()
-    });
-    let cam = camera_node(&mut b, Vec3::new(0.0, 0.0, 3.0), Quat::IDENTITY, 0.7);
-    b.add_scene("pixels", &[quad_node, cam], None);
-    let scene = write_and_load(&b, &temp_dir("nearest"), "nearest");
+    let scene = emissive_quad(b, tex, [1.0; 3], "nearest");
     assert!(scene.textures[0].nearest);
 
     let ctx = context();
@@ -248,31 +254,7 @@ fn textured_emitter_seen_directly_is_factor_times_texel() {
     let tex = b
         .add_texture_rgba8(2, 2, &texel.repeat(4), 10497)
         .expect("PNG encoding");
-    let mat = b.add_material(&MaterialDesc {
-        emissive: factor,
-        emissive_texture: Some(tex),
-        ..MaterialDesc::diffuse("glow", [0.0; 3])
-    });
-    let mut quad = radcache_scene::writer::PrimitiveDesc::triangles(
-        vec![
-            [-5.0, -5.0, 0.0],
-            [5.0, -5.0, 0.0],
-            [5.0, 5.0, 0.0],
-            [-5.0, 5.0, 0.0],
-        ],
-        Some(vec![[0.0, 0.0, 1.0]; 4]),
-        vec![0, 1, 2, 0, 2, 3],
-        Some(mat),
-    );
-    quad.texcoords = Some(vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]);
-    let mesh = b.add_mesh("glow", &[quad]);
-    let quad_node = b.add_node(&NodeDesc {
-        mesh: Some(mesh),
-        ..NodeDesc::default()
-    });
-    let cam = camera_node(&mut b, Vec3::new(0.0, 0.0, 3.0), Quat::IDENTITY, 0.7);
-    b.add_scene("glow", &[quad_node, cam], None);
-    let scene = write_and_load(&b, &temp_dir("glow"), "glow");
+    let scene = emissive_quad(b, tex, factor, "glow");
 
     let ctx = context();
     let shaders = shaders();
