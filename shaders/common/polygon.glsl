@@ -11,24 +11,39 @@
 uint clip_to_hemisphere(vec3 p, vec3 n, vec3 t[3], out vec3 q[4]) {
     // Each corner's side is decided once, so an edge and its neighbour agree on it (at most 4
     // vertices come out; recomputing a distance could round differently and overflow q).
+    // Every array index below is a constant once the fixed-count loops are unrolled (a vertex
+    // goes to slot k == count), so the arrays live in registers: no indexed local memory.
+    q[0] = vec3(0.0);
+    q[1] = vec3(0.0);
+    q[2] = vec3(0.0);
+    q[3] = vec3(0.0);
     float d[3];
     for (uint i = 0u; i < 3u; ++i) {
         d[i] = dot(n, t[i] - p);
     }
     uint count = 0u;
     for (uint i = 0u; i < 3u; ++i) {
-        uint j = (i + 1u) % 3u;
+        uint j = i == 2u ? 0u : i + 1u;
         vec3 a = t[i] - p;
         vec3 b = t[j] - p;
         bool a_in = d[i] >= 0.0;
         bool b_in = d[j] >= 0.0;
         if (a_in && count < 4u) {
-            q[count] = a;
+            for (uint k = 0u; k < 4u; ++k) {
+                if (k == count) {
+                    q[k] = a;
+                }
+            }
             count++;
         }
         if (a_in != b_in && count < 4u) {
             float s = d[i] / (d[i] - d[j]);
-            q[count] = a + (b - a) * s;
+            vec3 c = a + (b - a) * s;
+            for (uint k = 0u; k < 4u; ++k) {
+                if (k == count) {
+                    q[k] = c;
+                }
+            }
             count++;
         }
     }
@@ -51,9 +66,12 @@ float triangle_projected_solid_angle(vec3 p, vec3 n, vec3 t[3]) {
     vec3 q[4];
     uint count = clip_to_hemisphere(p, n, t, q);
     float sum = 0.0;
-    for (uint i = 0u; i < count; ++i) {
+    for (uint i = 0u; i < 4u; ++i) {
+        if (i >= count) {
+            break;
+        }
         vec3 a = q[i];
-        vec3 b = q[(i + 1u) % count];
+        vec3 b = i + 1u < count ? q[(i + 1u) & 3u] : q[0];
         float la = length(a);
         float lb = length(b);
         if (la > 0.0 && lb > 0.0) {
