@@ -4,7 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec3};
-use radcache_render::{render_path, Budget, FrameOutput, GpuScene, PathSettings};
+use radcache_render::{
+    render_ic, render_path, Budget, FrameOutput, GpuScene, IcSettings, PathSettings,
+};
 use radcache_scene::writer::{BufferLayout, GltfBuilder, NodeDesc, PrimitiveDesc};
 use radcache_scene::{LoadOptions, Scene};
 use radcache_vk::{Context, ShaderCompiler};
@@ -312,4 +314,25 @@ pub fn render(
 /// One channel of every pixel, as f64.
 pub fn channel(out: &FrameOutput, c: usize) -> Vec<f64> {
     out.pixels.iter().map(|p| f64::from(p[c])).collect()
+}
+
+/// `scene` at `size` with the path tracer (`spp` samples, `seed`; checked by [`render`]) and with
+/// the cache at its default settings, on one GPU upload.
+pub fn path_and_cache(
+    ctx: &Context,
+    shaders: &ShaderCompiler,
+    scene: &Scene,
+    size: (u32, u32),
+    spp: u32,
+    seed: u32,
+) -> (FrameOutput, FrameOutput) {
+    let mut gpu = GpuScene::new(ctx, scene, None).unwrap();
+    let pt = render(ctx, shaders, scene, &mut gpu, size, spp, seed);
+    let settings = IcSettings {
+        width: size.0,
+        height: size.1,
+        ..IcSettings::default()
+    };
+    let (ic, _) = render_ic(ctx, shaders, scene, &mut gpu, &settings, &mut |_| {}).unwrap();
+    (pt, ic)
 }

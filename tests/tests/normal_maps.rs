@@ -28,7 +28,9 @@ use radcache_render::{render_ic, FrameOutput, GpuScene, IcSettings};
 use radcache_scene::light::LightKind;
 use radcache_scene::writer::{GltfBuilder, LightDesc, MaterialDesc, NodeDesc, PrimitiveDesc};
 use radcache_scene::{EnvOverride, LoadOptions, Scene};
-use radcache_tests::scenes::{camera_node, pixel_to_ndc, render, temp_dir, write_and_load};
+use radcache_tests::scenes::{
+    camera_node, path_and_cache, pixel_to_ndc, render, temp_dir, write_and_load,
+};
 use radcache_tests::twin::{
     check_diffs, twin_pipeline, unit, v4, vec, Case, Expect, Row, ShaderMode,
 };
@@ -394,15 +396,7 @@ fn a_normal_map_tilts_the_specular_shading_frame_too() {
         flipped >= 10 && in_mapped_frame >= 10,
         "{flipped} / {in_mapped_frame}"
     );
-    let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
-    let pt = render(&ctx, &shaders, &scene, &mut gpu, size, 8, 11);
-    let settings = IcSettings {
-        width: size.0,
-        height: size.1,
-        ..IcSettings::default()
-    };
-    let (ic, _) = render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {}).unwrap();
-    drop(gpu);
+    let (pt, ic) = path_and_cache(&ctx, &shaders, &scene, size, 8, 11);
     finish(ctx);
     for (what, out) in [("path tracer", &pt), ("cache frame", &ic)] {
         assert_eq!(out.nonfinite_pixels, 0);
@@ -468,15 +462,7 @@ fn damaged_helmet_renders_with_its_generated_tangents() {
     let ctx = context();
     let shaders = shaders();
     let size = (24u32, 24u32);
-    let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
-    let pt = render(&ctx, &shaders, &scene, &mut gpu, size, 16, 5);
-    let settings = IcSettings {
-        width: size.0,
-        height: size.1,
-        ..IcSettings::default()
-    };
-    let (ic, _) = render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {}).unwrap();
-    drop(gpu);
+    let (pt, ic) = path_and_cache(&ctx, &shaders, &scene, size, 16, 5);
     finish(ctx);
     assert_eq!(ic.nonfinite_pixels, 0);
     let mean = |o: &FrameOutput| {

@@ -12,8 +12,8 @@ use radcache_scene::light::LightKind;
 use radcache_scene::writer::{GltfBuilder, LightDesc, MaterialDesc, NodeDesc};
 use radcache_scene::{CameraView, Scene};
 use radcache_tests::scenes::{
-    camera_node, convex_hull, inside_margin, ndc_to_pixel, pixel_coverage, pixel_to_ndc, plane_y,
-    render, temp_dir, write_and_load, Coverage, FLOAT_SLACK,
+    camera_node, convex_hull, inside_margin, ndc_to_pixel, path_and_cache, pixel_coverage,
+    pixel_to_ndc, plane_y, render, temp_dir, write_and_load, Coverage, FLOAT_SLACK,
 };
 use radcache_tests::{context, finish, shaders};
 
@@ -483,7 +483,6 @@ fn plane_under_a_constant_sky_reflects_albedo_times_sky() {
 #[test]
 fn a_floor_at_the_world_origin_sees_an_emitter_above_it() {
     use radcache_material::polygon::triangle_projected_solid_angle;
-    use radcache_render::{render_ic, IcSettings};
     let (le, half, height) = (10.0f32, 0.25f32, 2.0f32);
     let mut b = GltfBuilder::new();
     let floor = b.add_material(&MaterialDesc::diffuse("floor", ALBEDO));
@@ -533,15 +532,7 @@ fn a_floor_at_the_world_origin_sees_an_emitter_above_it() {
     let size = (16u32, 16u32);
     let ctx = context();
     let shaders = shaders();
-    let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
-    let pt = render(&ctx, &shaders, &scene, &mut gpu, size, 64, 9);
-    let settings = IcSettings {
-        width: size.0,
-        height: size.1,
-        ..IcSettings::default()
-    };
-    let (ic, _) = render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {}).unwrap();
-    drop(gpu);
+    let (pt, ic) = path_and_cache(&ctx, &shaders, &scene, size, 64, 9);
     finish(ctx);
     let view = scene.camera_at(0.0);
     for (what, out) in [("path tracer", &pt), ("cache frame", &ic)] {
