@@ -82,6 +82,15 @@ fn texture_ref(h: &mut Fnv1a, t: Option<TextureRef>) {
         Some(t) => {
             h.u32(1);
             h.usize(t.texture);
+            // Only where not the default (TEXCOORD_0, no transform), so that the hash of a
+            // scene without them is what it was before they were read.
+            if t.tex_coord != 0 || !t.transform.is_identity() {
+                h.bytes(b"uv map");
+                h.u32(t.tex_coord);
+                for row in t.transform.matrix() {
+                    h.floats(&row);
+                }
+            }
         }
     }
 }
@@ -95,9 +104,10 @@ fn wrap(w: WrapMode) -> u32 {
 }
 
 impl Scene {
-    /// A stable hash of the scene's content: geometry (vertices, normals, texture coordinates,
-    /// triangles and their materials, the instances and their transforms at t = 0), materials,
-    /// textures and images, punctual lights and their placement, the environment, and the
+    /// A stable hash of the scene's content: geometry (vertices, normals, texture coordinates
+    /// (TEXCOORD_1 where kept), triangles and their materials, the instances and their
+    /// transforms at t = 0), materials (with their texture references' sets and transforms, and
+    /// normal maps), textures and images, punctual lights and their placement, the environment, and the
     /// animation channels of every node but the camera's. Two loads of the same file (or of a
     /// copy under another name or with another camera) give the same value.
     pub fn content_hash(&self) -> u64 {
@@ -112,6 +122,12 @@ impl Scene {
             }
             for t in &m.texcoords {
                 h.floats(&t.to_array());
+            }
+            if !m.texcoords1.is_empty() {
+                h.bytes(b"TEXCOORD_1");
+                for t in &m.texcoords1 {
+                    h.floats(&t.to_array());
+                }
             }
             h.usize(m.indices.len());
             m.indices.iter().for_each(|&i| h.u32(i));
@@ -129,6 +145,11 @@ impl Scene {
             vec3(&mut h, m.specular_color);
             vec3(&mut h, m.emissive);
             texture_ref(&mut h, m.emissive_texture);
+            if m.normal_texture.is_some() {
+                h.bytes(b"normal map");
+                texture_ref(&mut h, m.normal_texture);
+                h.f32(m.normal_scale);
+            }
             h.u32(u32::from(m.double_sided));
             h.u32(m.alpha_mode as u32);
             h.f32(m.alpha_cutoff);

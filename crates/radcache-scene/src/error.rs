@@ -162,8 +162,10 @@ pub enum WarningKind {
     DegenerateTriangles,
     /// A primitive had no (or unusable) normals; flat normals were generated.
     GeneratedNormals,
-    /// A texture uses a texCoord set other than 0 or an unsupported image format, or sits in a
-    /// slot radcache does not sample (KHR_materials_specular's textures: the factors are used).
+    /// A texture uses a texCoord set above 1, an unsupported image format or an unreadable or
+    /// non-finite `KHR_texture_transform`, or sits in a slot radcache does not sample
+    /// (KHR_materials_specular's textures: the factors are used), or a primitive lacks the
+    /// texture coordinates or normals its material's textures need.
     TextureIgnored,
     /// Skins or morph targets are ignored (rest pose is used).
     SkinOrMorphIgnored,

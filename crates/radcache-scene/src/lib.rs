@@ -11,7 +11,8 @@
 //! intensities in the KHR_lights_punctual units (cd, lx) used as radiometric values.
 //!
 //! **For a GPU uploader.** Geometry: `scene.meshes[m]` holds `positions`, `normals`,
-//! `texcoords` (one entry per vertex; `tangents` too where a material has a normal map),
+//! `texcoords` (one entry per vertex; `tangents` too where a material has a normal map, and
+//! `texcoords1` where one samples TEXCOORD_1),
 //! `indices` (3 per triangle, CCW front faces) and
 //! `triangle_materials` (one per triangle), plus per-primitive [`PrimitiveRange`]s. Placement:
 //! `scene.instances[i].mesh` with `scene.instance_transforms(t)[i]` (`world_from_object`; a negative
@@ -32,11 +33,12 @@
 //! elements are dropped with a [`Warning`] that carries a count: degenerate triangles,
 //! non-TRIANGLES primitives, primitives without POSITION. Features outside the renderer's model are
 //! loaded with a documented fallback and a warning: skins and morph targets (rest pose), texCoord
-//! sets other than 0 (texture ignored), missing normals (flat), a negative `emissiveStrength` (not
+//! sets above 1 (texture ignored), missing normals (flat), a negative `emissiveStrength` (not
 //! emissive), KHR_materials_specular textures (factors used), material extensions other than
 //! emissive strength, ior and specular (core model; named once each, with a count, in the
-//! warnings and the summary), a normal map on a primitive without normals or TEXCOORD_0
-//! (ignored).
+//! warnings and the summary), a normal map on a primitive without normals or without the
+//! texture coordinates it samples (ignored), TEXCOORD_1 sampled where a primitive lacks it
+//! (zero).
 //!
 //! The [`writer`] module builds valid glTF files (used by tests and by [`assets`], which generates
 //! the bundled Cornell box, furnace and animated scenes).
@@ -79,4 +81,4 @@ pub use mesh::{Mesh, PrimitiveRange};
 pub use node::{LocalTransform, Node};
 pub use plan::{AnimationKind, AnimationPlan, EnvironmentKind, LightCounts, ScenePlan};
 pub use scene::{Instance, Scene};
-pub use texture::{Image, Texture, TextureRef, WrapMode};
+pub use texture::{Image, Texture, TextureRef, TextureTransform, WrapMode};

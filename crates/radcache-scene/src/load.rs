@@ -14,7 +14,7 @@ use crate::environment::{scene_radiance, EnvOverride, Environment};
 use crate::error::{label, Error, Result, Warning, WarningKind, Warnings};
 use crate::light::{load_lights, LightInstance};
 use crate::material::{load_materials, Material};
-use crate::mesh::load_mesh;
+use crate::mesh::{load_mesh, VertexNeeds};
 use crate::node::{load_nodes, traversal_order, Node};
 use crate::resources::Source;
 use crate::scene::{Instance, Scene};
@@ -57,20 +57,17 @@ impl Scene {
                 default_index
             }
         };
-        let normal_mapped = |i: u32| {
+        let needs = |i: u32| {
             materials
                 .get(i as usize)
-                .is_some_and(|m| m.normal_texture.is_some())
+                .map_or(VertexNeeds::default(), |m| VertexNeeds {
+                    normal_map: m.normal_texture,
+                    texcoord1: m.uses_texcoord1(),
+                })
         };
         let mut meshes = Vec::new();
         for m in src.doc.meshes() {
-            meshes.push(load_mesh(
-                &src,
-                &m,
-                &mut material_of,
-                &normal_mapped,
-                &mut w,
-            )?);
+            meshes.push(load_mesh(&src, &m, &mut material_of, &needs, &mut w)?);
         }
         if default_used {
             materials.push(Material::default_material());

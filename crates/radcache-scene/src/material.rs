@@ -16,9 +16,14 @@
 //! `KHR_materials_specular` gives `specular_factor` and `specular_color`; its two textures are not
 //! sampled (warning; the factors are used). A material without `KHR_materials_specular` has the
 //! specification's specular layer (F0 0.04): only `specularFactor` 0 with metallic 0 is exactly
-//! Lambertian. Other material extensions (transmission, volume, clearcoat, sheen, ...) and
-//! KHR_texture_transform are not implemented: such materials render with the core model, and
-//! the file's [`MaterialNotes`] name each extension once (warning and `radcache info`).
+//! Lambertian. Other material extensions (transmission, volume, clearcoat, sheen, ...) are not
+//! implemented: such materials render with the core model, and the file's [`MaterialNotes`] name
+//! each extension once (warning and `radcache info`).
+//!
+//! **Texture references** ([`TextureRef`]) sample TEXCOORD_0 or TEXCOORD_1 (`texCoord`; a set
+//! above 1 drops the texture with a warning) through their `KHR_texture_transform`, whose
+//! `texCoord` overrides the reference's (docs/materials.md §13), on every slot radcache samples:
+//! base colour, metallic-roughness, normal and emissive.
 //! Occlusion textures are not used: a global-illumination renderer computes occlusion itself.
 //!
 //! Alpha modes (docs/materials.md §11): MASK keeps a point whose alpha (base colour factor alpha ×
@@ -93,12 +98,14 @@ pub enum AlphaMode {
 /// that `1/ior` stays a normal f32.
 pub const IOR_INFINITE: f32 = 1e9;
 
-/// Material extensions the loader reads. Any other extension on a material or on one of its
-/// texture references (e.g. KHR_texture_transform) is reported in [`MaterialNotes`].
+/// Material extensions the loader reads (`KHR_texture_transform` on texture references). Any
+/// other extension on a material or on one of its texture references is reported in
+/// [`MaterialNotes`].
 pub const IMPLEMENTED_MATERIAL_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_specular",
+    "KHR_texture_transform",
 ];
 
 /// What the file's materials ask for that radcache does not render (summary and `radcache info`).
@@ -166,6 +173,29 @@ impl Material {
     pub fn is_emissive(&self) -> bool {
         self.emissive.max_element() > 0.0
     }
+
+    /// The texture references radcache samples: base colour, metallic-roughness, emissive and
+    /// normal, those that are set.
+    pub fn texture_refs(&self) -> impl Iterator<Item = TextureRef> {
+        [
+            self.base_color_texture,
+            self.metallic_roughness_texture,
+            self.emissive_texture,
+            self.normal_texture,
+        ]
+        .into_iter()
+        .flatten()
+    }
+
+    /// True when some texture reference samples TEXCOORD_1: the material's primitives keep it.
+    pub fn uses_texcoord1(&self) -> bool {
+        self.texture_refs().any(|t| t.tex_coord == 1)
+    }
+
+    /// True when some texture reference has a `KHR_texture_transform` other than the identity.
+    pub fn has_uv_transform(&self) -> bool {
+        self.texture_refs().any(|t| !t.transform.is_identity())
+    }
 }
 
 /// Radiance emitted by a surface point with unit front normal `normal` towards direction `dir`
@@ -195,7 +225,8 @@ pub(crate) fn load_materials(
     for m in src.doc.materials() {
         let index = m.index().unwrap_or(out.len());
         let user = label("material", index, m.name());
-        for name in src.material_extensions.get(index).into_iter().flatten() {
+        let raw = src.raw_materials.get(index);
+        for name in raw.into_iter().flat_map(|r| &r.extensions) {
             if !IMPLEMENTED_MATERIAL_EXTENSIONS.contains(&name.as_str()) {
                 unsupported.entry(name).or_default().push(user.clone());
             }
@@ -298,7 +329,13 @@ pub(crate) fn load_materials(
             specular_color,
             emissive,
             emissive_texture: textures.get(src, m.emissive_texture(), true, &user, warnings)?,
-            normal_texture: textures.get_normal(src, m.normal_texture(), &user, warnings)?,
+            normal_texture: textures.get_normal(
+                src,
+                m.normal_texture(),
+                raw.and_then(|r| r.normal_texture_transform.as_ref()),
+                &user,
+                warnings,
+            )?,
             normal_scale: m.normal_texture().map_or(1.0, |t| t.scale()),
             double_sided: m.double_sided(),
             alpha_mode: match m.alpha_mode() {
@@ -311,13 +348,8 @@ pub(crate) fn load_materials(
     }
     for (name, users) in &unsupported {
         let n = users.len();
-        let effect = if *name == "KHR_texture_transform" {
-            "their textures are sampled without the transform"
-        } else {
-            "they render with the core metallic-roughness model"
-        };
         let msg = format!(
-            "{file}: extension {name} is not implemented ({n} material{}: {}); {effect}",
+            "{file}: extension {name} is not implemented ({n} material{}: {}); they render with the core metallic-roughness model",
             if n == 1 { "" } else { "s" },
             users.join(", ")
         );

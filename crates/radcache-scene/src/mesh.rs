@@ -1,7 +1,8 @@
 //! Triangle meshes: one [`Mesh`] per glTF mesh, its primitives merged.
 //!
 //! Layout chosen for the GPU side (one BLAS per mesh): all TRIANGLES primitives of a glTF mesh are
-//! concatenated into one vertex array (positions, normals, texcoord0) and one `u32` index array,
+//! concatenated into one vertex array (positions, normals, TEXCOORD_0, and TEXCOORD_1 where a
+//! material samples it) and one `u32` index array,
 //! with a per-triangle material id (`triangle_materials`) and per-primitive [`PrimitiveRange`]s
 //! (contiguous triangle and vertex ranges with a single material).
 //!
@@ -11,8 +12,11 @@
 //! - a primitive without normals, or with a zero-length normal, gets flat normals: its vertices are
 //!   de-indexed so that each triangle has its own three vertices carrying the face normal.
 //! - a primitive whose material has a normal map gets tangents: its `TANGENT` attribute, else
-//!   MikkTSpace tangents (its vertices split where they need two); without normals or TEXCOORD_0
-//!   its normal map is ignored (zero tangents).
+//!   MikkTSpace tangents of the coordinates the map samples (its set, through its transform; its
+//!   vertices split where they need two); without normals or that set its normal map is ignored
+//!   (zero tangents);
+//! - a primitive whose material samples TEXCOORD_1 keeps it (zero coordinates, with a warning,
+//!   where the attribute is missing); other primitives' TEXCOORD_1 is not read.
 //!
 //! NaN/Inf in positions, normals, texcoords or tangents and indices out of range are errors.
 
@@ -23,6 +27,7 @@ use crate::error::{label, Error, Result, WarningKind, Warnings};
 use crate::math::{triangle_cross, Aabb};
 use crate::resources::Source;
 use crate::tangent::{generate_tangents, sanitize_tangent};
+use crate::texture::TextureRef;
 
 /// A triangle mesh in its local (object) space.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -35,6 +40,10 @@ pub struct Mesh {
     pub normals: Vec<Vec3>,
     /// TEXCOORD_0, same length as `positions` (zero where the primitive had none).
     pub texcoords: Vec<Vec2>,
+    /// TEXCOORD_1: same length as `positions` when some primitive's material samples a texture
+    /// through it ([`Material::uses_texcoord1`](crate::Material::uses_texcoord1)), else empty.
+    /// Zero on the vertices of the other primitives and where the attribute is missing.
+    pub texcoords1: Vec<Vec2>,
     /// Tangents (xyz, and w = ±1: bitangent = w · normal × tangent; see [`crate::tangent`]): same
     /// length as `positions` when some primitive's material has a normal map, else empty. Zero
     /// on the vertices of primitives that use no normal map.
@@ -95,11 +104,22 @@ pub fn is_degenerate(idx: [u32; 3], p: &[Vec3; 3]) -> bool {
     c.is_nan() || c <= threshold || c == 0.0
 }
 
+/// What a primitive's material needs from its vertices.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct VertexNeeds {
+    /// The material's normal map, whose coordinates generated tangents follow.
+    pub(crate) normal_map: Option<TextureRef>,
+    /// Some texture reference of the material samples TEXCOORD_1.
+    pub(crate) texcoord1: bool,
+}
+
 /// One primitive's data after reading and validation.
 struct PrimData {
     positions: Vec<Vec3>,
     normals: Option<Vec<Vec3>>,
     texcoords: Option<Vec<Vec2>>,
+    /// TEXCOORD_1, read only when the material samples it.
+    texcoords1: Option<Vec<Vec2>>,
     tangents: Option<Vec<Vec4>>,
     indices: Vec<u32>,
 }
@@ -121,12 +141,12 @@ fn check_finite<T: Copy>(
 }
 
 /// Loads glTF mesh `m`. `material_of` maps a primitive's material (None = default) to an index;
-/// `normal_mapped` says whether glTF material `i` has a normal map.
+/// `needs` says what glTF material `i` needs from its vertices.
 pub(crate) fn load_mesh(
     src: &Source,
     m: &gltf::Mesh<'_>,
     material_of: &mut dyn FnMut(Option<usize>) -> u32,
-    normal_mapped: &dyn Fn(u32) -> bool,
+    needs: &dyn Fn(u32) -> VertexNeeds,
     warnings: &mut Warnings,
 ) -> Result<Mesh> {
     let mesh_label = label("mesh", m.index(), m.name());
@@ -159,27 +179,27 @@ pub(crate) fn load_mesh(
                 ),
             );
         }
-        // The default material (no glTF material) has no normal map.
-        let want_tangents = prim
+        // The default material (no glTF material) has no textures.
+        let prim_needs = prim
             .material()
             .index()
-            .is_some_and(|i| normal_mapped(i as u32));
-        let Some(data) = read_primitive(src, &prim, want_tangents, &user, warnings)? else {
+            .map_or(VertexNeeds::default(), |i| needs(i as u32));
+        let Some(data) = read_primitive(src, &prim, prim_needs, &user, warnings)? else {
             continue;
         };
         let material = material_of(prim.material().index());
-        append_primitive(
-            src,
-            &mut mesh,
-            data,
-            prim.index(),
+        let at = PrimAt {
+            gltf_primitive: prim.index(),
             material,
-            &user,
-            warnings,
-        )?;
+            needs: prim_needs,
+        };
+        append_primitive(src, &mut mesh, data, at, &user, warnings)?;
     }
     if !mesh.tangents.is_empty() {
         mesh.tangents.resize(mesh.positions.len(), Vec4::ZERO);
+    }
+    if !mesh.texcoords1.is_empty() {
+        mesh.texcoords1.resize(mesh.positions.len(), Vec2::ZERO);
     }
     for &p in &mesh.positions {
         mesh.bounds.extend(p);
@@ -187,16 +207,17 @@ pub(crate) fn load_mesh(
     Ok(mesh)
 }
 
-/// Reads a primitive's attributes; `TANGENT` only when `want_tangents` (a normal-mapped
-/// material), else `tangents` is `None`. With `want_tangents` and no `TANGENT`, `tangents` is an
-/// empty list: generate them.
+/// Reads a primitive's attributes; `TANGENT` only when the material has a normal map, else
+/// `tangents` is `None` (with a normal map and no `TANGENT`, `tangents` is an empty list:
+/// generate them); TEXCOORD_1 only when the material samples it.
 fn read_primitive(
     src: &Source,
     prim: &gltf::Primitive<'_>,
-    want_tangents: bool,
+    needs: VertexNeeds,
     user: &str,
     warnings: &mut Warnings,
 ) -> Result<Option<PrimData>> {
+    let want_tangents = needs.normal_map.is_some();
     let Some(pos_acc) = prim.get(&gltf::Semantic::Positions) else {
         warnings.push(
             WarningKind::Other,
@@ -236,20 +257,35 @@ fn read_primitive(
         }
         None => None,
     };
-    let texcoords = match prim.get(&gltf::Semantic::TexCoords(0)) {
-        Some(acc) => {
-            let u = format!("{user} TEXCOORD_0");
-            let v = accessor::read_vec2(src, &acc, &u)?;
-            check_finite(src, accessor::element_label(&acc, &u), &v, |v| {
-                v.is_finite()
-            })?;
-            if v.len() != n {
-                return Err(count_err(&acc, "TEXCOORD_0", v.len()));
-            }
-            Some(v)
+    let read_texcoords = |set: u32| -> Result<Option<Vec<Vec2>>> {
+        let Some(acc) = prim.get(&gltf::Semantic::TexCoords(set)) else {
+            return Ok(None);
+        };
+        let what = format!("TEXCOORD_{set}");
+        let u = format!("{user} {what}");
+        let v = accessor::read_vec2(src, &acc, &u)?;
+        check_finite(src, accessor::element_label(&acc, &u), &v, |v| {
+            v.is_finite()
+        })?;
+        if v.len() != n {
+            return Err(count_err(&acc, &what, v.len()));
         }
-        None => None,
+        Ok(Some(v))
     };
+    let texcoords = read_texcoords(0)?;
+    let texcoords1 = if needs.texcoord1 {
+        read_texcoords(1)?
+    } else {
+        None
+    };
+    if needs.texcoord1 && texcoords1.is_none() {
+        let msg = format!(
+            "{}: {user}: no TEXCOORD_1 although its material samples a texture through it; \
+             those lookups use (0, 0)",
+            src.path.display()
+        );
+        warnings.push(WarningKind::TextureIgnored, 1, msg);
+    }
     let tangents = match prim
         .get(&gltf::Semantic::Tangents)
         .filter(|_| want_tangents)
@@ -307,24 +343,38 @@ fn read_primitive(
         positions,
         normals,
         texcoords,
+        texcoords1,
         tangents,
         indices,
     }))
+}
+
+/// Where a primitive goes and what its material needs.
+#[derive(Clone, Copy, Debug)]
+struct PrimAt {
+    gltf_primitive: usize,
+    material: u32,
+    needs: VertexNeeds,
 }
 
 fn append_primitive(
     src: &Source,
     mesh: &mut Mesh,
     data: PrimData,
-    gltf_primitive: usize,
-    material: u32,
+    at: PrimAt,
     user: &str,
     warnings: &mut Warnings,
 ) -> Result<()> {
+    let PrimAt {
+        gltf_primitive,
+        material,
+        needs,
+    } = at;
     let PrimData {
         positions,
         normals,
         texcoords,
+        texcoords1,
         tangents,
         indices,
     } = data;
@@ -356,6 +406,13 @@ fn append_primitive(
         reason: "mesh exceeds 2^32 vertices".into(),
     };
     let tc = |i: u32| texcoords.as_ref().map_or(Vec2::ZERO, |t| t[i as usize]);
+    let tc1 = |i: u32| texcoords1.as_ref().map_or(Vec2::ZERO, |t| t[i as usize]);
+    // The normal map's set is there (without a normal map nothing asks).
+    let map_set_present = match needs.normal_map {
+        Some(r) if r.tex_coord == 1 => texcoords1.is_some(),
+        _ => texcoords.is_some(),
+    };
+    let map_set = needs.normal_map.map_or(0, |r| r.tex_coord);
     let ignored = |why: &str| {
         format!(
             "{}: {user}: {why}; its material's normal map is ignored",
@@ -363,15 +420,18 @@ fn append_primitive(
         )
     };
     let mut prim_tangents = None;
+    let prim_uv1: Option<Vec<Vec2>>;
     match usable_normals {
         Some(ns) => {
             let mut ns: Vec<Vec3> = ns.iter().map(|n| n.normalize()).collect();
-            let mut uvs: Vec<Vec2> = (0..positions.len() as u32).map(tc).collect();
+            let count = positions.len() as u32;
+            let mut uvs: Vec<Vec2> = (0..count).map(tc).collect();
+            let mut uvs1: Vec<Vec2> = (0..count).map(tc1).collect();
             let mut positions = positions;
-            match (tangents, texcoords.is_some()) {
+            match (tangents, map_set_present) {
                 (None, _) => {}
                 (Some(_), false) => {
-                    let msg = ignored("no TEXCOORD_0");
+                    let msg = ignored(&format!("no TEXCOORD_{map_set}"));
                     warnings.push(WarningKind::TextureIgnored, 1, msg);
                 }
                 (Some(file), true) if !file.is_empty() => {
@@ -379,10 +439,23 @@ fn append_primitive(
                     prim_tangents = Some(t.collect());
                 }
                 (Some(_), true) => {
-                    let g = generate_tangents(&positions, &ns, &uvs, &kept);
+                    // The tangent frame of the coordinates the map is sampled at.
+                    let mapped: Vec<Vec2> = match needs.normal_map {
+                        Some(map) => uvs
+                            .iter()
+                            .zip(&uvs1)
+                            .map(|(&a, &b)| map.map(a, b))
+                            .collect(),
+                        None => uvs.clone(),
+                    };
+                    let g = generate_tangents(&positions, &ns, &mapped, &kept);
+                    let remap = |v: &[Vec2]| -> Vec<Vec2> {
+                        g.source.iter().map(|&i| v[i as usize]).collect()
+                    };
+                    uvs = remap(&uvs);
+                    uvs1 = remap(&uvs1);
                     positions = g.source.iter().map(|&v| positions[v as usize]).collect();
                     ns = g.source.iter().map(|&v| ns[v as usize]).collect();
-                    uvs = g.source.iter().map(|&v| uvs[v as usize]).collect();
                     kept = g.triangles;
                     prim_tangents = Some(g.tangents);
                 }
@@ -391,6 +464,7 @@ fn append_primitive(
             u32::try_from(first_vertex + positions.len()).map_err(|_| too_big())?;
             mesh.normals.extend(ns);
             mesh.texcoords.extend(uvs);
+            prim_uv1 = needs.texcoord1.then_some(uvs1);
             mesh.positions.extend_from_slice(&positions);
             for t in &kept {
                 mesh.indices.extend(t.iter().map(|&i| base + i));
@@ -410,6 +484,7 @@ fn append_primitive(
                 ),
             );
             u32::try_from(first_vertex + 3 * kept.len()).map_err(|_| too_big())?;
+            let mut uvs1 = Vec::new();
             for t in &kept {
                 let p = t.map(|i| positions[i as usize]);
                 let n = triangle_cross(&p).normalize_or(Vec3::Z);
@@ -418,9 +493,15 @@ fn append_primitive(
                     mesh.positions.push(p[k]);
                     mesh.normals.push(n);
                     mesh.texcoords.push(tc(i));
+                    uvs1.push(tc1(i));
                 }
             }
+            prim_uv1 = needs.texcoord1.then_some(uvs1);
         }
+    }
+    if let Some(t) = prim_uv1 {
+        mesh.texcoords1.resize(first_vertex, Vec2::ZERO);
+        mesh.texcoords1.extend(t);
     }
     if let Some(t) = prim_tangents {
         mesh.tangents.resize(first_vertex, Vec4::ZERO);

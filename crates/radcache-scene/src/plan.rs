@@ -3,7 +3,7 @@
 //! Later passes consult it instead of re-inspecting the scene: whether to build the emitter
 //! sampling table, whether the full metallic-roughness BRDF is needed or every material is
 //! Lambertian, which punctual light kinds exist, which environment is used, whether textures
-//! must be bound, and how the scene animates (nothing, camera only, lights only, or geometry —
+//! must be bound and which texture coordinates they need, and how the scene animates (nothing, camera only, lights only, or geometry —
 //! the latter needing TLAS refits) over which time range.
 
 use std::fmt;
@@ -100,6 +100,15 @@ pub struct ScenePlan {
     /// §12): the passes compile the normal-map code (`HAS_NORMAL_MAPS`) and upload a tangent per
     /// vertex. False otherwise: no tangent memory, no normal-map code.
     pub normal_maps: bool,
+    /// Some texture reference has a `KHR_texture_transform` other than the identity
+    /// ([`Material::has_uv_transform`](crate::Material::has_uv_transform); docs/materials.md
+    /// §13): the passes compile the transforms in (`HAS_UV_TRANSFORM`). False: every lookup
+    /// takes its coordinates as they are.
+    pub uv_transform: bool,
+    /// Some primitive's material samples a texture through TEXCOORD_1 (its mesh keeps
+    /// `Mesh::texcoords1`): the passes compile the second set in (`HAS_TEXCOORD1`) and upload it
+    /// per vertex. False: no second set in memory or in the shaders.
+    pub texcoord1: bool,
     /// Punctual light instances by kind.
     pub lights: LightCounts,
     /// Environment kind.
@@ -151,6 +160,8 @@ impl ScenePlan {
             specular,
             alpha,
             normal_maps: scene.meshes.iter().any(|m| !m.tangents.is_empty()),
+            uv_transform: scene.materials.iter().any(|m| m.has_uv_transform()),
+            texcoord1: scene.meshes.iter().any(|m| !m.texcoords1.is_empty()),
             emissive_triangles: count,
             emissive_power: emitters.total_power,
             lights,
@@ -267,6 +278,20 @@ impl fmt::Display for ScenePlan {
             f,
             "  textures: {}",
             if self.textures > 0 { "yes" } else { "no" }
+        )?;
+        writeln!(
+            f,
+            "  texture coordinates: {}, {}",
+            if self.texcoord1 {
+                "TEXCOORD_0 and TEXCOORD_1 (a second set per vertex)"
+            } else {
+                "TEXCOORD_0"
+            },
+            if self.uv_transform {
+                "KHR_texture_transform applied"
+            } else {
+                "no transforms"
+            }
         )?;
         writeln!(
             f,

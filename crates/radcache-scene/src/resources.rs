@@ -33,10 +33,20 @@ pub(crate) struct Source {
     pub(crate) doc: gltf::Document,
     /// Buffer contents, index-aligned with `doc.buffers()`; each is at least `byteLength` long.
     pub(crate) buffers: Vec<gltf::buffer::Data>,
-    /// Per material (index-aligned with `doc.materials()`): the names of the extensions it uses,
-    /// on the material itself or on its texture references, read from the raw JSON (the gltf
-    /// crate drops extensions it does not know).
-    pub(crate) material_extensions: Vec<Vec<String>>,
+    /// Per material (index-aligned with `doc.materials()`): what the raw JSON says that the gltf
+    /// crate does not give (see [`RawMaterial`]).
+    pub(crate) raw_materials: Vec<RawMaterial>,
+}
+
+/// What a material's raw JSON holds beyond the gltf crate's view of it.
+#[derive(Debug, Default)]
+pub(crate) struct RawMaterial {
+    /// The names of the extensions the material uses, on itself or on its texture references
+    /// (the gltf crate drops extensions it does not know).
+    pub(crate) extensions: Vec<String>,
+    /// The `KHR_texture_transform` object of its `normalTexture` (the gltf crate reads that
+    /// extension on `textureInfo` only).
+    pub(crate) normal_texture_transform: Option<serde_json::Value>,
 }
 
 impl Source {
@@ -76,7 +86,7 @@ impl Source {
         let mut source = Source {
             path: path.to_path_buf(),
             base,
-            material_extensions: material_extensions(&bytes, doc.materials().len()),
+            raw_materials: raw_materials(&bytes, doc.materials().len()),
             doc,
             buffers: Vec::new(),
         };
@@ -289,6 +299,7 @@ const SUPPORTED_REQUIRED: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_specular",
+    "KHR_texture_transform",
 ];
 
 /// Why a required extension cannot be honoured, for the error message.
@@ -303,7 +314,6 @@ fn unsupported_reason(name: &str) -> &'static str {
         "EXT_texture_webp" => "WebP textures cannot be decoded",
         "EXT_texture_avif" => "AVIF textures cannot be decoded",
         "MSFT_texture_dds" => "DDS textures cannot be decoded",
-        "KHR_texture_transform" => "texture coordinate transforms are not implemented",
         _ => "the file declares that it cannot be displayed without it",
     }
 }
@@ -317,9 +327,9 @@ const TEXTURE_SLOTS: &[&[&str]] = &[
     &["emissiveTexture"],
 ];
 
-/// The extension names each of the first `count` materials uses (see
-/// [`Source::material_extensions`]), from the JSON text or the GLB JSON chunk in `bytes`.
-fn material_extensions(bytes: &[u8], count: usize) -> Vec<Vec<String>> {
+/// The [`RawMaterial`] of each of the first `count` materials, from the JSON text or the GLB
+/// JSON chunk in `bytes`.
+fn raw_materials(bytes: &[u8], count: usize) -> Vec<RawMaterial> {
     let json = if bytes.starts_with(b"glTF") {
         gltf::Glb::from_slice(bytes).ok().map(|glb| glb.json)
     } else {
@@ -344,7 +354,15 @@ fn material_extensions(bytes: &[u8], count: usize) -> Vec<Vec<String>> {
             }
             names.sort();
             names.dedup();
-            names
+            let normal_texture_transform = m
+                .and_then(|m| m.get("normalTexture"))
+                .and_then(|t| t.get("extensions"))
+                .and_then(|e| e.get("KHR_texture_transform"))
+                .cloned();
+            RawMaterial {
+                extensions: names,
+                normal_texture_transform,
+            }
         })
         .collect()
 }

@@ -84,8 +84,9 @@ impl Geometry for Input<'_> {
     }
 }
 
-/// MikkTSpace tangents of the triangles `triangles` over the vertex arrays (unit normals,
-/// TEXCOORD_0 as glTF stores it), in glTF's convention (see the module docs), sanitized.
+/// MikkTSpace tangents of the triangles `triangles` over the vertex arrays (unit normals, and
+/// the texture coordinates the normal map samples: its set through its transform), in glTF's
+/// convention (see the module docs), sanitized.
 pub fn generate_tangents(
     positions: &[Vec3],
     normals: &[Vec3],

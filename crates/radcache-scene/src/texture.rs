@@ -2,12 +2,13 @@
 //!
 //! Images are kept as RGBA8 with an `srgb` flag (true for base-colour and emissive textures, whose
 //! texels are sRGB-encoded per the glTF spec): the GPU side can upload them as `R8G8B8A8_SRGB` and
-//! let the sampler decode, while [`Image::texel_linear`] is the CPU twin. Samplers keep only the
-//! wrap modes (filtering is left to the renderer).
+//! let the sampler decode, while [`Image::texel_linear`] is the CPU twin. Samplers keep the wrap
+//! modes and whether `magFilter` is NEAREST. A material's [`TextureRef`] names the texture, the
+//! texture coordinate set it samples and its `KHR_texture_transform` ([`TextureTransform`]).
 
 use std::collections::HashMap;
 
-use glam::Vec4;
+use glam::{Vec2, Vec4};
 
 use crate::error::{label, Result, WarningKind, Warnings};
 use crate::math::srgb_to_linear;
@@ -41,11 +42,98 @@ pub struct Texture {
     pub nearest: bool,
 }
 
-/// A material's reference to a texture (always sampled with TEXCOORD_0).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// A material's reference to a texture: which texture, which set of texture coordinates and
+/// which `KHR_texture_transform` (docs/materials.md §13). The set and the transform belong to
+/// the reference, not to the [`Texture`]: two materials may sample one texture differently.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TextureRef {
     /// Index into `Scene::textures`.
     pub texture: usize,
+    /// The texture coordinate set: 0 (TEXCOORD_0) or 1 (TEXCOORD_1); the transform's `texCoord`
+    /// already applied.
+    pub tex_coord: u32,
+    /// The reference's `KHR_texture_transform` (identity without the extension).
+    pub transform: TextureTransform,
+}
+
+impl TextureRef {
+    /// A reference to `texture` through TEXCOORD_0 without a transform.
+    pub fn new(texture: usize) -> TextureRef {
+        TextureRef {
+            texture,
+            tex_coord: 0,
+            transform: TextureTransform::IDENTITY,
+        }
+    }
+
+    /// The texture coordinates this reference samples at a point whose TEXCOORD_0 is `uv0` and
+    /// TEXCOORD_1 is `uv1`: its set, then its transform.
+    pub fn map(&self, uv0: Vec2, uv1: Vec2) -> Vec2 {
+        let uv = if self.tex_coord == 1 { uv1 } else { uv0 };
+        self.transform.apply(uv)
+    }
+}
+
+/// `KHR_texture_transform` of a texture reference: `uv' = T · R · S · (u, v, 1)` with `S` the
+/// scale, `T` the offset and `R` the rotation by `rotation` radians (docs/materials.md §13).
+///
+/// **The rotation's sign.** The specification says the rotation turns the UVs "counter-clockwise
+/// around the origin", equivalent to turning the image clockwise, in glTF's texture space (u
+/// right, v down: the origin is the image's top-left corner). As seen in that space, that is
+/// `R = [[cos, sin], [−sin, cos]]` (rows): `u' = cos·u + sin·v`, `v' = −sin·u + cos·v`. This is
+/// what the specification's own example needs ("offset [0, 1], rotation π/2, scale [0.5, 0.5]
+/// uses only the lower left quadrant of the image, rotated clockwise 90°") and what the Khronos
+/// sample viewer and the TextureTransformTest sample model use. The GLSL listing in the
+/// specification, `mat3(cos, sin, 0, −sin, cos, 0, 0, 0, 1)` (column-major), reads as the
+/// transposed matrix, the counter-clockwise turn of a v-up frame; it contradicts the example and
+/// the implementations (KhronosGroup/glTF issue 1563), and is not followed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureTransform {
+    /// `offset` (default `[0, 0]`).
+    pub offset: Vec2,
+    /// `rotation` in radians (default 0).
+    pub rotation: f32,
+    /// `scale` (default `[1, 1]`).
+    pub scale: Vec2,
+}
+
+impl Default for TextureTransform {
+    fn default() -> Self {
+        TextureTransform::IDENTITY
+    }
+}
+
+impl TextureTransform {
+    /// No transform: offset 0, rotation 0, scale 1.
+    pub const IDENTITY: TextureTransform = TextureTransform {
+        offset: Vec2::ZERO,
+        rotation: 0.0,
+        scale: Vec2::ONE,
+    };
+
+    /// True when the transform leaves every texture coordinate as it is.
+    pub fn is_identity(&self) -> bool {
+        self.matrix() == TextureTransform::IDENTITY.matrix()
+    }
+
+    /// The two rows of the 2×3 matrix `T · R · S`: `u' = m[0]·(u, v, 1)`, `v' = m[1]·(u, v, 1)`.
+    pub fn matrix(&self) -> [[f32; 3]; 2] {
+        let (s, c) = self.rotation.sin_cos();
+        let (sx, sy) = (self.scale.x, self.scale.y);
+        [
+            [c * sx, s * sy, self.offset.x],
+            [-s * sx, c * sy, self.offset.y],
+        ]
+    }
+
+    /// `uv` transformed: `T · R · S · (u, v, 1)`.
+    pub fn apply(&self, uv: Vec2) -> Vec2 {
+        let [r0, r1] = self.matrix();
+        Vec2::new(
+            r0[0] * uv.x + r0[1] * uv.y + r0[2],
+            r1[0] * uv.x + r1[1] * uv.y + r1[2],
+        )
+    }
 }
 
 /// A decoded image, RGBA8, rows top to bottom.
@@ -176,7 +264,8 @@ pub(crate) struct TextureLoader {
 }
 
 impl TextureLoader {
-    /// Resolves a material's texture slot; `None` (with a warning) when it cannot be used.
+    /// Resolves a material's texture slot, with its texture coordinate set and its
+    /// `KHR_texture_transform`; `None` (with a warning) when it cannot be used.
     pub(crate) fn get(
         &mut self,
         src: &Source,
@@ -186,39 +275,90 @@ impl TextureLoader {
         warnings: &mut Warnings,
     ) -> Result<Option<TextureRef>> {
         let Some(info) = info else { return Ok(None) };
-        self.resolve(src, info.texture(), info.tex_coord(), srgb, user, warnings)
+        let ext = info.texture_transform();
+        let mapping = Mapping {
+            tex_coord: ext
+                .as_ref()
+                .and_then(|t| t.tex_coord())
+                .unwrap_or(info.tex_coord()),
+            transform: ext.map(|t| TextureTransform {
+                offset: Vec2::from(t.offset()),
+                rotation: t.rotation(),
+                scale: Vec2::from(t.scale()),
+            }),
+        };
+        self.resolve(src, info.texture(), mapping, srgb, user, warnings)
     }
 
-    /// Resolves a material's normal texture (linear data), like [`TextureLoader::get`].
+    /// Resolves a material's normal texture (linear data), like [`TextureLoader::get`]. The gltf
+    /// crate gives `normalTexture` no `texture_transform()`: `raw_transform` is the reference's
+    /// `KHR_texture_transform` object from the file's JSON.
     pub(crate) fn get_normal(
         &mut self,
         src: &Source,
         info: Option<gltf::material::NormalTexture<'_>>,
+        raw_transform: Option<&serde_json::Value>,
         user: &str,
         warnings: &mut Warnings,
     ) -> Result<Option<TextureRef>> {
         let Some(info) = info else { return Ok(None) };
-        self.resolve(src, info.texture(), info.tex_coord(), false, user, warnings)
+        let mut mapping = Mapping {
+            tex_coord: info.tex_coord(),
+            transform: None,
+        };
+        if let Some(raw) = raw_transform {
+            match parse_transform(raw) {
+                Ok((transform, tex_coord)) => {
+                    mapping.transform = Some(transform);
+                    mapping.tex_coord = tex_coord.unwrap_or(mapping.tex_coord);
+                }
+                Err(why) => {
+                    let tex = info.texture();
+                    let msg = format!(
+                        "{}: {user} {}: KHR_texture_transform {why}; sampled without the transform",
+                        src.path.display(),
+                        label("texture", tex.index(), tex.name())
+                    );
+                    warnings.push(WarningKind::TextureIgnored, 1, msg);
+                }
+            }
+        }
+        self.resolve(src, info.texture(), mapping, false, user, warnings)
     }
 
     fn resolve(
         &mut self,
         src: &Source,
         tex: gltf::Texture<'_>,
-        tex_coord: u32,
+        mapping: Mapping,
         srgb: bool,
         user: &str,
         warnings: &mut Warnings,
     ) -> Result<Option<TextureRef>> {
         let tex_label = label("texture", tex.index(), tex.name());
         let file = src.path.display();
-        if tex_coord != 0 {
-            let msg = format!("{file}: {user} {tex_label}: texCoord {tex_coord} unsupported (only TEXCOORD_0); texture ignored");
+        let tex_coord = mapping.tex_coord;
+        if tex_coord > 1 {
+            let msg = format!("{file}: {user} {tex_label}: texCoord {tex_coord} unsupported (only TEXCOORD_0 and TEXCOORD_1); texture ignored");
             warnings.push(WarningKind::TextureIgnored, 1, msg);
             return Ok(None);
         }
+        let transform = match mapping.transform {
+            Some(t) if !(t.matrix().iter().flatten().all(|v| v.is_finite())) => {
+                let msg = format!("{file}: {user} {tex_label}: KHR_texture_transform has a non-finite value; sampled without the transform");
+                warnings.push(WarningKind::TextureIgnored, 1, msg);
+                TextureTransform::IDENTITY
+            }
+            Some(t) => t,
+            None => TextureTransform::IDENTITY,
+        };
+        let reference = |texture| TextureRef {
+            texture,
+            tex_coord,
+            transform,
+        };
         if let Some(&t) = self.texture_map.get(&tex.index()) {
-            return Ok(Some(TextureRef { texture: t }));
+            return Ok(Some(reference(t)));
         }
         let img = tex.source();
         let image = match self.image_map.get(&img.index()) {
@@ -257,8 +397,151 @@ impl TextureLoader {
         });
         self.texture_map
             .insert(tex.index(), self.textures.len() - 1);
-        Ok(Some(TextureRef {
-            texture: self.textures.len() - 1,
-        }))
+        Ok(Some(reference(self.textures.len() - 1)))
+    }
+}
+
+/// A reference's texture coordinate set (the transform's `texCoord` applied) and transform, as
+/// the file gives them.
+#[derive(Clone, Copy, Debug)]
+struct Mapping {
+    tex_coord: u32,
+    transform: Option<TextureTransform>,
+}
+
+/// Reads a `KHR_texture_transform` JSON object: the transform and its `texCoord` override, or
+/// what is wrong with it.
+fn parse_transform(
+    v: &serde_json::Value,
+) -> std::result::Result<(TextureTransform, Option<u32>), String> {
+    let Some(obj) = v.as_object() else {
+        return Err("is not an object".into());
+    };
+    let number = |key: &str, x: &serde_json::Value| {
+        x.as_f64()
+            .map(|x| x as f32)
+            .ok_or_else(|| format!("{key} is not a number"))
+    };
+    let pair = |key: &str, default: Vec2| -> std::result::Result<Vec2, String> {
+        match obj.get(key) {
+            None => Ok(default),
+            Some(serde_json::Value::Array(a)) if a.len() == 2 => {
+                Ok(Vec2::new(number(key, &a[0])?, number(key, &a[1])?))
+            }
+            Some(_) => Err(format!("{key} is not an array of two numbers")),
+        }
+    };
+    let rotation = match obj.get("rotation") {
+        None => 0.0,
+        Some(x) => number("rotation", x)?,
+    };
+    let tex_coord = match obj.get("texCoord") {
+        None => None,
+        Some(x) => Some(
+            x.as_u64()
+                .and_then(|t| u32::try_from(t).ok())
+                .ok_or("texCoord is not a non-negative integer")?,
+        ),
+    };
+    let transform = TextureTransform {
+        offset: pair("offset", Vec2::ZERO)?,
+        rotation,
+        scale: pair("scale", Vec2::ONE)?,
+    };
+    Ok((transform, tex_coord))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: Vec2, b: Vec2) {
+        assert!((a - b).abs().max_element() < 1e-6, "{a} against {b}");
+    }
+
+    #[test]
+    fn the_transform_is_translation_rotation_scale() {
+        let t = TextureTransform {
+            offset: Vec2::new(0.25, -0.5),
+            rotation: 0.3,
+            scale: Vec2::new(2.0, 0.5),
+        };
+        let (s, c) = 0.3f32.sin_cos();
+        for uv in [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::new(0.7, -1.3)] {
+            // S, then R (u' = cos·u + sin·v, v' = −sin·u + cos·v), then T.
+            let scaled = uv * Vec2::new(2.0, 0.5);
+            let rotated = Vec2::new(c * scaled.x + s * scaled.y, -s * scaled.x + c * scaled.y);
+            close(t.apply(uv), rotated + Vec2::new(0.25, -0.5));
+        }
+        assert!(TextureTransform::IDENTITY.is_identity() && !t.is_identity());
+        close(
+            TextureTransform::IDENTITY.apply(Vec2::new(0.3, 0.9)),
+            Vec2::new(0.3, 0.9),
+        );
+    }
+
+    #[test]
+    fn the_specification_example_uses_the_lower_left_quadrant_turned_clockwise() {
+        // KHR_texture_transform's example: offset [0, 1], rotation π/2, scale [0.5, 0.5] "utilizes
+        // only the lower left quadrant of the source image, rotated clockwise 90°" (v down).
+        let t = TextureTransform {
+            offset: Vec2::new(0.0, 1.0),
+            rotation: std::f32::consts::FRAC_PI_2,
+            scale: Vec2::splat(0.5),
+        };
+        // The unit square's corners land on the lower left quadrant's: u' = v/2, v' = 1 − u/2.
+        close(t.apply(Vec2::new(0.0, 0.0)), Vec2::new(0.0, 1.0));
+        close(t.apply(Vec2::new(1.0, 0.0)), Vec2::new(0.0, 0.5));
+        close(t.apply(Vec2::new(1.0, 1.0)), Vec2::new(0.5, 0.5));
+        close(t.apply(Vec2::new(0.0, 1.0)), Vec2::new(0.5, 1.0));
+        // Rotating the UVs counter-clockwise as seen in texture space (v down): +u turns to −v.
+        let r = TextureTransform {
+            rotation: std::f32::consts::FRAC_PI_2,
+            ..TextureTransform::IDENTITY
+        };
+        close(r.apply(Vec2::X), Vec2::new(0.0, -1.0));
+        close(r.apply(Vec2::Y), Vec2::new(1.0, 0.0));
+    }
+
+    #[test]
+    fn a_reference_maps_its_own_set() {
+        let r = TextureRef {
+            texture: 0,
+            tex_coord: 1,
+            transform: TextureTransform {
+                offset: Vec2::new(1.0, 2.0),
+                ..TextureTransform::IDENTITY
+            },
+        };
+        close(
+            r.map(Vec2::ZERO, Vec2::new(0.5, 0.25)),
+            Vec2::new(1.5, 2.25),
+        );
+        close(
+            TextureRef::new(3).map(Vec2::new(0.1, 0.2), Vec2::ONE),
+            Vec2::new(0.1, 0.2),
+        );
+    }
+
+    #[test]
+    fn raw_transforms_are_parsed_with_their_defaults_and_checked() {
+        let json = serde_json::json!({"offset": [0.5, 0.25], "rotation": 1.0, "scale": [2, 3], "texCoord": 1});
+        let (t, set) = parse_transform(&json).unwrap();
+        assert_eq!(
+            (t.offset, t.rotation, t.scale, set),
+            (Vec2::new(0.5, 0.25), 1.0, Vec2::new(2.0, 3.0), Some(1))
+        );
+        let (t, set) = parse_transform(&serde_json::json!({})).unwrap();
+        assert_eq!((t, set), (TextureTransform::IDENTITY, None));
+        for bad in [
+            serde_json::json!([1, 2]),
+            serde_json::json!({"offset": [1]}),
+            serde_json::json!({"scale": "big"}),
+            serde_json::json!({"rotation": [0]}),
+            serde_json::json!({"texCoord": -1}),
+            serde_json::json!({"texCoord": 0.5}),
+        ] {
+            assert!(parse_transform(&bad).is_err(), "{bad}");
+        }
     }
 }

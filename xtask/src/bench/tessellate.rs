@@ -77,6 +77,11 @@ pub fn subdivide_mesh(mesh: &Mesh, n: u32) -> Result<Mesh> {
         positions: Vec::with_capacity(vertex_total),
         normals: Vec::with_capacity(vertex_total),
         texcoords: Vec::with_capacity(vertex_total),
+        texcoords1: Vec::with_capacity(if mesh.texcoords1.is_empty() {
+            0
+        } else {
+            vertex_total
+        }),
         tangents: Vec::with_capacity(if mesh.tangents.is_empty() {
             0
         } else {
@@ -92,6 +97,7 @@ pub fn subdivide_mesh(mesh: &Mesh, n: u32) -> Result<Mesh> {
         let p = idx.map(|i| mesh.positions[i]);
         let nrm = idx.map(|i| mesh.normals[i]);
         let uv = idx.map(|i| mesh.texcoords[i]);
+        let uv1 = idx.map(|i| mesh.texcoords1.get(i).copied().unwrap_or_default());
         let tan = idx.map(|i| mesh.tangents.get(i).copied().unwrap_or_default());
         let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(Vec3::Z);
         let base = out.positions.len() as u32;
@@ -101,6 +107,10 @@ pub fn subdivide_mesh(mesh: &Mesh, n: u32) -> Result<Mesh> {
                 .push((nrm[0] * w[0] + nrm[1] * w[1] + nrm[2] * w[2]).normalize_or(face));
             out.texcoords
                 .push(uv[0] * w[0] + uv[1] * w[1] + uv[2] * w[2]);
+            if !mesh.texcoords1.is_empty() {
+                out.texcoords1
+                    .push(uv1[0] * w[0] + uv1[1] * w[1] + uv1[2] * w[2]);
+            }
             if !mesh.tangents.is_empty() {
                 // The handedness of the first corner (a triangle's corners share it).
                 let t =
@@ -190,6 +200,7 @@ mod tests {
             positions,
             normals,
             texcoords,
+            texcoords1: Vec::new(),
             tangents: Vec::new(),
             indices: vec![0, 1, 2, 2, 1, 3],
             triangle_materials: vec![3, 5],

@@ -2,6 +2,7 @@
 
 use crate::animation::{Interpolation, Property};
 use crate::light::LightKind;
+use crate::texture::TextureTransform;
 
 /// Index component type of a primitive.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -49,6 +50,27 @@ pub struct MaterialDesc {
     pub alpha_mode: Option<String>,
     /// `alphaCutoff` (written when set).
     pub alpha_cutoff: Option<f32>,
+    /// How the base colour texture maps texture coordinates.
+    pub base_color_uv: TexCoordDesc,
+    /// How the emissive texture maps texture coordinates.
+    pub emissive_uv: TexCoordDesc,
+    /// How the metallic-roughness texture maps texture coordinates.
+    pub metallic_roughness_uv: TexCoordDesc,
+    /// How the normal texture maps texture coordinates.
+    pub normal_uv: TexCoordDesc,
+}
+
+/// How a material's texture reference maps texture coordinates: its `texCoord` and its
+/// `KHR_texture_transform`, written on its textureInfo.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TexCoordDesc {
+    /// `texCoord` of the textureInfo (written when not 0).
+    pub tex_coord: u32,
+    /// `KHR_texture_transform`'s offset, rotation and scale (written when set).
+    pub transform: Option<TextureTransform>,
+    /// `KHR_texture_transform`'s `texCoord`, which overrides `tex_coord` (written when set, with
+    /// the transform or with an identity one).
+    pub transform_tex_coord: Option<u32>,
 }
 
 impl MaterialDesc {
@@ -71,6 +93,10 @@ impl MaterialDesc {
             normal_texture: None,
             alpha_mode: None,
             alpha_cutoff: None,
+            base_color_uv: TexCoordDesc::default(),
+            emissive_uv: TexCoordDesc::default(),
+            metallic_roughness_uv: TexCoordDesc::default(),
+            normal_uv: TexCoordDesc::default(),
         }
     }
 
@@ -103,6 +129,8 @@ pub struct PrimitiveDesc {
     pub normals: Option<Vec<[f32; 3]>>,
     /// TEXCOORD_0 (optional).
     pub texcoords: Option<Vec<[f32; 2]>>,
+    /// TEXCOORD_1 (optional).
+    pub texcoords1: Option<Vec<[f32; 2]>>,
     /// TANGENT (optional).
     pub tangents: Option<Vec<[f32; 4]>>,
     /// Indices (optional: non-indexed).
@@ -127,6 +155,7 @@ impl PrimitiveDesc {
             positions,
             normals,
             texcoords: None,
+            texcoords1: None,
             tangents: None,
             indices: Some(indices),
             index_format: IndexFormat::Auto,

@@ -6,7 +6,8 @@
 //! 4-byte-aligned buffer view; float accessors carry `min`/`max`. Emission is given as radiance and
 //! split into `emissiveFactor` × `KHR_materials_emissive_strength` when it exceeds 1; a specular
 //! factor other than 1 (0 for the Lambertian [`MaterialDesc::diffuse`]) is written as
-//! `KHR_materials_specular`, an ior as `KHR_materials_ior`. The JSON is
+//! `KHR_materials_specular`, an ior as `KHR_materials_ior`, a texture reference's transform as
+//! `KHR_texture_transform` ([`TexCoordDesc`]). The JSON is
 //! written with serde_json; [`GltfBuilder::to_json`] exposes it so tests can mutate it.
 
 mod desc;
@@ -22,7 +23,9 @@ use crate::animation::{Interpolation, Property};
 use crate::error::{Error, Result};
 use crate::light::LightKind;
 
-pub use desc::{ChannelDesc, IndexFormat, LightDesc, MaterialDesc, NodeDesc, PrimitiveDesc};
+pub use desc::{
+    ChannelDesc, IndexFormat, LightDesc, MaterialDesc, NodeDesc, PrimitiveDesc, TexCoordDesc,
+};
 
 /// Where the binary buffer goes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -135,14 +138,36 @@ impl GltfBuilder {
         )
     }
 
+    /// A textureInfo of texture `index` mapped by `uv` (`texCoord`, `KHR_texture_transform`).
+    fn texture_info(&mut self, index: usize, uv: &TexCoordDesc) -> Value {
+        let mut info = json!({"index": index});
+        if uv.tex_coord != 0 {
+            info["texCoord"] = json!(uv.tex_coord);
+        }
+        if uv.transform.is_some() || uv.transform_tex_coord.is_some() {
+            let t = uv.transform.unwrap_or_default();
+            let mut ext = json!({
+                "offset": nums(&t.offset.to_array()),
+                "rotation": num(t.rotation),
+                "scale": nums(&t.scale.to_array()),
+            });
+            if let Some(set) = uv.transform_tex_coord {
+                ext["texCoord"] = json!(set);
+            }
+            info["extensions"] = json!({ "KHR_texture_transform": ext });
+            self.extensions_used.insert("KHR_texture_transform".into());
+        }
+        info
+    }
+
     /// Adds a material; returns its index.
     pub fn add_material(&mut self, m: &MaterialDesc) -> usize {
         let mut pbr = json!({"baseColorFactor": nums(&m.base_color), "metallicFactor": num(m.metallic), "roughnessFactor": num(m.roughness)});
         if let Some(t) = m.base_color_texture {
-            pbr["baseColorTexture"] = json!({"index": t});
+            pbr["baseColorTexture"] = self.texture_info(t, &m.base_color_uv);
         }
         if let Some(t) = m.metallic_roughness_texture {
-            pbr["metallicRoughnessTexture"] = json!({"index": t});
+            pbr["metallicRoughnessTexture"] = self.texture_info(t, &m.metallic_roughness_uv);
         }
         let mut v = json!({"name": m.name, "pbrMetallicRoughness": pbr});
         let mut extensions = Map::new();
@@ -171,10 +196,12 @@ impl GltfBuilder {
             v["extensions"] = Value::Object(extensions);
         }
         if let Some(t) = m.emissive_texture {
-            v["emissiveTexture"] = json!({"index": t});
+            v["emissiveTexture"] = self.texture_info(t, &m.emissive_uv);
         }
         if let Some((t, scale)) = m.normal_texture {
-            v["normalTexture"] = json!({"index": t, "scale": num(scale)});
+            let mut info = self.texture_info(t, &m.normal_uv);
+            info["scale"] = num(scale);
+            v["normalTexture"] = info;
         }
         if m.double_sided {
             v["doubleSided"] = json!(true);
@@ -205,12 +232,14 @@ impl GltfBuilder {
                     json!(self.add_float_accessor(&flat, 3, Some(34962))),
                 );
             }
-            if let Some(t) = &p.texcoords {
-                let flat: Vec<f32> = t.iter().flatten().copied().collect();
-                attrs.insert(
-                    "TEXCOORD_0".into(),
-                    json!(self.add_float_accessor(&flat, 2, Some(34962))),
-                );
+            for (name, set) in [("TEXCOORD_0", &p.texcoords), ("TEXCOORD_1", &p.texcoords1)] {
+                if let Some(t) = set {
+                    let flat: Vec<f32> = t.iter().flatten().copied().collect();
+                    attrs.insert(
+                        name.into(),
+                        json!(self.add_float_accessor(&flat, 2, Some(34962))),
+                    );
+                }
             }
             if let Some(t) = &p.tangents {
                 let flat: Vec<f32> = t.iter().flatten().copied().collect();
