@@ -99,6 +99,18 @@ float emitter_area_pdf(float mean_luminance, bool two_sided) {
     return total > 0.0 ? mean_luminance * PI * (two_sided ? 2.0 : 1.0) / total : 0.0;
 }
 
+// The texture coordinates at barycentrics b (of corners 1 and 2) of emitter e: TEXCOORD_0, and
+// TEXCOORD_1 with HAS_TEXCOORD1; the material's references map them as at a ray hit.
+TexCoords emitter_texcoords(GpuEmitter e, vec2 b) {
+    float w0 = 1.0 - b.x - b.y;
+    vec2 uv0 = w0 * e.uvs.xy + b.x * e.uvs.zw + b.y * e.uv2_material.xy;
+#ifdef HAS_TEXCOORD1
+    return vec4(uv0, w0 * e.uvs1.xy + b.x * e.uvs1.zw + b.y * e.uv1_2.xy);
+#else
+    return uv0;
+#endif
+}
+
 // Samples a point on an emissive triangle as seen from p. On success: unit direction to the
 // point, its distance, the radiance it sends toward p, and the solid-angle pdf.
 bool sample_emitter(vec3 p, vec3 u, out vec3 dir, out float dist, out vec3 radiance, out float pdf) {
@@ -127,7 +139,7 @@ bool sample_emitter(vec3 p, vec3 u, out vec3 dir, out float dist, out vec3 radia
     if (cos_l <= 0.0 && !two_sided) {
         return false;
     }
-    vec2 uv = (1.0 - b.x - b.y) * e.uvs.xy + b.x * e.uvs.zw + b.y * e.uv2_material.xy;
+    TexCoords uv = emitter_texcoords(e, b);
     radiance = material_emission(uint(e.uv2_material.z), uv, cos_l > 0.0);
 #ifdef HAS_ALPHA
     // Where an alpha-tested emitter is missing it emits nothing: its mean coverage there (MASK 0

@@ -2,7 +2,10 @@
 // The scene as every scene-reading pass sees it: bindings 0-15 (see shared/bindings.glsl),
 // surface reconstruction at a ray-query hit, materials, textures and emission, and the traversal
 // every ray query of the passes goes through (scene_trace, with the alpha test under HAS_ALPHA). With
-// HAS_NORMAL_MAPS, the vertex tangents and the normal maps (common/normal_map.glsl).
+// HAS_NORMAL_MAPS, the vertex tangents and the normal maps (common/normal_map.glsl). Every texture
+// lookup takes its coordinates from its reference's GpuUvMap (texture_uv): TEXCOORD_1 with
+// HAS_TEXCOORD1, KHR_texture_transform with HAS_UV_TRANSFORM (docs/materials.md §13); without
+// them every lookup samples TEXCOORD_0 as it is.
 #ifndef RADCACHE_SCENE_GLSL
 #define RADCACHE_SCENE_GLSL
 
@@ -27,6 +30,43 @@ layout(binding = B_EMITTER_ALIAS, std430) readonly buffer EmitterAlias { GpuAlia
 layout(binding = B_LIGHTS, std430) readonly buffer Lights { GpuLight lights[]; };
 layout(binding = B_ENV_TEXELS, std430) readonly buffer EnvTexels { vec4 env_texels[]; };
 layout(binding = B_ENV_ALIAS, std430) readonly buffer EnvAlias { GpuAlias env_alias[]; };
+#ifdef HAS_TEXCOORD1
+layout(binding = B_TEXCOORDS1, std430) readonly buffer Texcoords1 { vec2 texcoords1[]; };
+#endif
+
+// The texture coordinates of a point: TEXCOORD_0, with HAS_TEXCOORD1 followed by TEXCOORD_1
+// (zw). Interpolated like any vector; a lookup picks its set in texture_uv.
+#ifdef HAS_TEXCOORD1
+#define TexCoords vec4
+#else
+#define TexCoords vec2
+#endif
+
+// The texture coordinates of vertex v (global index i).
+TexCoords vertex_texcoords(GpuVertex v, uint i) {
+#ifdef HAS_TEXCOORD1
+    return vec4(v.position_u.w, v.normal_v.w, texcoords1[i]);
+#else
+    return vec2(v.position_u.w, v.normal_v.w);
+#endif
+}
+
+// Where a texture reference samples at a point of coordinates uv (GpuUvMap, docs/materials.md
+// §13): its set (row_u.w), then its KHR_texture_transform T·R·S as two rows,
+// uv' = (row_u·(u, v, 1), row_v·(u, v, 1)).
+vec2 texture_uv(GpuUvMap map, TexCoords uv) {
+#ifdef HAS_TEXCOORD1
+    vec2 t = map.row_u.w != 0.0 ? uv.zw : uv.xy;
+#else
+    vec2 t = uv;
+#endif
+#ifdef HAS_UV_TRANSFORM
+    vec3 h = vec3(t, 1.0);
+    t = vec2(dot(map.row_u.xyz, h), dot(map.row_v.xyz, h));
+#endif
+    return t;
+}
+
 #ifdef HAS_NORMAL_MAPS
 #include "normal_map.glsl"
 layout(binding = B_TANGENTS, std430) readonly buffer Tangents { vec4 tangents[]; };
@@ -43,12 +83,12 @@ vec4 world_tangent(GpuInstance inst, vec4 t) {
 // The shading normal of material m at uv (docs/materials.md §12) from the unit interpolated
 // normal n, the unit geometric normal ng (both outward) and the world tangent: n itself where the
 // material has no normal map or the primitive no tangents (w = 0).
-vec3 material_shading_normal(uint m, vec2 uv, vec4 tangent, vec3 n, vec3 ng) {
+vec3 material_shading_normal(uint m, TexCoords uv, vec4 tangent, vec3 n, vec3 ng) {
     vec4 map = materials[m].normal_map;
     if (map.x < 0.0 || tangent.w == 0.0) {
         return n;
     }
-    vec3 texel = texture_sample(int(map.x), uv).rgb;
+    vec3 texel = texture_sample(int(map.x), texture_uv(materials[m].normal_uv, uv)).rgb;
     return normal_map_normal(n, ng, tangent, texel, map.y);
 }
 #endif
@@ -58,7 +98,7 @@ struct Surface {
     vec3 position;
     vec3 geometric_normal;  // unit, facing the incoming ray
     vec3 shading_normal;    // unit, on the same side as geometric_normal
-    vec2 uv;
+    TexCoords uv;
     uint material;
     bool front_face;        // the ray hit the counter-clockwise (front) side
 };
@@ -117,8 +157,8 @@ Surface surface_at(uint instance, uint prim, vec2 bary, vec3 dir) {
     vec3 ns = (inst.normal_to_world * vec4(n_obj, 0.0)).xyz;
     float ns_len = length(ns);
     ns = (ns_len > 0.0 && !isnan(ns_len)) ? ns / ns_len : ng;
-    s.uv = w.x * vec2(v0.position_u.w, v0.normal_v.w) + w.y * vec2(v1.position_u.w, v1.normal_v.w) +
-           w.z * vec2(v2.position_u.w, v2.normal_v.w);
+    s.uv = w.x * vertex_texcoords(v0, i0) + w.y * vertex_texcoords(v1, i1) +
+           w.z * vertex_texcoords(v2, i2);
     s.material = tri_materials[inst.mesh.w + prim];
 #ifdef HAS_NORMAL_MAPS
     // The map acts on the outward normals (the flip below turns its result with them); the
@@ -185,11 +225,11 @@ vec4 texture_sample(int index, vec2 uv) {
 }
 
 // Diffuse albedo: base colour × (1 − metallic).
-vec3 material_albedo(uint m, vec2 uv) {
+vec3 material_albedo(uint m, TexCoords uv) {
     GpuMaterial mat = materials[m];
     vec3 base = mat.base_color.rgb;
     if (mat.textures.x >= 0) {
-        base *= texture_sample(mat.textures.x, uv).rgb;
+        base *= texture_sample(mat.textures.x, texture_uv(mat.base_color_uv, uv)).rgb;
     }
     return clamp(base * (1.0 - mat.params.x), 0.0, 1.0);
 }
@@ -200,16 +240,16 @@ vec3 material_albedo(uint m, vec2 uv) {
 // The metallic-roughness BRDF parameters of material m at uv (docs/materials.md §1): factors ×
 // textures (base colour sRGB, metallic from the blue and roughness from the green channel of the
 // metallic-roughness texture), clamped to their ranges.
-Material material_at(uint m, vec2 uv) {
+Material material_at(uint m, TexCoords uv) {
     GpuMaterial mat = materials[m];
     vec3 base = mat.base_color.rgb;
     if (mat.textures.x >= 0) {
-        base *= texture_sample(mat.textures.x, uv).rgb;
+        base *= texture_sample(mat.textures.x, texture_uv(mat.base_color_uv, uv)).rgb;
     }
     float metallic = mat.params.x;
     float roughness = mat.params.y;
     if (mat.textures.z >= 0) {
-        vec4 mr = texture_sample(mat.textures.z, uv);
+        vec4 mr = texture_sample(mat.textures.z, texture_uv(mat.metallic_roughness_uv, uv));
         roughness *= mr.g;
         metallic *= mr.b;
     }
@@ -227,11 +267,12 @@ const int ALPHA_NONE = 0;
 const int ALPHA_MASK = 1;
 const int ALPHA_BLEND = 2;
 
-// Alpha of material `mat` at uv: base colour factor alpha × base colour texture alpha (bilinear).
-float material_alpha(GpuMaterial mat, vec2 uv) {
+// Alpha of material `mat` at uv: base colour factor alpha × base colour texture alpha (bilinear,
+// at the base colour reference's coordinates).
+float material_alpha(GpuMaterial mat, TexCoords uv) {
     float a = mat.base_color.a;
     if (mat.textures.x >= 0) {
-        a *= texture_sample(mat.textures.x, uv).a;
+        a *= texture_sample(mat.textures.x, texture_uv(mat.base_color_uv, uv)).a;
     }
     return a;
 }
@@ -240,7 +281,7 @@ float material_alpha(GpuMaterial mat, vec2 uv) {
 // the ray or fragment that `seed` names (docs/materials.md §11): MASK when alpha ≥ the cutoff;
 // BLEND when a uniform number hashed from the seed, the instance and the primitive is below alpha
 // (probability alpha; the same answer every time the same ray meets the same triangle).
-bool alpha_keep(uint m, vec2 uv, uint instance, uint prim, uint seed) {
+bool alpha_keep(uint m, TexCoords uv, uint instance, uint prim, uint seed) {
     GpuMaterial mat = materials[m];
     if (mat.textures.w == ALPHA_NONE) {
         return true;
@@ -254,7 +295,7 @@ bool alpha_keep(uint m, vec2 uv, uint instance, uint prim, uint seed) {
 
 // The expected coverage of material m at uv: MASK 0 or 1, BLEND alpha, 1 without an alpha test
 // (what light sampling of an emitter weighs its radiance by: the mean of what hits see).
-float material_coverage(uint m, vec2 uv) {
+float material_coverage(uint m, TexCoords uv) {
     GpuMaterial mat = materials[m];
     if (mat.textures.w == ALPHA_NONE) {
         return 1.0;
@@ -286,12 +327,12 @@ bool alpha_passes(uint instance, uint prim, vec2 bary, uint seed) {
         return true;  // an opaque material in a mesh that also has alpha-tested ones
     }
     uint first_index = mesh.z + 3u * prim;
-    GpuVertex v0 = vertices[indices[first_index] + mesh.y];
-    GpuVertex v1 = vertices[indices[first_index + 1u] + mesh.y];
-    GpuVertex v2 = vertices[indices[first_index + 2u] + mesh.y];
-    vec2 uv = (1.0 - bary.x - bary.y) * vec2(v0.position_u.w, v0.normal_v.w) +
-              bary.x * vec2(v1.position_u.w, v1.normal_v.w) +
-              bary.y * vec2(v2.position_u.w, v2.normal_v.w);
+    uint i0 = indices[first_index] + mesh.y;
+    uint i1 = indices[first_index + 1u] + mesh.y;
+    uint i2 = indices[first_index + 2u] + mesh.y;
+    TexCoords uv = (1.0 - bary.x - bary.y) * vertex_texcoords(vertices[i0], i0) +
+                   bary.x * vertex_texcoords(vertices[i1], i1) +
+                   bary.y * vertex_texcoords(vertices[i2], i2);
     return alpha_keep(m, uv, instance, prim, seed);
 }
 
@@ -332,14 +373,14 @@ void scene_trace(rayQueryEXT q, uint flags, vec3 origin, vec3 dir, float tmax) {
 }
 
 // Emitted radiance toward the viewer: front face only, or both when double-sided.
-vec3 material_emission(uint m, vec2 uv, bool front_face) {
+vec3 material_emission(uint m, TexCoords uv, bool front_face) {
     GpuMaterial mat = materials[m];
     if (!front_face && mat.emission.w == 0.0) {
         return vec3(0.0);
     }
     vec3 e = mat.emission.rgb;
     if (mat.textures.y >= 0 && any(greaterThan(e, vec3(0.0)))) {
-        e *= texture_sample(mat.textures.y, uv).rgb;
+        e *= texture_sample(mat.textures.y, texture_uv(mat.emissive_uv, uv)).rgb;
     }
     return e;
 }

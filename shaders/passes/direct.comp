@@ -303,7 +303,7 @@ vec3 analytic_emitter_irradiance(vec3 origin, vec3 n) {
         GpuEmitter e = emitters[i];
         vec3 ng = cross(e.p1.xyz - e.p0.xyz, e.p2.xyz - e.p0.xyz);
         bool front = dot(origin - e.p0.xyz, ng) > 0.0;
-        vec3 le = material_emission(uint(e.uv2_material.z), vec2(0.0), front);
+        vec3 le = material_emission(uint(e.uv2_material.z), TexCoords(0.0), front);
         if (any(greaterThan(le, vec3(0.0)))) {
             vec3 t[3] = vec3[3](e.p0.xyz, e.p1.xyz, e.p2.xyz);
             sum += le * triangle_projected_solid_angle(origin, n, t);
@@ -376,7 +376,7 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     s.position = g.position;
     s.geometric_normal = g.geometric;
     s.shading_normal = g.normal;
-    s.uv = vec2(0.0);
+    s.uv = TexCoords(0.0);
     s.material = g.material;
     s.front_face = true;
     vec3 origin = offset_ray_origin(s.position, s.geometric_normal);

@@ -20,7 +20,7 @@
 
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
-layout(location = 2) in vec2 v_uv;
+layout(location = 2) in TexCoords v_uv;
 layout(location = 3) flat in uint v_triangle;
 #ifdef HAS_NORMAL_MAPS
 layout(location = 4) in vec3 v_tangent;
@@ -105,7 +105,7 @@ void main() {
     vec3 ns = v_normal;
     float ns_len = length(ns);
     ns = (ns_len > 0.0 && !isnan(ns_len)) ? ns / ns_len : ng;
-    vec2 uv = v_uv;
+    TexCoords uv = v_uv;
 #ifdef HAS_NORMAL_MAPS
     // On the outward normals, as surface_at does; the flip below turns the result with them.
     ns = material_shading_normal(material, uv, vec4(v_tangent, v_tangent_w), ns,

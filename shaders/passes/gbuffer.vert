@@ -15,7 +15,7 @@
 
 layout(location = 0) out vec3 v_position;
 layout(location = 1) out vec3 v_normal;
-layout(location = 2) out vec2 v_uv;
+layout(location = 2) out TexCoords v_uv;  // both sets with HAS_TEXCOORD1
 layout(location = 3) flat out uint v_triangle;
 #ifdef HAS_NORMAL_MAPS
 // World tangent (xyz) and handedness (the provoking, first, corner's: surface_at uses it too).
@@ -30,7 +30,7 @@ void main() {
     vec4 world = inst.world_from_object * vec4(v.position_u.xyz, 1.0);
     v_position = world.xyz;
     v_normal = (inst.normal_to_world * vec4(v.normal_v.xyz, 0.0)).xyz;
-    v_uv = vec2(v.position_u.w, v.normal_v.w);
+    v_uv = vertex_texcoords(v, index);
     v_triangle = uint(gl_VertexIndex) / 3u;
 #ifdef HAS_NORMAL_MAPS
     vec4 t = world_tangent(inst, tangents[index]);

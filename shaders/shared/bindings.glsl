@@ -18,6 +18,7 @@
 #define B_ENV_TEXELS 12
 #define B_ENV_ALIAS 13
 #define B_TANGENTS 14
+#define B_TEXCOORDS1 15
 #define B_PASS_BASE 16
 #define B_GBUFFER_END 22
 

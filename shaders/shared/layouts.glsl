@@ -17,6 +17,11 @@ struct GpuInstance {
     uvec4 mesh;
 };  // 144 bytes
 
+struct GpuUvMap {
+    vec4 row_u;
+    vec4 row_v;
+};  // 32 bytes
+
 struct GpuMaterial {
     vec4 base_color;
     vec4 emission;
@@ -25,7 +30,11 @@ struct GpuMaterial {
     vec4 specular;
     vec4 alpha;
     vec4 normal_map;
-};  // 112 bytes
+    GpuUvMap base_color_uv;
+    GpuUvMap emissive_uv;
+    GpuUvMap metallic_roughness_uv;
+    GpuUvMap normal_uv;
+};  // 240 bytes
 
 struct GpuTexture {
     uvec4 info;
@@ -38,7 +47,9 @@ struct GpuEmitter {
     vec4 radiance;
     vec4 uvs;
     vec4 uv2_material;
-};  // 96 bytes
+    vec4 uvs1;
+    vec4 uv1_2;
+};  // 128 bytes
 
 struct GpuAlias {
     float prob;

@@ -1,4 +1,4 @@
-//! The one owner of binding numbers and kinds. Bindings 0–15 are the scene's (0–14 used; every
+//! The one owner of binding numbers and kinds. Bindings 0–15 are the scene's (every
 //! pass that reads the scene pushes the same table); the G-buffer's six images follow at
 //! [`PASS_BASE`] in the passes that read it; each pass's own bindings come next, declared once
 //! here by [`pass_bindings!`] as a named table. `cargo xtask codegen` writes every number to
@@ -39,11 +39,14 @@ pub const ENV_ALIAS: u32 = 13;
 /// Vertex tangents (`vec4[]`, parallel to the vertices; w = ±1 handedness, 0 where no normal map
 /// applies). A 16-byte placeholder unless the plan has normal maps.
 pub const TANGENTS: u32 = 14;
+/// TEXCOORD_1 per vertex (`vec2[]`, parallel to the vertices; zero where a mesh has none). An
+/// 16-byte placeholder unless the plan has TEXCOORD_1 (docs/materials.md §13).
+pub const TEXCOORDS1: u32 = 15;
 /// First binding of a pass's own resources.
 pub const PASS_BASE: u32 = 16;
 
 /// The scene's binding table (prefix of every scene-reading pass's table).
-pub const SCENE: [BindingLayout; 15] = [
+pub const SCENE: [BindingLayout; 16] = [
     BindingLayout::new(FRAME, BindingKind::UniformBuffer),
     BindingLayout::new(TLAS, BindingKind::AccelerationStructure),
     BindingLayout::new(VERTICES, BindingKind::StorageBuffer),
@@ -59,6 +62,7 @@ pub const SCENE: [BindingLayout; 15] = [
     BindingLayout::new(ENV_TEXELS, BindingKind::StorageBuffer),
     BindingLayout::new(ENV_ALIAS, BindingKind::StorageBuffer),
     BindingLayout::new(TANGENTS, BindingKind::StorageBuffer),
+    BindingLayout::new(TEXCOORDS1, BindingKind::StorageBuffer),
 ];
 
 /// One named binding of a table.
@@ -335,6 +339,7 @@ pub fn generated_glsl() -> String {
         ("ENV_TEXELS", ENV_TEXELS),
         ("ENV_ALIAS", ENV_ALIAS),
         ("TANGENTS", TANGENTS),
+        ("TEXCOORDS1", TEXCOORDS1),
         ("PASS_BASE", PASS_BASE),
         ("GBUFFER_END", GBUFFER_END),
     ];

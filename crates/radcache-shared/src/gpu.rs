@@ -35,7 +35,20 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// A material (metallic-roughness; rendered as diffuse for now).
+    /// How a material's texture reference maps texture coordinates (docs/materials.md §13): its
+    /// set, then its `KHR_texture_transform` as the 2×3 matrix `T·R·S`, `uv' = (row_u·(u, v, 1),
+    /// row_v·(u, v, 1))`. The identity and set 0 for a reference without them (and for none).
+    pub struct GpuUvMap {
+        /// First row of the matrix (xyz) and the texture coordinate set (w: 0 TEXCOORD_0, 1
+        /// TEXCOORD_1).
+        pub row_u: [f32; 4] => "vec4",
+        /// Second row of the matrix (xyz); unused (w).
+        pub row_v: [f32; 4] => "vec4",
+    }
+}
+
+gpu_struct! {
+    /// A material (metallic-roughness).
     pub struct GpuMaterial {
         /// Base colour factor (linear RGBA).
         pub base_color: [f32; 4] => "vec4",
@@ -55,6 +68,14 @@ gpu_struct! {
         /// Normal map: texture index as a float (x, −1 for none), `normalTexture.scale` (y),
         /// unused (z, w).
         pub normal_map: [f32; 4] => "vec4",
+        /// The base colour texture's coordinates.
+        pub base_color_uv: GpuUvMap => struct,
+        /// The emissive texture's coordinates.
+        pub emissive_uv: GpuUvMap => struct,
+        /// The metallic-roughness texture's coordinates.
+        pub metallic_roughness_uv: GpuUvMap => struct,
+        /// The normal map's coordinates.
+        pub normal_uv: GpuUvMap => struct,
     }
 }
 
@@ -77,10 +98,14 @@ gpu_struct! {
         pub p2: [f32; 4] => "vec4",
         /// Radiance factor (rgb, before textures) and two-sidedness (w: 1 or 0).
         pub radiance: [f32; 4] => "vec4",
-        /// Texture coordinates of corners 0 (xy) and 1 (zw).
+        /// Texture coordinates (TEXCOORD_0) of corners 0 (xy) and 1 (zw).
         pub uvs: [f32; 4] => "vec4",
         /// Texture coordinates of corner 2 (xy), material index (z, exact in f32), unused (w).
         pub uv2_material: [f32; 4] => "vec4",
+        /// TEXCOORD_1 of corners 0 (xy) and 1 (zw); zero unless the scene keeps TEXCOORD_1.
+        pub uvs1: [f32; 4] => "vec4",
+        /// TEXCOORD_1 of corner 2 (xy); unused (zw).
+        pub uv1_2: [f32; 4] => "vec4",
     }
 }
 
@@ -302,6 +327,7 @@ pub fn generated_glsl() -> String {
         glsl_struct::<GpuVertex>(),
         glsl_struct::<GpuMesh>(),
         glsl_struct::<GpuInstance>(),
+        glsl_struct::<GpuUvMap>(),
         glsl_struct::<GpuMaterial>(),
         glsl_struct::<GpuTexture>(),
         glsl_struct::<GpuEmitter>(),
@@ -332,6 +358,7 @@ mod tests {
         errors.extend(std430_violations::<GpuVertex>());
         errors.extend(std430_violations::<GpuMesh>());
         errors.extend(std430_violations::<GpuInstance>());
+        errors.extend(std430_violations::<GpuUvMap>());
         errors.extend(std430_violations::<GpuMaterial>());
         errors.extend(std430_violations::<GpuTexture>());
         errors.extend(std430_violations::<GpuEmitter>());
@@ -346,6 +373,8 @@ mod tests {
         assert_eq!(std::mem::size_of::<GpuRecord>(), 176);
         assert_eq!(std::mem::size_of::<GpuRecordTemporal>(), 96);
         assert_eq!(std::mem::size_of::<IcCounters>(), 80);
+        assert_eq!(std::mem::size_of::<GpuMaterial>(), 240);
+        assert_eq!(std::mem::size_of::<GpuEmitter>(), 128);
         assert!(errors.is_empty(), "{}", errors.join("\n"));
     }
 

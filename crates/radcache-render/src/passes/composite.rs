@@ -4,7 +4,7 @@
 //! G-buffer's emission goes to its own accumulator, which the emission pass turns into the
 //! box-filtered emission it adds to the image.
 //!
-//! Bindings: the scene (0–14), the G-buffer (16–21), then from 22: the splat sum (Σw·Ẽ, Σw), the
+//! Bindings: the scene (0–15), the G-buffer (16–21), then from 22: the splat sum (Σw·Ẽ, Σw), the
 //! frame accumulator, the non-finite counter, the emission accumulator (read by
 //! [`crate::EmissionPass`], which adds the box-filtered emission), the debug accumulator and the
 //! splat record count. A non-finite value is replaced by 0 and counted.

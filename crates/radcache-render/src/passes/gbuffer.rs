@@ -4,7 +4,7 @@
 //!
 //! Writes the five attachments of `shaders/common/gbuffer.glsl` (position, shading normal +
 //! footprint, geometric normal + material, albedo, emission), zero on the background, and clears
-//! the direct-light image. Reads the scene bindings 0–14 (vertex and fragment stages; nothing is
+//! the direct-light image. Reads the scene bindings 0–15 (vertex and fragment stages; nothing is
 //! written from the vertex stage). Each fragment traces one ray query from the camera to itself:
 //! a surface hit before it (rasterization snapped a zero-thickness wall's edge away from the
 //! sample, so the sample sees the floor behind the wall) replaces it, so the G-buffer never holds

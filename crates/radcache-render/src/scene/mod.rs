@@ -50,6 +50,7 @@ pub struct GpuScene {
     frame: Buffer,
     vertices: Buffer,
     tangents: Buffer,
+    texcoords1: Buffer,
     indices: Buffer,
     instances: Buffer,
     tri_materials: Buffer,
@@ -100,10 +101,11 @@ impl GpuScene {
         let PackedGeometry {
             vertices,
             tangents,
+            texcoords1,
             indices,
             tri_materials,
             meshes,
-        } = pack_geometry(scene, plan.normal_maps);
+        } = pack_geometry(scene, plan.normal_maps, plan.texcoord1);
         let geometry_usage = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
             | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
         let none = vk::BufferUsageFlags::empty();
@@ -127,6 +129,13 @@ impl GpuScene {
         )?;
         // Empty without normal maps: `storage` then makes a 16-byte placeholder.
         let tangent_buf = storage(ctx, "scene.tangents", none, bytemuck::cast_slice(&tangents))?;
+        // Empty without TEXCOORD_1: a placeholder too.
+        let texcoord1_buf = storage(
+            ctx,
+            "scene.texcoords1",
+            none,
+            bytemuck::cast_slice(&texcoords1),
+        )?;
 
         let (materials, textures, texels) = pack_materials(scene);
         let material_buf = storage(
@@ -248,6 +257,7 @@ impl GpuScene {
         stats.buffer_bytes = [
             &vertex_buf,
             &tangent_buf,
+            &texcoord1_buf,
             &index_buf,
             &tri_mat_buf,
             &material_buf,
@@ -274,6 +284,7 @@ impl GpuScene {
             frame,
             vertices: vertex_buf,
             tangents: tangent_buf,
+            texcoords1: texcoord1_buf,
             indices: index_buf,
             instances,
             tri_materials: tri_mat_buf,

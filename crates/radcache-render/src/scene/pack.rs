@@ -1,8 +1,8 @@
 //! Packing of the scene's geometry and materials into the flat GPU layouts.
 
 use glam::Vec3;
-use radcache_scene::{AlphaMode, Material, Scene, WrapMode};
-use radcache_shared::gpu::{GpuMaterial, GpuMesh, GpuTexture, GpuVertex};
+use radcache_scene::{AlphaMode, Material, Scene, TextureRef, WrapMode};
+use radcache_shared::gpu::{GpuMaterial, GpuMesh, GpuTexture, GpuUvMap, GpuVertex};
 
 /// Geometry of every mesh in shared buffers.
 #[derive(Debug, Default)]
@@ -12,6 +12,9 @@ pub(crate) struct PackedGeometry {
     /// A tangent per vertex when `normal_maps` was asked for (zero where a mesh has none), else
     /// empty.
     pub tangents: Vec<[f32; 4]>,
+    /// TEXCOORD_1 per vertex when `texcoord1` was asked for (zero where a mesh has none), else
+    /// empty.
+    pub texcoords1: Vec<[f32; 2]>,
     /// Mesh-local indices of all meshes.
     pub indices: Vec<u32>,
     /// Material of every triangle.
@@ -20,10 +23,12 @@ pub(crate) struct PackedGeometry {
     pub meshes: Vec<GpuMesh>,
 }
 
-/// Packs every mesh of `scene`, with tangents when `normal_maps` (`ScenePlan::normal_maps`).
-pub(crate) fn pack_geometry(scene: &Scene, normal_maps: bool) -> PackedGeometry {
+/// Packs every mesh of `scene`, with tangents when `normal_maps` (`ScenePlan::normal_maps`) and
+/// TEXCOORD_1 when `texcoord1` (`ScenePlan::texcoord1`).
+pub(crate) fn pack_geometry(scene: &Scene, normal_maps: bool, texcoord1: bool) -> PackedGeometry {
     let mut vertices = Vec::new();
     let mut tangents = Vec::new();
+    let mut texcoords1 = Vec::new();
     let mut indices = Vec::new();
     let mut tri_materials = Vec::new();
     let mut meshes = Vec::with_capacity(scene.meshes.len());
@@ -48,12 +53,17 @@ pub(crate) fn pack_geometry(scene: &Scene, normal_maps: bool) -> PackedGeometry 
             let t = |i: usize| mesh.tangents.get(i).map_or([0.0; 4], |t| t.to_array());
             tangents.extend((0..mesh.positions.len()).map(t));
         }
+        if texcoord1 {
+            let t = |i: usize| mesh.texcoords1.get(i).map_or([0.0; 2], |t| t.to_array());
+            texcoords1.extend((0..mesh.positions.len()).map(t));
+        }
         indices.extend_from_slice(&mesh.indices);
         tri_materials.extend_from_slice(&mesh.triangle_materials);
     }
     PackedGeometry {
         vertices,
         tangents,
+        texcoords1,
         indices,
         tri_materials,
         meshes,
@@ -79,6 +89,16 @@ pub(crate) fn mesh_is_opaque(scene: &Scene, triangle_materials: &[u32]) -> bool 
     !triangle_materials
         .iter()
         .any(|&m| scene.materials[m as usize].has_alpha())
+}
+
+/// The texture coordinates of reference `t` (set 0 and the identity for none).
+fn uv_map(t: Option<TextureRef>) -> GpuUvMap {
+    let t = t.unwrap_or(TextureRef::new(0));
+    let [u, v] = t.transform.matrix();
+    GpuUvMap {
+        row_u: [u[0], u[1], u[2], t.tex_coord as f32],
+        row_v: [v[0], v[1], v[2], 0.0],
+    }
 }
 
 /// Materials, texture descriptors and the shared RGBA8 texel array.
@@ -121,6 +141,10 @@ pub(crate) fn pack_materials(scene: &Scene) -> (Vec<GpuMaterial>, Vec<GpuTexture
                 0.0,
                 0.0,
             ],
+            base_color_uv: uv_map(m.base_color_texture),
+            emissive_uv: uv_map(m.emissive_texture),
+            metallic_roughness_uv: uv_map(m.metallic_roughness_texture),
+            normal_uv: uv_map(m.normal_texture),
         })
         .collect();
     let mut texels: Vec<u32> = Vec::new();
@@ -159,4 +183,40 @@ pub(crate) fn pack_materials(scene: &Scene) -> (Vec<GpuMaterial>, Vec<GpuTexture
         })
         .collect();
     (materials, textures, texels)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec2;
+    use radcache_scene::TextureTransform;
+
+    use super::*;
+
+    #[test]
+    fn a_reference_packs_its_set_and_its_matrix_rows() {
+        let t = TextureRef {
+            texture: 2,
+            tex_coord: 1,
+            transform: TextureTransform {
+                offset: Vec2::new(0.25, -0.5),
+                rotation: 0.5,
+                scale: Vec2::new(2.0, 3.0),
+            },
+        };
+        let m = uv_map(Some(t));
+        let (s, c) = 0.5f32.sin_cos();
+        assert_eq!(m.row_u, [2.0 * c, 3.0 * s, 0.25, 1.0]);
+        assert_eq!(m.row_v, [-2.0 * s, 3.0 * c, -0.5, 0.0]);
+        // The rows give what the CPU transform gives.
+        let uv = Vec2::new(0.3, 0.7);
+        let p = [uv.x, uv.y, 1.0];
+        let dot = |r: [f32; 4]| r[0] * p[0] + r[1] * p[1] + r[2] * p[2];
+        let got = Vec2::new(dot(m.row_u), dot(m.row_v));
+        assert!((got - t.transform.apply(uv)).abs().max_element() < 1e-6);
+        let none = uv_map(None);
+        assert_eq!(
+            (none.row_u, none.row_v),
+            ([1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0])
+        );
+    }
 }

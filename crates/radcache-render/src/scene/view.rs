@@ -57,8 +57,12 @@ impl GpuScene {
     /// Shader defines of the scene's materials: `HAS_SPECULAR` when some material is not
     /// Lambertian (`ScenePlan::specular`), which compiles in the full metallic-roughness BRDF;
     /// `HAS_ALPHA` when some material is alpha-tested (`ScenePlan::alpha`), which compiles the
-    /// alpha test into every ray query and the G-buffer; `HAS_NORMAL_MAPS` when some primitive has a normal map (`ScenePlan::normal_maps`), which
-    /// compiles in the tangent binding and the normal-map code.
+    /// alpha test into every ray query and the G-buffer; `HAS_NORMAL_MAPS` when some primitive
+    /// has a normal map (`ScenePlan::normal_maps`), which compiles in the tangent binding and the
+    /// normal-map code; `HAS_UV_TRANSFORM` when some texture reference has a
+    /// `KHR_texture_transform` (`ScenePlan::uv_transform`) and `HAS_TEXCOORD1` when some samples
+    /// TEXCOORD_1 (`ScenePlan::texcoord1`), which compile in the transforms and the second set
+    /// (its binding, its interpolation and the choice of set per reference).
     pub fn material_defines(&self) -> Vec<(&'static str, &'static str)> {
         let mut d = Vec::new();
         if self.plan.specular {
@@ -69,6 +73,12 @@ impl GpuScene {
         }
         if self.plan.normal_maps {
             d.push(("HAS_NORMAL_MAPS", "1"));
+        }
+        if self.plan.uv_transform {
+            d.push(("HAS_UV_TRANSFORM", "1"));
+        }
+        if self.plan.texcoord1 {
+            d.push(("HAS_TEXCOORD1", "1"));
         }
         d
     }
@@ -92,7 +102,7 @@ impl GpuScene {
         d
     }
 
-    /// The scene's binding table (bindings 0–14), to prefix a pass's own bindings.
+    /// The scene's binding table (bindings 0–15), to prefix a pass's own bindings.
     pub fn bindings(&self) -> Vec<(u32, Resource<'_>)> {
         vec![
             (b::FRAME, Resource::Buffer(&self.frame)),
@@ -110,6 +120,7 @@ impl GpuScene {
             (b::ENV_TEXELS, Resource::Buffer(&self.env_texels)),
             (b::ENV_ALIAS, Resource::Buffer(&self.env_alias)),
             (b::TANGENTS, Resource::Buffer(&self.tangents)),
+            (b::TEXCOORDS1, Resource::Buffer(&self.texcoords1)),
         ]
     }
 }
