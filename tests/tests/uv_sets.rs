@@ -11,6 +11,10 @@
 //!   per pixel in the path tracer, its albedo AOV and the cache frame (G-buffer, emission pass,
 //!   records of E = πL). The same pixels under the references' other set or without their
 //!   transforms differ, so a renderer that dropped either fails.
+//! - The same quad with a normal map of 16 texels tilted by distinct angles, through TEXCOORD_1
+//!   and a transform, lit by a directional light along its normal: every pixel inside one texel
+//!   is ρ/π · E · cos θ of that texel (the cosine between the mapped and the geometric normal does
+//!   not depend on the tangent's direction), in both renderers.
 //! - An emitter over a floor whose emission reference maps all of it into one texel of a texture
 //!   whose other texels are dark (through TEXCOORD_1 and a transform, TEXCOORD_0 spanning the
 //!   texture): the floor's radiance is ρ/π · L · texel · the emitter's projected solid angle
@@ -22,8 +26,11 @@ use std::f64::consts::PI;
 use glam::{Quat, Vec2, Vec3};
 use radcache_material::polygon::triangle_projected_solid_angle;
 use radcache_render::{render_ic, render_path, Budget, GpuScene, IcSettings, PathSettings};
+use radcache_scene::light::LightKind;
 use radcache_scene::math::srgb_to_linear;
-use radcache_scene::writer::{GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc, TexCoordDesc};
+use radcache_scene::writer::{
+    GltfBuilder, LightDesc, MaterialDesc, NodeDesc, PrimitiveDesc, TexCoordDesc,
+};
 use radcache_scene::{CameraView, Scene, TextureRef, TextureTransform};
 use radcache_tests::scenes::{
     camera_node, pixel_to_ndc, plane_y, render, temp_dir, write_and_load,
@@ -130,6 +137,33 @@ fn tt(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> TextureTransform {
     }
 }
 
+/// The quad of material `mat` (both sets of texture coordinates), its node and a camera on +Z
+/// that sees [−1, 1]² of it.
+fn quad_nodes(b: &mut GltfBuilder, mat: usize, tag: &str) -> Vec<usize> {
+    let corners = [[-QUAD, -QUAD], [QUAD, -QUAD], [QUAD, QUAD], [-QUAD, QUAD]];
+    let at = |c: &[f32; 2]| Vec3::new(c[0], c[1], 0.0);
+    let quad = PrimitiveDesc {
+        texcoords: Some(corners.iter().map(|c| uv0_at(at(c)).to_array()).collect()),
+        texcoords1: Some(corners.iter().map(|c| uv1_at(at(c)).to_array()).collect()),
+        ..PrimitiveDesc::triangles(
+            corners.iter().map(|c| [c[0], c[1], 0.0]).collect(),
+            Some(vec![[0.0, 0.0, 1.0]; 4]),
+            vec![0, 1, 2, 0, 2, 3],
+            Some(mat),
+        )
+    };
+    let mesh = b.add_mesh(tag, &[quad]);
+    let node = b.add_node(&NodeDesc {
+        mesh: Some(mesh),
+        ..NodeDesc::default()
+    });
+    let yfov = 2.0 * (1.0f32 / 3.0).atan();
+    vec![
+        node,
+        camera_node(b, Vec3::new(0.0, 0.0, 3.0), Quat::IDENTITY, yfov),
+    ]
+}
+
 /// The quad's scene: emission `emit_uv` of texture 0 (× EMISSION) and base colour `base_uv` of
 /// texture `base_tex` (0 or 1), under the sky, both textures NEAREST and REPEAT.
 fn quad_scene(tag: &str, emit_uv: TexCoordDesc, base_uv: TexCoordDesc, base_tex: usize) -> Scene {
@@ -151,27 +185,9 @@ fn quad_scene(tag: &str, emit_uv: TexCoordDesc, base_uv: TexCoordDesc, base_tex:
         base_color_uv: base_uv,
         ..MaterialDesc::diffuse(tag, [1.0; 3])
     });
-    let corners = [[-QUAD, -QUAD], [QUAD, -QUAD], [QUAD, QUAD], [-QUAD, QUAD]];
-    let at = |c: &[f32; 2]| Vec3::new(c[0], c[1], 0.0);
-    let quad = PrimitiveDesc {
-        texcoords: Some(corners.iter().map(|c| uv0_at(at(c)).to_array()).collect()),
-        texcoords1: Some(corners.iter().map(|c| uv1_at(at(c)).to_array()).collect()),
-        ..PrimitiveDesc::triangles(
-            corners.iter().map(|c| [c[0], c[1], 0.0]).collect(),
-            Some(vec![[0.0, 0.0, 1.0]; 4]),
-            vec![0, 1, 2, 0, 2, 3],
-            Some(mat),
-        )
-    };
-    let mesh = b.add_mesh(tag, &[quad]);
-    let node = b.add_node(&NodeDesc {
-        mesh: Some(mesh),
-        ..NodeDesc::default()
-    });
-    let yfov = 2.0 * (1.0f32 / 3.0).atan();
-    let cam = camera_node(&mut b, Vec3::new(0.0, 0.0, 3.0), Quat::IDENTITY, yfov);
+    let roots = quad_nodes(&mut b, mat, tag);
     let sky = serde_json::json!({"environment": {"radiance": [SKY, SKY, SKY]}});
-    b.add_scene(tag, &[node, cam], Some(sky));
+    b.add_scene(tag, &roots, Some(sky));
     let scene = write_and_load(&b, &temp_dir(tag), tag);
     assert!(scene.materials[0].is_lambertian());
     scene
@@ -349,6 +365,123 @@ fn texcoord1_references_sample_the_second_set() {
         1,
     );
     render_and_check("TEXCOORD_1", &scene, &set0);
+}
+
+/// Normal-map texels: tilt θ_k = 0.07·k towards azimuth 2.4·k, encoded as glTF stores them.
+fn tilted_texels() -> Vec<u8> {
+    (0..N * N)
+        .flat_map(|k| {
+            let (theta, phi) = (0.07 * k as f32, 2.4 * k as f32);
+            let v = [
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            ];
+            let b = v.map(|c| ((c + 1.0) * 0.5 * 255.0).round() as u8);
+            [b[0], b[1], b[2], 255]
+        })
+        .collect()
+}
+
+const RHO: f32 = 0.8;
+const SUN: f32 = 2.0;
+
+/// The quad with a NEAREST normal map mapped by `normal_uv`, lit by a directional light of
+/// illuminance SUN along −Z (onto the quad, along its normal), no sky.
+fn normal_scene(tag: &str, normal_uv: TexCoordDesc) -> Scene {
+    let mut b = GltfBuilder::new();
+    let tex = b
+        .add_texture_rgba8(N as u32, N as u32, &tilted_texels(), 10497)
+        .unwrap();
+    b.set_mag_filter(tex, 9728);
+    let mat = b.add_material(&MaterialDesc {
+        normal_texture: Some((tex, 1.0)),
+        normal_uv,
+        ..MaterialDesc::diffuse(tag, [RHO; 3])
+    });
+    let mut roots = quad_nodes(&mut b, mat, tag);
+    let sun = b.add_light(&LightDesc {
+        name: Some("sun".into()),
+        kind: LightKind::Directional,
+        color: [1.0; 3],
+        intensity: SUN,
+        range: None,
+    });
+    roots.push(b.add_node(&NodeDesc {
+        light: Some(sun),
+        translation: Some([0.0, 0.0, 5.0]),
+        ..NodeDesc::default()
+    }));
+    b.add_scene(tag, &roots, None);
+    write_and_load(&b, &temp_dir(tag), tag)
+}
+
+/// Per pixel: ρ/π · E · cos θ of the normal-map texel that holds every point `at` of the pixel.
+fn expected_shading(scene: &Scene, at: &[(f64, f64)]) -> Vec<Option<[f64; 3]>> {
+    let view = scene.camera_at(0.0);
+    let r = scene.materials[0].normal_texture.unwrap();
+    let image = &scene.images[scene.textures[r.texture].image];
+    assert!(!image.srgb, "normal maps are linear");
+    let uvs = |p: Vec3| (uv0_at(p), uv1_at(p));
+    let mut out = Vec::new();
+    for py in 0..SIZE.1 {
+        for px in 0..SIZE.0 {
+            out.push(pixel_texel(&view, (px, py), at, &r, &uvs).map(|(x, y)| {
+                let t = image.texel_linear(x as u32, y as u32);
+                let v = [t.x, t.y, t.z].map(|c| 2.0 * f64::from(c) - 1.0);
+                let cos = v[2] / (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                [f64::from(RHO) / PI * f64::from(SUN) * cos; 3]
+            }));
+        }
+    }
+    out
+}
+
+#[test]
+fn a_normal_map_through_texcoord1_and_a_transform_shades_by_its_texels() {
+    let map = uv(0, Some(tt([0.15, -0.3], 2.2, [1.4, 1.1])), Some(1));
+    let scene = normal_scene("uv-normal", map);
+    let plan = scene.plan();
+    assert!(
+        plan.normal_maps && plan.texcoord1 && plan.uv_transform,
+        "{plan}"
+    );
+    let exp = expected_shading(&scene, &CORNERS);
+    let checked = exp.iter().flatten().count();
+    assert!(
+        checked >= 600,
+        "only {checked} pixels lie inside single texels"
+    );
+    let wrong = expected_shading(&normal_scene("uv-normal-as-0", uv(0, None, None)), &CENTRE);
+    let differ = exp
+        .iter()
+        .zip(&wrong)
+        .filter(|(a, b)| match (a, b) {
+            (Some(a), Some(b)) => (a[0] - b[0]).abs() > 1e-3,
+            (Some(_), None) => true,
+            _ => false,
+        })
+        .count();
+    eprintln!(
+        "normal map: {checked} pixels checked, {differ} differ under TEXCOORD_0 untransformed"
+    );
+    assert!(differ * 4 > checked * 3, "{differ} of {checked}");
+
+    let ctx = context();
+    let shaders = shaders();
+    let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
+    let path = render(&ctx, &shaders, &scene, &mut gpu, SIZE, 4, 3);
+    check("normal map, path tracer", &path.pixels, &exp);
+    let settings = IcSettings {
+        width: SIZE.0,
+        height: SIZE.1,
+        ..IcSettings::default()
+    };
+    let (ic, _) = render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {}).unwrap();
+    assert_eq!(ic.nonfinite_pixels, 0);
+    check("normal map, cache frame", &ic.pixels, &exp);
+    drop(gpu);
+    finish(ctx);
 }
 
 const FLOOR_RGB: [f32; 3] = [0.8, 0.6, 0.4];
