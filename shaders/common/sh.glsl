@@ -32,6 +32,30 @@ void sh_basis(vec3 d, out float y[SH_COEFFS]) {
     y[15] = SH_K33 * x * (x * x - 3.0 * yy * yy);
 }
 
+// A switch rather than an index into sh_basis's array: no local array indexed at run time.
+float sh_basis_one(uint i, vec3 d) {
+    float x = d.x, yy = d.y, z = d.z;
+    switch (i) {
+    case 0u: return SH_K00;
+    case 1u: return SH_K1 * yy;
+    case 2u: return SH_K1 * z;
+    case 3u: return SH_K1 * x;
+    case 4u: return SH_K2 * x * yy;
+    case 5u: return SH_K2 * yy * z;
+    case 6u: return SH_K20 * (3.0 * z * z - 1.0);
+    case 7u: return SH_K2 * x * z;
+    case 8u: return SH_K22 * (x * x - yy * yy);
+    case 9u: return SH_K33 * yy * (3.0 * x * x - yy * yy);
+    case 10u: return SH_K32 * x * yy * z;
+    case 11u: return SH_K31 * yy * (5.0 * z * z - 1.0);
+    case 12u: return SH_K30 * z * (5.0 * z * z - 3.0);
+    case 13u: return SH_K31 * x * (5.0 * z * z - 1.0);
+    case 14u: return SH_K32B * z * (x * x - yy * yy);
+    case 15u: return SH_K33 * x * (x * x - 3.0 * yy * yy);
+    default: return 0.0;
+    }
+}
+
 uint sh_band(uint i) {
     uint l = 0u;
     while ((l + 1u) * (l + 1u) <= i) {

@@ -89,9 +89,12 @@ const float SH_K32B = 1.4453057;
 const uint GLOSSY_TABLE_ROUGHNESS = 16u;
 const uint GLOSSY_TABLE_NV = 16u;
 const float GLOSSY_NV_MIN = 0.02;
+const uint RADIANCE_VEC4S = 12u;
 const float GLOSSY_ROUGHNESS_MIN = 0.6;
 
 const uint SH_TWIN_BASIS = 0u;
 const uint SH_TWIN_GLOSSY = 1u;
+const uint SH_TWIN_WEIGHTS = 2u;
+const uint SH_TWIN_BASIS_ONE = 3u;
 
 #endif

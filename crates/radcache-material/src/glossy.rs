@@ -23,7 +23,10 @@ use glam::Vec3;
 use crate::fresnel::dielectric_f0;
 use crate::ggx::{alpha_from_roughness, ggx_d, smith_v_correlated};
 use crate::sampling::{ggx_reflection_pdf, reflect, sample_ggx_vndf};
-use crate::sh::{sh_basis, sh_frame_values, sh_frame_weights, sh_view_frame, ShRgb, SH_COEFFS};
+use crate::sh::{
+    sh_band, sh_basis, sh_frame_values, sh_frame_weights, sh_view_frame, ShRgb, SH_COEFFS,
+    SH_FRAME_DIRS,
+};
 use crate::Material;
 use radcache_shared::consts::{GLOSSY_NV_MIN, GLOSSY_TABLE_NV, GLOSSY_TABLE_ROUGHNESS};
 
@@ -49,7 +52,11 @@ pub fn glossy_table_nv(i: usize) -> f32 {
 /// The lobe projections `(A, B)` (module docs) for one roughness and `n·v`, by stratified
 /// sampling of the GGX visible normals (`strata²` samples; f64 sums): each sample's weight
 /// `D·V·(n·l)/pdf` is the smooth `G2/G1`-like ratio, so few samples give a precise integral.
-pub fn glossy_projection(roughness: f32, n_dot_v: f32, strata: usize) -> ([f64; SH_COEFFS], [f64; SH_COEFFS]) {
+pub fn glossy_projection(
+    roughness: f32,
+    n_dot_v: f32,
+    strata: usize,
+) -> ([f64; SH_COEFFS], [f64; SH_COEFFS]) {
     let alpha = alpha_from_roughness(roughness);
     let nv = n_dot_v.clamp(GLOSSY_NV_MIN, 1.0);
     let v = Vec3::new((1.0 - nv * nv).max(0.0).sqrt(), 0.0, nv);
@@ -87,9 +94,8 @@ pub fn glossy_projection(roughness: f32, n_dot_v: f32, strata: usize) -> ([f64; 
 /// [`GLOSSY_ENTRY`] floats, row-major in roughness (entry `j·GLOSSY_TABLE_NV + i`): what the
 /// renderer uploads for `shaders/common/glossy.glsl`. `strata` as in [`glossy_projection`].
 pub fn glossy_table(strata: usize) -> Vec<f32> {
-    let mut out = Vec::with_capacity(
-        (GLOSSY_TABLE_ROUGHNESS * GLOSSY_TABLE_NV) as usize * GLOSSY_ENTRY,
-    );
+    let mut out =
+        Vec::with_capacity((GLOSSY_TABLE_ROUGHNESS * GLOSSY_TABLE_NV) as usize * GLOSSY_ENTRY);
     for j in 0..GLOSSY_TABLE_ROUGHNESS as usize {
         for i in 0..GLOSSY_TABLE_NV as usize {
             let (a, b) = glossy_projection(glossy_table_roughness(j), glossy_table_nv(i), strata);
@@ -154,6 +160,38 @@ pub fn glossy_radiance(table: &[f32], m: &Material, n: Vec3, v: Vec3, c: &ShRgb)
     out.max(Vec3::ZERO)
 }
 
+/// The world-space weights `W` of the glossy lobe for one pixel: `Σ_i c_i ⊙ W_i` is
+/// [`glossy_radiance`] before its clamp at 0, for every coefficient vector `c`. The frame change
+/// is linear in `c`: `value_k = Σ_{i ∈ band(k)} c_i·Y_i(M·d_k)`, so
+/// `W_i = Σ_{k: band(k) = band(i)} Y_i(M·d_k) · (K0·gA_k + K1·gB_k)`. The splat weighs each
+/// record's coefficients by them (one dot product per record and pixel, docs/radiance-caching.md
+/// §6.2); zero where `n·v ≤ 0`.
+pub fn glossy_world_weights(table: &[f32], m: &Material, n: Vec3, v: Vec3) -> ShRgb {
+    let mut w = [Vec3::ZERO; SH_COEFFS];
+    let nv = n.dot(v);
+    if nv <= 0.0 {
+        return w;
+    }
+    let (t, b, n) = sh_view_frame(n, v);
+    let g = glossy_lookup(table, m.roughness, nv);
+    let (k0, k1) = glossy_weights(m);
+    for k in 0..SH_COEFFS {
+        let d = SH_FRAME_DIRS[k];
+        let y = sh_basis(t * d.x + b * d.y + n * d.z);
+        let gk = k0 * g[k] + Vec3::splat(k1 * g[SH_COEFFS + k]);
+        let band = sh_band(k);
+        for (i, wi) in w
+            .iter_mut()
+            .enumerate()
+            .take((band + 1) * (band + 1))
+            .skip(band * band)
+        {
+            *wi += gk * y[i];
+        }
+    }
+    w
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -179,6 +217,42 @@ mod tests {
     }
 
     #[test]
+    fn world_weights_reproduce_the_glossy_radiance() {
+        let table = glossy_table(16);
+        for i in 0..50u32 {
+            let f = |k: u32| ((i * 31 + k * 17) % 97) as f32 / 97.0;
+            let n = Vec3::new(f(1) - 0.5, f(2) - 0.5, f(3) - 0.3).normalize();
+            let v = (Vec3::new(f(4) - 0.5, f(5) - 0.5, f(6) - 0.5) + n).normalize();
+            let c: ShRgb = std::array::from_fn(|k| {
+                Vec3::new(f(k as u32 + 7), f(k as u32 + 8), f(k as u32 + 9)) - 0.3
+            });
+            let m = Material::metal_rough(Vec3::new(f(10), f(11), f(12)), f(13), 0.5 + f(14) / 2.0);
+            let w = glossy_world_weights(&table, &m, n, v);
+            let by_weights: Vec3 = (0..SH_COEFFS).map(|k| c[k] * w[k]).sum();
+            let (t, b, nn) = sh_view_frame(n, v);
+            let values = sh_frame_values(&c, t, b, nn);
+            let g = glossy_lookup(&table, m.roughness, n.dot(v));
+            let (k0, k1) = glossy_weights(&m);
+            let direct: Vec3 = (0..SH_COEFFS)
+                .map(|k| values[k] * (k0 * g[k] + Vec3::splat(k1 * g[SH_COEFFS + k])))
+                .sum();
+            assert!(
+                (by_weights - direct).abs().max_element()
+                    < 1e-4 * (1.0 + direct.abs().max_element())
+            );
+            assert_eq!(
+                direct.max(Vec3::ZERO),
+                glossy_radiance(&table, &m, n, v, &c)
+            );
+        }
+        let m = Material::default();
+        assert_eq!(
+            glossy_world_weights(&table, &m, Vec3::Z, -Vec3::Z),
+            [Vec3::ZERO; SH_COEFFS]
+        );
+    }
+
+    #[test]
     fn table_convolution_matches_numerical_integration_at_the_nodes() {
         let table = glossy_table(GLOSSY_TABLE_STRATA);
         // Linear fields (exactly band-limited): the SH product is exact up to the table's
@@ -198,7 +272,10 @@ mod tests {
             let got = glossy_radiance(&table, &m, Vec3::Z, v, &c);
 
             let err = (got - expected).abs().max_element() / expected.max_element();
-            assert!(err < 5e-3, "r {roughness} nv {nv}: {got} vs {expected} ({err})");
+            assert!(
+                err < 5e-3,
+                "r {roughness} nv {nv}: {got} vs {expected} ({err})"
+            );
         }
     }
 }
@@ -311,11 +388,17 @@ mod band_limit {
             assert!(e <= limit, "roughness {r}: {e}");
         }
         let e = truncation_error(GLOSSY_ROUGHNESS_MIN, SH_BANDS - 1, &dirs, dw);
-        eprintln!("roughness {GLOSSY_ROUGHNESS_MIN}: {} bands {e:.3}", SH_BANDS - 1);
+        eprintln!(
+            "roughness {GLOSSY_ROUGHNESS_MIN}: {} bands {e:.3}",
+            SH_BANDS - 1
+        );
         assert!(e > limit, "{} bands would do: {e}", SH_BANDS - 1);
         // Below the threshold the chosen order is not enough: those lobes stay path traced.
         let e = truncation_error(GLOSSY_ROUGHNESS_MIN - 0.1, SH_BANDS, &dirs, dw);
-        eprintln!("roughness {}: {SH_BANDS} bands {e:.3}", GLOSSY_ROUGHNESS_MIN - 0.1);
+        eprintln!(
+            "roughness {}: {SH_BANDS} bands {e:.3}",
+            GLOSSY_ROUGHNESS_MIN - 0.1
+        );
         assert!(e > limit);
     }
 

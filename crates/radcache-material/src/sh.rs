@@ -50,6 +50,12 @@ pub fn sh_basis(d: Vec3) -> [f32; SH_COEFFS] {
     ]
 }
 
+/// Basis function `i` alone (`sh_basis(d)[i]`; 0 past the last): what one shader invocation
+/// evaluates when it projects one coefficient.
+pub fn sh_basis_one(i: usize, d: Vec3) -> f32 {
+    sh_basis(d).get(i).copied().unwrap_or(0.0)
+}
+
 /// The band of coefficient `i`: `⌊√i⌋`.
 pub fn sh_band(i: usize) -> usize {
     let mut l = 0;
@@ -80,8 +86,8 @@ pub fn sh_eval(l: usize, m: i32, d: DVec3) -> f64 {
         let mut p_prev = p_mm;
         let mut p_cur = z * (2 * am + 1) as f64 * p_mm;
         for ll in (am + 2)..=l {
-            let next =
-                (z * (2 * ll - 1) as f64 * p_cur - (ll + am - 1) as f64 * p_prev) / (ll - am) as f64;
+            let next = (z * (2 * ll - 1) as f64 * p_cur - (ll + am - 1) as f64 * p_prev)
+                / (ll - am) as f64;
             p_prev = p_cur;
             p_cur = next;
         }
@@ -234,7 +240,8 @@ fn frame_matrix(band: usize) -> Vec<f64> {
 fn solve(mut a: Vec<f64>, mut y: Vec<f64>) -> Option<Vec<f64>> {
     let n = y.len();
     for col in 0..n {
-        let piv = (col..n).max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))?;
+        let piv =
+            (col..n).max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))?;
         if a[piv * n + col].abs() < 1e-12 {
             return None;
         }
@@ -317,7 +324,10 @@ mod tests {
                 let l = sh_band(k);
                 let m = k as i32 - (l * l + l) as i32;
                 let e = sh_eval(l, m, d.as_dvec3());
-                assert!((f64::from(*yk) - e).abs() < 1e-6, "Y{l},{m}({d}) {yk} vs {e}");
+                assert!(
+                    (f64::from(*yk) - e).abs() < 1e-6,
+                    "Y{l},{m}({d}) {yk} vs {e}"
+                );
             }
         }
     }
@@ -369,8 +379,8 @@ mod tests {
                 for ip in 0..np {
                     let p = std::f64::consts::TAU * (ip as f64 + 0.5) / np as f64;
                     let dl = DVec3::new(r * p.cos(), r * p.sin(), z);
-                    let dw = (t.as_dvec3() * dl.x + b.as_dvec3() * dl.y + n.as_dvec3() * dl.z)
-                        .as_vec3();
+                    let dw =
+                        (t.as_dvec3() * dl.x + b.as_dvec3() * dl.y + n.as_dvec3() * dl.z).as_vec3();
                     let val = sh_reconstruct(&c, dw).as_dvec3();
                     let y = sh_basis(dl.as_vec3());
                     for k in 0..SH_COEFFS {

@@ -198,25 +198,56 @@ fn glsl_compiles() {
 /// Rust functions of [`SH_MODULES`] with no GLSL twin: the table is built on the CPU and
 /// uploaded, and the analytic fields are test references.
 const SH_CPU_ONLY: [(&str, &str); 10] = [
-    ("sh_eval", "any band in f64, by recurrence: the measurement and the check of sh_basis"),
-    ("sh_frame_weights", "folds A⁻ᵀ into the table, built on the CPU"),
+    (
+        "sh_eval",
+        "any band in f64, by recurrence: the measurement and the check of sh_basis",
+    ),
+    (
+        "sh_frame_weights",
+        "folds A⁻ᵀ into the table, built on the CPU",
+    ),
     ("frame_matrix", "part of sh_frame_weights"),
     ("solve", "part of sh_frame_weights"),
     ("glossy_projection", "builds the table on the CPU"),
     ("glossy_table", "builds the table on the CPU"),
-    ("glossy_table_roughness", "the table's grid, used where it is built"),
-    ("glossy_table_nv", "the table's grid, used where it is built"),
-    ("sh_hemisphere_constant", "an analytic radiance field for the tests"),
-    ("sh_sphere_linear", "an analytic radiance field for the tests"),
+    (
+        "glossy_table_roughness",
+        "the table's grid, used where it is built",
+    ),
+    (
+        "glossy_table_nv",
+        "the table's grid, used where it is built",
+    ),
+    (
+        "sh_hemisphere_constant",
+        "an analytic radiance field for the tests",
+    ),
+    (
+        "sh_sphere_linear",
+        "an analytic radiance field for the tests",
+    ),
 ];
 
 /// Twins whose GLSL signature differs from Rust's, with the GLSL arity and why.
-const SH_ARITY: [(&str, usize, &str); 6] = [
+const SH_ARITY: [(&str, usize, &str); 7] = [
+    (
+        "glossy_world_weights",
+        4,
+        "the table is the buffer glossy_table; W is an out array",
+    ),
     ("sh_basis", 2, "the 16 values are an out array"),
     ("sh_frame_values", 5, "the 16 values are an out array"),
-    ("sh_view_frame", 4, "t and b are out parameters (n is the input)"),
+    (
+        "sh_view_frame",
+        4,
+        "t and b are out parameters (n is the input)",
+    ),
     ("glossy_weights", 2, "K1 is an out parameter"),
-    ("glossy_lookup", 3, "the table is the buffer glossy_table; the entry is an out array"),
+    (
+        "glossy_lookup",
+        3,
+        "the table is the buffer glossy_table; the entry is an out array",
+    ),
     ("glossy_radiance", 4, "the table is the buffer glossy_table"),
 ];
 
@@ -255,8 +286,7 @@ fn sh_and_glossy_have_glsl_twins() {
     }
     assert!(twins >= 10, "{twins} twins");
     for name in glsl.keys() {
-        let known = rust.contains_key(name)
-            || name == "sh_frame_dir";
+        let known = rust.contains_key(name) || name == "sh_frame_dir";
         assert!(known, "GLSL `{name}` has no Rust reference");
     }
     let names = [

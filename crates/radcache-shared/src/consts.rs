@@ -247,6 +247,9 @@ gpu_consts! {
     pub const GLOSSY_TABLE_NV: u32 = 16;
     /// The smallest `n·v` of the glossy lobe table; views closer to the horizon use its column.
     pub const GLOSSY_NV_MIN: f32 = 0.02;
+    /// vec4s per record of the radiance coefficients (`3·SH_COEFFS` floats, packed: coefficient
+    /// `i`'s channel `c` at float `3i + c`).
+    pub const RADIANCE_VEC4S: u32 = 3 * SH_COEFFS / 4;
     /// The smallest roughness whose specular lobe is taken from radiance records: from here up
     /// the 4-band product errs by at most 10 % in a room (7.5 % at 0.6, 11.8 % at 0.55;
     /// docs/radiance-caching.md §4); sharper lobes stay path traced per pixel.
@@ -328,6 +331,10 @@ gpu_enum! {
         Basis = 0,
         /// The change of frame by evaluation, the table lookup and the glossy radiance.
         Glossy = 1,
+        /// The glossy lobe's world-space weights.
+        Weights = 2,
+        /// One basis function at a time (`sh_basis_one`).
+        BasisOne = 3,
     }
 }
 
