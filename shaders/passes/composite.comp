@@ -25,6 +25,11 @@ layout(binding = B_COMPOSITE_SPLAT_COUNT, r32f) readonly uniform image2D splat_c
 
 layout(push_constant) uniform Push { CompositePush pc; };
 
+#ifdef HAS_RADIANCE_CACHE
+// Σw·L_glossy (rgb), Σw (a): the glossy splat (passes/splat_glossy.frag; pc.glossy set).
+layout(binding = B_COMPOSITE_GLOSSY_SUM, rgba32f) readonly uniform image2D glossy_sum;
+#endif
+
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(pixel, ivec2(frame.resolution.xy)))) {
@@ -45,6 +50,17 @@ void main() {
         vec3 indirect = g.albedo * (share * INV_PI) * e;
 #else
         vec3 indirect = g.albedo * INV_PI * e;
+#endif
+#ifdef HAS_RADIANCE_CACHE
+        // The specular lobe's indirect light from the radiance records, where the glossy splat
+        // reached the pixel (its lobe rough enough: docs/radiance-caching.md §6.2); clamped at 0
+        // as a truncated SH product can dip below it.
+        if (pc.glossy != 0u) {
+            vec4 gs = imageLoad(glossy_sum, pixel);
+            if (gs.a > 0.0) {
+                indirect += max(gs.rgb / gs.a, vec3(0.0));
+            }
+        }
 #endif
         l = imageLoad(g_direct, pixel).rgb + indirect;
         emitted = g.emission;

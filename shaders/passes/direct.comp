@@ -31,6 +31,33 @@ layout(binding = B_DIRECT_RAY_COUNT, std430) buffer RayCount { uint ray_count; }
 
 layout(push_constant) uniform Push { DirectPush pc; };
 
+#ifdef HAS_RADIANCE_CACHE
+// Radiance records for glossy lobes (docs/radiance-caching.md §6.2): where pc.radiance_cache is
+// set and the pixel's roughness is at least GLOSSY_ROUGHNESS_MIN, the specular lobe's indirect
+// light comes from the records (passes/splat_glossy.frag) instead of specular_indirect's paths,
+// and this pass writes the pixel's glossy world weights for that splat.
+#define GLOSSY_TABLE_BINDING B_DIRECT_GLOSSY_TABLE
+#include "../common/glossy.glsl"
+layout(binding = B_DIRECT_GLOSSY_WEIGHTS, std430) writeonly buffer GlossyWeights { vec4 glossy_w[]; };
+
+// The world weights of pixel `index`'s lobe, packed as the records' coefficients.
+void write_glossy_weights(uint index, Bsdf f, vec3 to_viewer) {
+    vec3 w[SH_COEFFS];
+    glossy_world_weights(f.m, f.n, to_viewer, w);
+    uint base = index * RADIANCE_VEC4S;
+    for (uint q = 0u; q < RADIANCE_VEC4S; ++q) {
+        vec4 v;
+        for (uint lane = 0u; lane < 4u; ++lane) {
+            uint fi = 4u * q + lane;
+            vec3 wi = w[fi / 3u];
+            float x = wi[fi % 3u];
+            v[lane] = (isnan(x) || isinf(x)) ? 0.0 : x;
+        }
+        glossy_w[base + q] = v;
+    }
+}
+#endif
+
 const float ONE_MINUS_EPS = 0.99999994;
 
 vec3 kronecker3(uint g, vec3 shift) {
@@ -430,6 +457,12 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
 #ifdef HAS_SPECULAR
     vec3 spec = vec3(0.0);
     uint paths = max(pc.specular_paths, 1u);
+#ifdef HAS_RADIANCE_CACHE
+    if (pc.radiance_cache != 0u && f.m.roughness >= GLOSSY_ROUGHNESS_MIN) {
+        write_glossy_weights(index, f, normalize(frame.camera_position.xyz - g.position));
+        paths = 0u;
+    }
+#endif
     for (uint k = 0u; k < paths; ++k) {
         Rng spec_rng = rng_init(index, pc.sub_frame * paths + k, pc.seed ^ 0x5bd1e995u);
         vec3 e = specular_indirect(s, f, origin, spec_rng);
@@ -437,7 +470,7 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
             spec += e;
         }
     }
-    light.rest = sum / float(n) + punctual_brdf(s, f, origin) + spec / float(paths);
+    light.rest = sum / float(n) + punctual_brdf(s, f, origin) + spec / float(max(paths, 1u));
 #else
     light.rest = sum / float(n) + punctual(s, origin);
 #endif

@@ -41,6 +41,14 @@
 // fails), R_orig = IC_FAR (it clamps no neighbour) and R⁻ = R⁺ = R_FLOOR (its splat is empty);
 // it is flagged and counted in rejected_records. No field is ever NaN or Inf.
 //
+// Radiance records (HAS_RADIANCE_CACHE, docs/radiance-caching.md §6.1): the same strata are
+// projected a second time, onto the 16 real SH coefficients of the incoming radiance per channel
+// (common/sh.glsl, world space), each stratum weighted by its solid angle
+// (2π/N)·(√(1 − j/M) − √(1 − (j+1)/M)) at its (folded) direction; strata that escaped are left
+// out (the light straight from the sky is the direct pass's for the specular lobe). Invocation
+// i < SH_COEFFS sums coefficient i; they go to B_RECORD_RADIANCE at RADIANCE_VEC4S·index when
+// that buffer is large enough. A non-finite coefficient is stored as 0.
+//
 // Optional sample dump (tests): when the buffer bound at B_GBUFFER_END + 4 holds at least
 // (i + 1)·M·N vec4, request i writes (L_jk, r_jk) of its strata at i·M·N + j·N + k.
 #version 460
@@ -64,6 +72,11 @@ layout(binding = B_RECORD_RAY_COUNT, std430) buffer RayCount { uint ray_count; }
 layout(binding = B_RECORD_SAMPLES, std430) writeonly buffer Samples { vec4 samples[]; };
 
 layout(push_constant) uniform Push { RecordPush pc; };
+
+#ifdef HAS_RADIANCE_CACHE
+#include "../common/sh.glsl"
+layout(binding = B_RECORD_RADIANCE, std430) writeonly buffer Radiance { vec4 radiance[]; };
+#endif
 
 // Level and sub-frame of the record being written (a refreshed record keeps its own).
 uint g_level_subframe;
@@ -150,6 +163,47 @@ vec4 hessian_share(uint lid, uint m, uint n, uint seed, float r_eps) {
         acc += hessian_cell(a, b, c, d, bl, au, vec4(ya, yb, yc, yd), y_bl, y_au, y_cap, j == 0u, j + 1u == m);
     }
     return acc;
+}
+#endif
+
+// Stratum i's gather direction, as begin_stratum draws it (folded above the geometric surface).
+vec3 stratum_direction(uint i, uint n, uint m, vec3 t, vec3 b, vec3 nn, vec3 ng, uint record_seed) {
+    float xi, psi;
+    stratum_jitter(record_seed, i, xi, psi);
+    vec3 dir = frame_to_world(stratum_direction_local(i / n, i % n, m, n, xi, psi), t, b, nn);
+    float below = dot(dir, ng);
+    return below <= 0.0 ? normalize(dir - 2.0 * below * ng) : dir;
+}
+
+#ifdef HAS_RADIANCE_CACHE
+// Invocation lid < SH_COEFFS: coefficient lid of record `index`'s radiance (see the header).
+void project_radiance(uint lid, uint index, uint m, uint n, vec3 t, vec3 b, vec3 nn, vec3 ng,
+                      uint record_seed) {
+    if (lid >= SH_COEFFS || uint(radiance.length()) < (index + 1u) * RADIANCE_VEC4S) {
+        return;
+    }
+    vec3 acc = vec3(0.0);
+    float d_phi = 2.0 * IC_PI / float(n);
+    for (uint j = 0u; j < m; ++j) {
+        float omega = d_phi * (sqrt(max(1.0 - float(j) / float(m), 0.0)) -
+                               sqrt(max(1.0 - float(j + 1u) / float(m), 0.0)));
+        for (uint k = 0u; k < n; ++k) {
+            uint i = stratum_index(j, k, n);
+            if (s_r[i] >= IC_FAR) {
+                continue;
+            }
+            vec3 dir = stratum_direction(i, n, m, t, b, nn, ng, record_seed);
+            acc += stratum_l(i) * (omega * sh_basis_one(lid, dir));
+        }
+    }
+    if (any(isnan(acc)) || any(isinf(acc))) {
+        acc = vec3(0.0);
+    }
+    uint base = index * RADIANCE_VEC4S;
+    for (uint c = 0u; c < 3u; ++c) {
+        uint f = 3u * lid + c;
+        radiance[base + f / 4u][f % 4u] = acc[c];
+    }
 }
 #endif
 
@@ -319,6 +373,9 @@ void main() {
     }
     atomicAdd(s_rays, rays_traced);
     barrier();
+#ifdef HAS_RADIANCE_CACHE
+    project_radiance(lid, index, m, n, t, b, nn, ng, record_seed);
+#endif
 #ifdef IC_HESSIAN
     vec4 share = hessian_share(lid, m, n, record_seed, pc.r_eps_rel * frame.camera_position.w);
     s_hessian[lid] = share;

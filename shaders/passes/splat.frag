@@ -25,9 +25,7 @@ void main() {
     GpuRecord rec = records[v_record];
     vec3 p_i = rec.position_radius.xyz;
     vec3 n_i = rec.normal_rorig.xyz;
-    float r_i = record_radius(rec);
-    float tol = pc.front_tol_px * g.footprint;
-    float w = record_weight(pc.kind, g.position, g.normal, p_i, n_i, r_i, pc.param, tol);
+    float w = splat_weight_at(g, rec);
     if (!(w > pc.w_min)) {
         discard;
     }

@@ -23,4 +23,17 @@ float splat_extent(GpuRecord rec) {
     return splat_radius(pc.kind, record_radius(rec), pc.param, pc.w_min);
 }
 
+#ifdef RADCACHE_GBUFFER_GLSL
+// The weight of record `rec` at the G-buffer sample g: the pass's weight with the normal and
+// in-front tests (0 outside the record's zone; splat.frag and splat_glossy.frag discard at or
+// below pc.w_min).
+float splat_weight_at(GSample g, GpuRecord rec) {
+    vec3 p_i = rec.position_radius.xyz;
+    vec3 n_i = rec.normal_rorig.xyz;
+    float r_i = record_radius(rec);
+    float tol = pc.front_tol_px * g.footprint;
+    return record_weight(pc.kind, g.position, g.normal, p_i, n_i, r_i, pc.param, tol);
+}
+#endif
+
 #endif

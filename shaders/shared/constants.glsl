@@ -74,4 +74,27 @@ const uint BRDF_TWIN_TERMS = 0u;
 const uint BRDF_TWIN_BRDF = 1u;
 const uint BRDF_TWIN_POLYGON = 2u;
 
+const uint SH_BANDS = 4u;
+const uint SH_COEFFS = 16u;
+const float SH_K00 = 0.28209478;
+const float SH_K1 = 0.48860252;
+const float SH_K2 = 1.0925484;
+const float SH_K20 = 0.31539157;
+const float SH_K22 = 0.5462742;
+const float SH_K33 = 0.5900436;
+const float SH_K32 = 2.8906114;
+const float SH_K31 = 0.4570458;
+const float SH_K30 = 0.37317634;
+const float SH_K32B = 1.4453057;
+const uint GLOSSY_TABLE_ROUGHNESS = 16u;
+const uint GLOSSY_TABLE_NV = 16u;
+const float GLOSSY_NV_MIN = 0.02;
+const uint RADIANCE_VEC4S = 12u;
+const float GLOSSY_ROUGHNESS_MIN = 0.6;
+
+const uint SH_TWIN_BASIS = 0u;
+const uint SH_TWIN_GLOSSY = 1u;
+const uint SH_TWIN_WEIGHTS = 2u;
+const uint SH_TWIN_BASIS_ONE = 3u;
+
 #endif

@@ -5,7 +5,7 @@
 struct CompositePush {
     vec2 jitter;
     uint debug;
-    uint pad;
+    uint glossy;
 };  // 16 bytes
 
 struct DirectPush {
@@ -13,7 +13,11 @@ struct DirectPush {
     uint seed;
     uint sub_frame;
     uint specular_paths;
-};  // 16 bytes
+    uint radiance_cache;
+    uint pad0;
+    uint pad1;
+    uint pad2;
+};  // 32 bytes
 
 struct GBufferPush {
     uint instance;

@@ -7,7 +7,7 @@ use glam::Vec3;
 use radcache_vk::{vk, Access, BindingKind, BindingLayout, Context, Pipeline, Resource};
 
 use crate::Rng;
-pub use radcache_shared::consts::{BrdfTwinMode, TwinMode};
+pub use radcache_shared::consts::{BrdfTwinMode, ShTwinMode, TwinMode};
 
 /// The pipeline of the twin shader `shaders/tests/<file>`: its three storage buffers (inputs,
 /// outputs, samples) and the 8-byte push block `{mode, count}`.
@@ -28,6 +28,12 @@ pub trait ShaderMode: Copy {
 }
 
 impl ShaderMode for TwinMode {
+    fn bits(self) -> u32 {
+        self as u32
+    }
+}
+
+impl ShaderMode for ShTwinMode {
     fn bits(self) -> u32 {
         self as u32
     }

@@ -234,7 +234,8 @@ pub fn run(args: &ConvergenceArgs) -> Result<ExitCode> {
         Weight::Tl => WeightKind::TabellionLamorlette,
         Weight::Ward => WeightKind::Ward,
     };
-    for case in ladder::ic_cases(weight, args.quick) {
+    let glossy = scene.plan().radiance_cache();
+    for case in ladder::ic_cases(weight, args.quick, glossy) {
         let p = bench.ic(&mut gpu, &reference, &case)?;
         say(format!(
             "IC {:>14}: {:8.3} s, relMSE {:.3e}",
@@ -289,6 +290,22 @@ fn analyse(points: &mut [Point], reference_spp: Option<u32>) -> (Option<f64>, f6
         .collect();
     for p in points.iter_mut().filter(|p| p.ic.is_some()) {
         p.matched = model::pt_time_to_match(&curve, p.own_relmse);
+    }
+    // The per-pixel glossy paths' curve, over the presets (scenes with radiance records).
+    let paths: Vec<PtPoint> = points
+        .iter()
+        .filter(|p| p.ladder == Ladder::GlossyPaths)
+        .enumerate()
+        .map(|(i, p)| PtPoint {
+            spp: i as u32 + 1,
+            time_s: p.wall_s,
+            error: p.own_relmse,
+        })
+        .collect();
+    if !paths.is_empty() {
+        for p in points.iter_mut().filter(|p| p.ladder == Ladder::Preset) {
+            p.matched_paths = model::pt_time_to_match(&paths, p.own_relmse);
+        }
     }
     let xy: Vec<(f64, f64)> = points
         .iter()

@@ -169,6 +169,7 @@ pub fn ic_settings(ic: &IcArgs, size: (u32, u32), seed: u32) -> Result<IcSetting
         sub_frames: ic.sub_frames.unwrap_or(defaults.sub_frames).max(1),
         direct_samples: ic.direct_samples.unwrap_or(defaults.direct_samples).max(1),
         sky: ic.sky_light(),
+        glossy: ic.glossy_light(),
         emitters: ic.emitter_light(),
         seed,
         ..defaults

@@ -13,6 +13,8 @@
 //! | [`sampling`] | cosine and GGX visible-normal sampling, lobe choice, the mixture pdf | §5 |
 //! | [`polygon`] | the irradiance of a uniformly emitting triangle on a Lambertian receiver (Lambert's formula, horizon-clipped) | §7 |
 //! | [`normal_map`] | the shading normal from a normal-map texel, kept on the geometric side | §12 |
+//! | [`sh`] | real spherical harmonics, bands 0–3: basis, projection, change of frame by evaluation | radiance-caching §2–§3 |
+//! | [`glossy`] | the specular lobe's projection table and the glossy radiance of SH coefficients | radiance-caching §3 |
 //!
 //! **GLSL twin.** `shaders/common/brdf.glsl` (`polygon.glsl`, `normal_map.glsl` for those
 //! modules) mirrors the functions one to one (checked by `tests/glsl.rs`; values compared on
@@ -30,9 +32,11 @@
 pub mod brdf;
 pub mod fresnel;
 pub mod ggx;
+pub mod glossy;
 pub mod normal_map;
 pub mod polygon;
 pub mod sampling;
+pub mod sh;
 
 pub use brdf::{brdf_eval, brdf_eval_lobes, diffuse_share, BrdfLobes, Material};
 pub use normal_map::normal_map_normal;

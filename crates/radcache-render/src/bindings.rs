@@ -202,6 +202,8 @@ pass_bindings! {
         DEBUG_ACCUM: StorageBuffer,
         /// Records reaching each pixel (the splat's count target).
         SPLAT_COUNT: StorageImage,
+        /// Σw·L_glossy (rgb), Σw (a): the glossy splat's target (read with `HAS_RADIANCE_CACHE`).
+        GLOSSY_SUM: StorageImage,
     }
 }
 
@@ -210,6 +212,11 @@ pass_bindings! {
     pub mod direct("DIRECT", base = GBUFFER_END, prefix = [SCENE, GBUFFER]) {
         /// Ray queries traced (`uint`).
         RAY_COUNT: StorageBuffer,
+        /// Each pixel's glossy world weights (`vec4[12 per pixel]`, written with
+        /// `HAS_RADIANCE_CACHE`; docs/radiance-caching.md §6.2).
+        GLOSSY_WEIGHTS: StorageBuffer,
+        /// The glossy lobe's SH table (`float[]`, read with `HAS_RADIANCE_CACHE`).
+        GLOSSY_TABLE: StorageBuffer,
     }
 }
 
@@ -286,6 +293,9 @@ pass_bindings! {
         RAY_COUNT: StorageBuffer,
         /// Stratum samples, for the twin tests (`vec4[]`).
         SAMPLES: StorageBuffer,
+        /// The records' radiance coefficients (`vec4[12 per record]`, written with
+        /// `HAS_RADIANCE_CACHE` where large enough; docs/radiance-caching.md §6.1).
+        RADIANCE: StorageBuffer,
     }
 }
 
@@ -298,6 +308,25 @@ pass_bindings! {
         LAST_USED: StorageBuffer,
     }
 }
+
+pass_bindings! {
+    /// `passes/splat.vert` + `splat_glossy.frag`: the records' radiance, weighted by each pixel's
+    /// glossy lobe, into the glossy target. Its first two bindings are the splat's (the vertex
+    /// shader is shared).
+    pub mod splat_glossy("SPLAT_GLOSSY", base = GBUFFER_END, prefix = [FRAME_ONLY, GBUFFER]) {
+        /// `GpuRecord[]`.
+        RECORDS: StorageBuffer,
+        /// Last frame each record weighed on a pixel (`uint[]`; not written here).
+        LAST_USED: StorageBuffer,
+        /// The records' radiance coefficients (`vec4[12 per record]`).
+        RADIANCE: StorageBuffer,
+        /// Each pixel's glossy world weights (`vec4[12 per pixel]`).
+        GLOSSY_WEIGHTS: StorageBuffer,
+    }
+}
+
+const _: () = assert!(splat_glossy::RECORDS == splat::RECORDS);
+const _: () = assert!(splat_glossy::LAST_USED == splat::LAST_USED);
 
 pass_bindings! {
     /// `passes/temporal.comp`: the records' temporal lifecycle.
@@ -362,6 +391,7 @@ pub fn generated_glsl() -> String {
         path_trace::glsl(),
         record::glsl(),
         splat::glsl(),
+        splat_glossy::glsl(),
         temporal::glsl(),
     ] {
         s.push('\n');

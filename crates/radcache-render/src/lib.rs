@@ -24,7 +24,9 @@ pub use error::{Error, Result};
 pub use frame::clock::{Span, Track};
 pub use frame::ic::{render_ic, IcRenderer};
 pub use frame::path::{render_path, Budget, FrameOutput, PathSettings, Progress};
-pub use frame::settings::{sub_frame_jitter, EmitterLight, IcDebug, IcSettings, IcStats, SkyLight};
+pub use frame::settings::{
+    sub_frame_jitter, EmitterLight, GlossyLight, IcDebug, IcSettings, IcStats, SkyLight,
+};
 pub use passes::aov::{render_aovs, AovPass, Aovs};
 pub use passes::composite::CompositePass;
 pub use passes::direct::DirectPass;
@@ -40,6 +42,7 @@ pub use passes::record::{
 };
 pub use passes::record::{RecordPass, MAX_STRATA, R_EPS_REL};
 pub use passes::splat::{SplatPass, SplatScope, SplatWeights};
+pub use passes::splat_glossy::GlossySplatPass;
 pub use passes::temporal::{Lifespans, TemporalPass};
 pub use scene::env_map::{gpu_alias, texel_solid_angle, EnvMap};
 pub use scene::upload::vulkan_clip_from_view;

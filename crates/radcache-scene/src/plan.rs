@@ -8,6 +8,8 @@
 
 use std::fmt;
 
+use radcache_shared::consts::GLOSSY_ROUGHNESS_MIN;
+
 use crate::environment::Environment;
 use crate::light::LightKind;
 use crate::scene::Scene;
@@ -91,6 +93,11 @@ pub struct ScenePlan {
     /// compile the full metallic-roughness BRDF (`HAS_SPECULAR`). False when every material is
     /// Lambertian ([`Material::is_lambertian`](crate::Material::is_lambertian)).
     pub specular: bool,
+    /// Materials whose specular lobe is rough enough for the radiance records
+    /// (docs/radiance-caching.md §4): not Lambertian, roughness factor at or above
+    /// `GLOSSY_ROUGHNESS_MIN` (a roughness texture can only lower it; pixels below the threshold
+    /// keep the per-pixel specular paths). Zero: no radiance records, nothing of them compiled.
+    pub glossy_materials: usize,
     /// Some material's surface may be missing in places (alpha mode MASK or BLEND,
     /// [`Material::has_alpha`](crate::Material::has_alpha)): the passes compile the alpha test
     /// (`HAS_ALPHA`) into every ray query and the G-buffer, and the geometry of those materials is
@@ -152,7 +159,13 @@ impl ScenePlan {
         let count = emitters.triangles.len();
         let specular = scene.materials.iter().any(|m| !m.is_lambertian());
         let alpha = scene.materials.iter().any(|m| m.has_alpha());
+        let glossy_materials = scene
+            .materials
+            .iter()
+            .filter(|m| !m.is_lambertian() && m.roughness >= GLOSSY_ROUGHNESS_MIN)
+            .count();
         ScenePlan {
+            glossy_materials,
             analytic_emitters: count > 0
                 && count <= ANALYTIC_EMITTERS_MAX
                 && !textured_emission
@@ -184,6 +197,11 @@ impl ScenePlan {
     /// The scene has emissive triangles.
     pub fn has_emissive(&self) -> bool {
         self.emissive_triangles > 0
+    }
+
+    /// The cache caches incoming radiance for glossy lobes ([`ScenePlan::glossy_materials`]).
+    pub fn radiance_cache(&self) -> bool {
+        self.glossy_materials > 0
     }
 
     /// The scene has punctual lights.
@@ -265,6 +283,23 @@ impl fmt::Display for ScenePlan {
                 "lambertian only (no specular code compiled)"
             }
         )?;
+        if self.specular {
+            if self.radiance_cache() {
+                writeln!(
+                    f,
+                    "  glossy lobes: radiance records for roughness ≥ {GLOSSY_ROUGHNESS_MIN} \
+                     ({} material{}; sharper lobes path traced per pixel)",
+                    self.glossy_materials,
+                    if self.glossy_materials == 1 { "" } else { "s" }
+                )?;
+            } else {
+                writeln!(
+                    f,
+                    "  glossy lobes: none at roughness ≥ {GLOSSY_ROUGHNESS_MIN} (specular light \
+                     path traced per pixel; no radiance records)"
+                )?;
+            }
+        }
         writeln!(
             f,
             "  normal maps: {}",

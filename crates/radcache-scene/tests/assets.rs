@@ -331,6 +331,7 @@ fn repository_assets_are_up_to_date() {
         "cornell_fly",
         "courtyard",
         "metal_spheres",
+        "glossy_room",
     ] {
         for ext in ["gltf", "bin"] {
             let rel = format!("{name}/{name}.{ext}");

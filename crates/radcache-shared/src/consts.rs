@@ -213,6 +213,49 @@ gpu_consts! {
     pub const NORMAL_MAP_COS_MIN: f32 = 0.05;
 }
 
+gpu_consts! {
+    /// The radiance-caching constants' GLSL (`radcache-material`'s `sh`/`glossy` and
+    /// `shaders/common/sh.glsl`, `glossy.glsl`; docs/radiance-caching.md).
+    fn glossy_glsl;
+    /// Bands of the spherical harmonics of a radiance record (0 to 3; §4).
+    pub const SH_BANDS: u32 = 4;
+    /// Coefficients per colour channel of a radiance record: `SH_BANDS²`.
+    pub const SH_COEFFS: u32 = SH_BANDS * SH_BANDS;
+    /// `1/(2√π)`: `Y_0^0`.
+    pub const SH_K00: f32 = 0.282_094_79;
+    /// `√(3/(4π))`: band 1.
+    pub const SH_K1: f32 = 0.488_602_51;
+    /// `√(15/(4π))`: `Y_2^{-2}`, `Y_2^{-1}`, `Y_2^1`.
+    pub const SH_K2: f32 = 1.092_548_4;
+    /// `√(5/(16π))`: `Y_2^0`.
+    pub const SH_K20: f32 = 0.315_391_57;
+    /// `√(15/(16π))`: `Y_2^2`.
+    pub const SH_K22: f32 = 0.546_274_2;
+    /// `√(35/(32π))`: `Y_3^{±3}`.
+    pub const SH_K33: f32 = 0.590_043_6;
+    /// `√(105/(4π))`: `Y_3^{-2}`.
+    pub const SH_K32: f32 = 2.890_611_4;
+    /// `√(21/(32π))`: `Y_3^{±1}`.
+    pub const SH_K31: f32 = 0.457_045_8;
+    /// `√(7/(16π))`: `Y_3^0`.
+    pub const SH_K30: f32 = 0.373_176_33;
+    /// `√(105/(16π))`: `Y_3^2`.
+    pub const SH_K32B: f32 = 1.445_305_7;
+    /// Rows of the glossy lobe table: roughness `j/(GLOSSY_TABLE_ROUGHNESS − 1)` over `[0, 1]`.
+    pub const GLOSSY_TABLE_ROUGHNESS: u32 = 16;
+    /// Columns of the glossy lobe table: `n·v` from `GLOSSY_NV_MIN` to 1, evenly spaced.
+    pub const GLOSSY_TABLE_NV: u32 = 16;
+    /// The smallest `n·v` of the glossy lobe table; views closer to the horizon use its column.
+    pub const GLOSSY_NV_MIN: f32 = 0.02;
+    /// vec4s per record of the radiance coefficients (`3·SH_COEFFS` floats, packed: coefficient
+    /// `i`'s channel `c` at float `3i + c`).
+    pub const RADIANCE_VEC4S: u32 = 3 * SH_COEFFS / 4;
+    /// The smallest roughness whose specular lobe is taken from radiance records: from here up
+    /// the 4-band product errs by at most 10 % in a room (7.5 % at 0.6, 11.8 % at 0.55;
+    /// docs/radiance-caching.md §4); sharper lobes stay path traced per pixel.
+    pub const GLOSSY_ROUGHNESS_MIN: f32 = 0.6;
+}
+
 gpu_enum! {
     /// The steps of the cache's counter bookkeeping (`shaders/passes/ic_counters.comp`).
     pub enum CounterStep("COUNTERS") {
@@ -282,6 +325,20 @@ gpu_enum! {
 }
 
 gpu_enum! {
+    /// The function families of the spherical-harmonics twin test (`shaders/tests/sh_twin.comp`).
+    pub enum ShTwinMode("SH_TWIN") {
+        /// The basis, projection and reconstruction.
+        Basis = 0,
+        /// The change of frame by evaluation, the table lookup and the glossy radiance.
+        Glossy = 1,
+        /// The glossy lobe's world-space weights.
+        Weights = 2,
+        /// One basis function at a time (`sh_basis_one`).
+        BasisOne = 3,
+    }
+}
+
+gpu_enum! {
     /// The formula families of the GLSL twin test (`shaders/tests/ircache_twin.comp`).
     pub enum TwinMode("TWIN") {
         /// Stratified hemisphere sampling and hashing.
@@ -319,6 +376,8 @@ pub fn generated_glsl() -> String {
         TwinMode::glsl(),
         material_glsl(),
         BrdfTwinMode::glsl(),
+        glossy_glsl(),
+        ShTwinMode::glsl(),
     ] {
         s.push_str(&part);
         s.push('\n');

@@ -51,6 +51,12 @@ pub fn assert_constants_generated(file: &str, text: &str, names: &[&str]) {
 /// and runs `main_body` compiles with `glslangValidator` for Vulkan 1.2. `main_body` may write
 /// `o.v[i]` (a `vec4` buffer at binding 0). A machine without the tool fails.
 pub fn assert_compiles_with_glslang(dir: &Path, file: &str, main_body: &str) {
+    assert_compiles_with_glslang_after(dir, file, "", main_body);
+}
+
+/// [`assert_compiles_with_glslang`] with `prelude` (e.g. `#define`s the file needs) placed
+/// before the includes.
+pub fn assert_compiles_with_glslang_after(dir: &Path, file: &str, prelude: &str, main_body: &str) {
     let out = Command::new("glslangValidator")
         .arg("--version")
         .output()
@@ -67,7 +73,7 @@ pub fn assert_compiles_with_glslang(dir: &Path, file: &str, main_body: &str) {
     std::fs::create_dir_all(&tmp).unwrap();
     let wrapper = tmp.join("wrap.comp");
     let source = format!(
-        "#version 460\n#extension GL_GOOGLE_include_directive : require\n#include \"{file}\"\n\
+        "#version 460\n#extension GL_GOOGLE_include_directive : require\n{prelude}\n#include \"{file}\"\n\
          #include \"{file}\"\nlayout(local_size_x = 1) in;\n\
          layout(std430, binding = 0) buffer Out {{ vec4 v[]; }} o;\n\
          void main() {{ {main_body} }}\n"

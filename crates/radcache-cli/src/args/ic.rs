@@ -4,7 +4,7 @@
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 use radcache_cache::{ErrorControl, IcParams, Preset, WeightKind};
-use radcache_render::{EmitterLight, SkyLight};
+use radcache_render::{EmitterLight, GlossyLight, SkyLight};
 
 /// Cache quality preset.
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -44,6 +44,16 @@ pub enum Emitters {
     Analytic,
     /// Light and BSDF sampling with MIS.
     Sampled,
+}
+
+/// Where glossy lobes take their indirect light from in a cache frame.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Glossy {
+    /// Radiance records for lobes of roughness ≥ 0.6 (default; where the plan has such
+    /// materials, see `radcache info`), sharper lobes path traced per pixel.
+    Records,
+    /// Every lobe's indirect light path traced per pixel.
+    Paths,
 }
 
 /// The rule that sets a record's radius.
@@ -91,6 +101,9 @@ pub struct IcArgs {
     /// How the direct pass estimates the light of emissive triangles (`--method ic`).
     #[arg(long, value_enum, default_value_t = Emitters::Analytic)]
     pub emitters: Emitters,
+    /// Where glossy lobes take their indirect light from (`--method ic`).
+    #[arg(long, value_enum, default_value_t = Glossy::Records)]
+    pub glossy: Glossy,
 }
 
 fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T)> {
@@ -112,6 +125,14 @@ impl IcArgs {
         match self.emitters {
             Emitters::Analytic => EmitterLight::Analytic,
             Emitters::Sampled => EmitterLight::Sampled,
+        }
+    }
+
+    /// Where glossy lobes' indirect light comes from.
+    pub fn glossy_light(&self) -> GlossyLight {
+        match self.glossy {
+            Glossy::Records => GlossyLight::Records,
+            Glossy::Paths => GlossyLight::Paths,
         }
     }
 

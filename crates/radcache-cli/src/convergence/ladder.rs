@@ -5,7 +5,7 @@ use anyhow::{Context as _, Result};
 use radcache_cache::{IcParams, Preset, WeightKind};
 use radcache_image::{compare, Image, Metrics};
 use radcache_render::{
-    render_ic, render_path, Budget, FrameOutput, GpuScene, IcSettings, PathSettings,
+    render_ic, render_path, Budget, FrameOutput, GlossyLight, GpuScene, IcSettings, PathSettings,
 };
 use radcache_scene::Scene;
 use radcache_vk::{Context, ShaderCompiler};
@@ -30,6 +30,10 @@ pub enum Ladder {
     Accuracy,
     /// The cache's hemisphere strata around the default preset.
     Strata,
+    /// The cache's presets with the glossy lobes' indirect light path traced per pixel
+    /// (`GlossyLight::Paths`), in scenes with radiance records (docs/radiance-caching.md): the
+    /// curve the [`Ladder::Preset`] points' per-pixel time to the same error is read from.
+    GlossyPaths,
 }
 
 impl Ladder {
@@ -40,6 +44,7 @@ impl Ladder {
             Ladder::Preset => "preset",
             Ladder::Accuracy => "accuracy",
             Ladder::Strata => "strata",
+            Ladder::GlossyPaths => "glossy_paths",
         }
     }
 }
@@ -55,6 +60,8 @@ pub struct IcCase {
     pub preset: Preset,
     /// Its parameters.
     pub params: IcParams,
+    /// Where glossy lobes' indirect light comes from.
+    pub glossy: GlossyLight,
 }
 
 /// A rendered and measured point of any ladder.
@@ -82,6 +89,9 @@ pub struct Point {
     pub own_relmse: f64,
     /// The path tracer's time to reach this point's own relMSE (cache only).
     pub matched: Option<Match>,
+    /// The per-pixel glossy paths' time to reach this point's own relMSE ([`Ladder::Preset`]
+    /// points of scenes with radiance records).
+    pub matched_paths: Option<Match>,
     /// On the Pareto front of relMSE against wall time.
     pub pareto: bool,
 }
@@ -137,8 +147,10 @@ pub fn preset_name(preset: Preset) -> &'static str {
 /// The cache's points: the three presets; the accuracy of `weight` (Ward's `a`, or T&L's `κ`
 /// through `a = 1/κ`) at the default preset's value × 2, 1.5, 0.75 and 0.5 (`quick`: × 2 and
 /// 0.5); the strata 4×12, 8×24 and 24×72 (`quick`: 4×12 and 8×24) at the default preset
-/// otherwise. The default preset (16×48) is the centre of both sweeps.
-pub fn ic_cases(weight: WeightKind, quick: bool) -> Vec<IcCase> {
+/// otherwise. The default preset (16×48) is the centre of both sweeps. With `glossy` (the scene
+/// has radiance records) the three presets again with per-pixel glossy paths
+/// ([`Ladder::GlossyPaths`]).
+pub fn ic_cases(weight: WeightKind, quick: bool, glossy: bool) -> Vec<IcCase> {
     let with_weight = |preset| IcParams {
         weight_kind: weight,
         ..IcParams::preset(preset)
@@ -150,8 +162,20 @@ pub fn ic_cases(weight: WeightKind, quick: bool) -> Vec<IcCase> {
             label: preset_name(preset).to_string(),
             preset,
             params: with_weight(preset),
+            glossy: GlossyLight::Records,
         })
         .collect();
+    if glossy {
+        for preset in [Preset::Draft, Preset::Default, Preset::High] {
+            cases.push(IcCase {
+                ladder: Ladder::GlossyPaths,
+                label: format!("{} glossy paths", preset_name(preset)),
+                preset,
+                params: with_weight(preset),
+                glossy: GlossyLight::Paths,
+            });
+        }
+    }
     let base = with_weight(Preset::Default);
     let factors: &[f32] = if quick {
         &[2.0, 0.5]
@@ -176,6 +200,7 @@ pub fn ic_cases(weight: WeightKind, quick: bool) -> Vec<IcCase> {
             label,
             preset: Preset::Default,
             params,
+            glossy: GlossyLight::Records,
         });
     }
     let strata: &[(u32, u32)] = if quick {
@@ -191,6 +216,7 @@ pub fn ic_cases(weight: WeightKind, quick: bool) -> Vec<IcCase> {
             label: format!("strata {m}x{n}"),
             preset: Preset::Default,
             params,
+            glossy: GlossyLight::Records,
         });
     }
     cases
@@ -256,6 +282,14 @@ impl Bench<'_> {
         };
         render_ic(self.ctx, self.shaders, self.scene, gpu, &ic, &mut |_| {})
             .context("warm-up frame of the cache")?;
+        if self.scene.plan().radiance_cache() {
+            let paths = IcSettings {
+                glossy: GlossyLight::Paths,
+                ..ic
+            };
+            render_ic(self.ctx, self.shaders, self.scene, gpu, &paths, &mut |_| {})
+                .context("warm-up frame of the cache with per-pixel glossy paths")?;
+        }
         let mut pt = self.path_settings(1, REFERENCE_SEED);
         (pt.width, pt.height) = (16, 16);
         render_path(self.ctx, self.shaders, self.scene, gpu, &pt, &mut |_| {})
@@ -310,6 +344,7 @@ impl Bench<'_> {
             seed: IC_SEED,
             frame: self.frame,
             time: self.time,
+            glossy: case.glossy,
             ..IcSettings::default()
         };
         let (out, stats) = render_ic(
@@ -347,6 +382,7 @@ fn measure(out: FrameOutput, reference: &Image, ladder: Ladder, label: String) -
         own_relmse: metrics.relmse,
         metrics,
         matched: None,
+        matched_paths: None,
         pareto: false,
     })
 }
@@ -363,7 +399,7 @@ mod tests {
 
     #[test]
     fn accuracy_sweep_varies_the_selected_weights_parameter() {
-        let tl = ic_cases(WeightKind::TabellionLamorlette, true);
+        let tl = ic_cases(WeightKind::TabellionLamorlette, true, false);
         let labels: Vec<&str> = tl.iter().map(|c| c.label.as_str()).collect();
         assert_eq!(
             labels,
@@ -379,7 +415,7 @@ mod tests {
         );
         assert_eq!(tl[3].params.kappa, IcParams::default().kappa / 2.0);
         assert_eq!(tl[3].params.accuracy, IcParams::default().accuracy);
-        let ward = ic_cases(WeightKind::Ward, false);
+        let ward = ic_cases(WeightKind::Ward, false, false);
         let sweep: Vec<f32> = ward
             .iter()
             .filter(|c| c.ladder == Ladder::Accuracy)
@@ -394,5 +430,27 @@ mod tests {
             .iter()
             .all(|c| c.params.weight_kind == WeightKind::Ward));
         assert!(ward.iter().all(|c| c.params.is_valid()));
+        assert!(ward.iter().all(|c| c.glossy == GlossyLight::Records));
+    }
+
+    #[test]
+    fn glossy_scenes_add_the_presets_with_per_pixel_paths() {
+        let cases = ic_cases(WeightKind::TabellionLamorlette, true, true);
+        let paths: Vec<&IcCase> = cases
+            .iter()
+            .filter(|c| c.ladder == Ladder::GlossyPaths)
+            .collect();
+        let labels: Vec<&str> = paths.iter().map(|c| c.label.as_str()).collect();
+        assert_eq!(
+            labels,
+            [
+                "draft glossy paths",
+                "default glossy paths",
+                "high glossy paths"
+            ]
+        );
+        assert!(paths.iter().all(|c| c.glossy == GlossyLight::Paths));
+        let presets = cases.iter().filter(|c| c.ladder == Ladder::Preset);
+        assert!(presets.clone().count() == 3 && presets.all(|c| c.glossy == GlossyLight::Records));
     }
 }

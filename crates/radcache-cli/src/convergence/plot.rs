@@ -65,7 +65,9 @@ struct Series {
 fn order_key(p: &Point, ladder: Ladder) -> f64 {
     match (&p.ic, ladder) {
         (None, _) => f64::from(p.spp.unwrap_or(0)),
-        (Some((preset, _)), Ladder::Preset | Ladder::Spp) => f64::from(*preset as u8),
+        (Some((preset, _)), Ladder::Preset | Ladder::Spp | Ladder::GlossyPaths) => {
+            f64::from(*preset as u8)
+        }
         (Some((_, params)), Ladder::Accuracy) => f64::from(accuracy_of(params)),
         (Some((_, params)), Ladder::Strata) => f64::from(params.strata_m * params.strata_n),
     }
@@ -87,7 +89,7 @@ fn series(points: &[Point]) -> Vec<Series> {
             .map(|p| (p.wall_s, p.metrics.relmse))
             .collect()
     };
-    vec![
+    let mut out = vec![
         Series {
             name: "path tracer (1, 2, 4, ... spp)".into(),
             color: RGBColor(0, 0, 0),
@@ -108,7 +110,16 @@ fn series(points: &[Point]) -> Vec<Series> {
             color: RGBColor(44, 160, 44),
             points: pick(Ladder::Strata, true),
         },
-    ]
+    ];
+    // Scenes with radiance records: the presets with per-pixel glossy paths.
+    if points.iter().any(|p| p.ladder == Ladder::GlossyPaths) {
+        out.push(Series {
+            name: "IC presets, glossy lobes path traced per pixel".into(),
+            color: RGBColor(148, 103, 189),
+            points: pick(Ladder::GlossyPaths, false),
+        });
+    }
+    out
 }
 
 /// A log axis range over the positive finite `values`, widened to whole decades (at least one).

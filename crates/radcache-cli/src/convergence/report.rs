@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use super::ladder::{accuracy_of, preset_name, weight_name, Point};
+use super::ladder::{accuracy_of, preset_name, weight_name, Ladder, Point};
 
 /// The CSV's header: one column per field, in order.
 pub const CSV_HEADER: &str = "method,ladder,label,preset,weight,accuracy,weight_param,strata,spp,\
@@ -195,6 +195,43 @@ pub fn summary(info: &RunInfo, points: &[Point]) -> String {
         );
     }
 
+    if points.iter().any(|p| p.ladder == Ladder::GlossyPaths) {
+        let _ = writeln!(
+            s,
+            "\n## Glossy lobes: radiance records against per-pixel paths\n\n\
+             The presets with the glossy lobes' indirect light from the radiance records (the \
+             default) and the per-pixel paths' time to the same own relMSE, read from the \
+             `glossy_paths` points as the path tracer's is from its ladder \
+             (docs/radiance-caching.md §6).\n"
+        );
+        let _ = writeln!(
+            s,
+            "| preset | wall s | own relMSE | per-pixel paths: time to same relMSE (s) | speed-up |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|---|");
+        for p in points.iter().filter(|p| p.ladder == Ladder::Preset) {
+            let (t, ratio) = match p.matched_paths {
+                Some(m) => (
+                    format!(
+                        "{:.3}{}",
+                        m.time_s,
+                        if m.extrapolated {
+                            " (extrapolated)"
+                        } else {
+                            ""
+                        }
+                    ),
+                    format!("{:.2}×", m.time_s / p.wall_s),
+                ),
+                None => ("within the reference's noise".into(), "–".into()),
+            };
+            let _ = writeln!(
+                s,
+                "| {} | {:.3} | {:.3e} | {t} | {ratio} |",
+                p.label, p.wall_s, p.own_relmse
+            );
+        }
+    }
     let ic = points.iter().filter(|p| p.ic.is_some()).count();
     let extrapolated = points
         .iter()

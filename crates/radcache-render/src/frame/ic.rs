@@ -13,7 +13,7 @@ use radcache_vk::{Context, ShaderCompiler};
 
 use crate::error::{Error, Result};
 use crate::frame::path::{FrameOutput, Progress};
-use crate::frame::settings::{IcDebug, IcSettings, IcStats};
+use crate::frame::settings::{GlossyLight, IcDebug, IcSettings, IcStats};
 use crate::passes::composite::CompositePass;
 use crate::passes::direct::DirectPass;
 use crate::passes::emission::EmissionPass;
@@ -22,6 +22,7 @@ use crate::passes::holes::HolePass;
 use crate::passes::neighbours::NeighbourPass;
 use crate::passes::record::RecordPass;
 use crate::passes::splat::SplatPass;
+use crate::passes::splat_glossy::GlossySplatPass;
 use crate::passes::temporal::TemporalPass;
 use crate::scene::GpuScene;
 use crate::state::IcState;
@@ -41,6 +42,13 @@ pub struct IcRenderer {
     gbuffer_pass: GBufferPass,
     direct: DirectPass,
     splat: SplatPass,
+    /// Radiance records for glossy lobes (docs/radiance-caching.md §6): in scenes with
+    /// materials rough enough ([`radcache_scene::ScenePlan::radiance_cache`]) when records are
+    /// not kept across frames (temporal caching keeps irradiance records only, so far).
+    glossy: Option<GlossySplatPass>,
+    /// The records' radiance coefficients are theirs (false after [`IcRenderer::import_cache`]
+    /// until the records are made again: the files hold no coefficients).
+    glossy_valid: bool,
     holes: HolePass,
     neighbours: NeighbourPass,
     records: RecordPass,
@@ -92,18 +100,41 @@ impl IcRenderer {
             )));
         }
         let params = settings.params;
+        let temporal = settings.time_step_s > 0.0 || settings.settle_records;
+        let radiance =
+            gpu.plan().radiance_cache() && !temporal && settings.glossy == GlossyLight::Records;
+        let glossy = if radiance {
+            Some(GlossySplatPass::new(
+                ctx,
+                shaders,
+                w,
+                h,
+                settings.record_capacity,
+            )?)
+        } else {
+            None
+        };
         Ok(IcRenderer {
             width: w,
             height: h,
             params,
             gbuffer: GBuffer::new(ctx, w, h)?,
             gbuffer_pass: GBufferPass::new(ctx, shaders, gpu)?,
-            direct: DirectPass::new(ctx, shaders, gpu, settings.sky, settings.emitters)?,
+            direct: DirectPass::with_radiance(
+                ctx,
+                shaders,
+                gpu,
+                settings.sky,
+                settings.emitters,
+                radiance,
+            )?,
             splat: SplatPass::new(ctx, shaders, w, h)?,
+            glossy,
+            glossy_valid: true,
             holes: HolePass::new(ctx, shaders)?,
             neighbours: NeighbourPass::new(ctx, shaders)?,
-            records: RecordPass::new(ctx, shaders, gpu, &params, settings.sky)?,
-            composite: CompositePass::new(ctx, shaders, gpu, w, h)?,
+            records: RecordPass::with_radiance(ctx, shaders, gpu, &params, settings.sky, radiance)?,
+            composite: CompositePass::with_radiance(ctx, shaders, gpu, w, h, radiance)?,
             emission: EmissionPass::new(ctx, shaders, gpu)?,
             state: IcState::new(ctx, shaders, settings.record_capacity, w * h)?,
             temporal: if settings.time_step_s > 0.0 || settings.settle_records {
@@ -127,6 +158,12 @@ impl IcRenderer {
     /// Drops every record: the next frame builds its cache from scratch.
     pub fn forget(&mut self) {
         self.has_records = false;
+        self.glossy_valid = true;
+    }
+
+    /// The glossy splat when its records' coefficients are valid.
+    fn glossy(&self) -> Option<&GlossySplatPass> {
+        self.glossy.as_ref().filter(|_| self.glossy_valid)
     }
 
     /// The cache's GPU state (records, counters).

@@ -56,6 +56,22 @@ pub struct IcSettings {
     /// How the direct pass estimates the light of emissive triangles. Must be set when the
     /// renderer is created.
     pub emitters: EmitterLight,
+    /// Where glossy lobes take their indirect light from. Must be set when the renderer is
+    /// created.
+    pub glossy: GlossyLight,
+}
+
+/// Where the specular lobe's indirect light comes from in a frame rendered with the cache
+/// (docs/radiance-caching.md §6).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum GlossyLight {
+    /// Radiance records for lobes at or above `GLOSSY_ROUGHNESS_MIN`, where the plan has such
+    /// materials and records are not kept with temporal caching; sharper lobes (and every lobe
+    /// otherwise) as [`GlossyLight::Paths`].
+    #[default]
+    Records,
+    /// BRDF-sampled paths per pixel and sub-frame (docs/materials.md §10).
+    Paths,
 }
 
 /// How the cache's direct pass estimates the light of emissive triangles (docs/cache-frame.md
@@ -121,6 +137,7 @@ impl Default for IcSettings {
             time_step_s: 0.0,
             sky: SkyLight::Records,
             emitters: EmitterLight::Analytic,
+            glossy: GlossyLight::Records,
         }
     }
 }

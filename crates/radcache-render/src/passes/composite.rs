@@ -18,6 +18,7 @@ use crate::bindings::composite as b;
 use crate::error::Result;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::splat::SplatPass;
+use crate::passes::splat_glossy::GlossySplatPass;
 use crate::scene::GpuScene;
 
 radcache_shared::gpu_struct! {
@@ -27,8 +28,9 @@ radcache_shared::gpu_struct! {
         pub jitter: [f32; 2] => "vec2",
         /// Debug.
         pub debug: u32 => "uint",
-        /// Padding.
-        pub pad: u32 => "uint",
+        /// 1: add the glossy splat's target (pass built with radiance; docs/radiance-caching.md
+        /// §6.2).
+        pub glossy: u32 => "uint",
     }
 }
 
@@ -61,7 +63,24 @@ impl CompositePass {
         width: u32,
         height: u32,
     ) -> Result<CompositePass> {
-        let spirv = shaders.compile("passes/composite.comp", &scene.defines())?;
+        Self::with_radiance(ctx, shaders, scene, width, height, false)
+    }
+
+    /// As [`CompositePass::new`]; with `radiance` the pass can add the glossy splat's target
+    /// (`HAS_RADIANCE_CACHE`, [`CompositePass::record_glossy`]).
+    pub fn with_radiance(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        scene: &GpuScene,
+        width: u32,
+        height: u32,
+        radiance: bool,
+    ) -> Result<CompositePass> {
+        let mut defines = scene.defines();
+        if radiance {
+            defines.push(("HAS_RADIANCE_CACHE", "1"));
+        }
+        let spirv = shaders.compile("passes/composite.comp", &defines)?;
         let pipeline = Pipeline::compute(
             ctx,
             "composite",
@@ -112,11 +131,30 @@ impl CompositePass {
         jitter: [f32; 2],
         debug: bool,
     ) -> Result<()> {
+        self.record_glossy(rec, scene, gbuffer, splat, None, jitter, debug)
+    }
+
+    /// As [`CompositePass::record`]; with `glossy`, the glossy target's `rgb/a` is added where
+    /// its weight is positive.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_glossy(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        splat: &SplatPass,
+        glossy: Option<&GlossySplatPass>,
+        jitter: [f32; 2],
+        debug: bool,
+    ) -> Result<()> {
         for image in gbuffer.images() {
             rec.use_image(image, ImageUse::ComputeStorage);
         }
         rec.use_image(&splat.sum, ImageUse::ComputeStorage);
         rec.use_image(&splat.count, ImageUse::ComputeStorage);
+        // Without a glossy splat the target is not read; the splat's own stands in.
+        let glossy_sum = glossy.map_or(&splat.sum, |g| &g.sum);
+        rec.use_image(glossy_sum, ImageUse::ComputeStorage);
         let mut bindings = scene.bindings();
         bindings.extend(gbuffer.bindings());
         bindings.extend([
@@ -126,11 +164,12 @@ impl CompositePass {
             (b::EMISSION_ACCUM, Resource::Buffer(&self.emission_accum)),
             (b::DEBUG_ACCUM, Resource::Buffer(&self.debug_accum)),
             (b::SPLAT_COUNT, Resource::StorageImage(&splat.count)),
+            (b::GLOSSY_SUM, Resource::StorageImage(glossy_sum)),
         ]);
         let push = CompositePush {
             jitter,
             debug: u32::from(debug),
-            pad: 0,
+            glossy: u32::from(glossy.is_some()),
         };
         let (w, h) = (self.width, self.height);
         rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);

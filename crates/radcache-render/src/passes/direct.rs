@@ -11,6 +11,7 @@ use crate::bindings::direct as b;
 use crate::error::Result;
 use crate::frame::settings::{EmitterLight, SkyLight};
 use crate::passes::gbuffer::GBuffer;
+use crate::passes::splat_glossy::GlossySplatPass;
 use crate::scene::GpuScene;
 
 radcache_shared::gpu_struct! {
@@ -25,6 +26,15 @@ radcache_shared::gpu_struct! {
         /// Paths of the specular lobe's indirect light per pixel (scenes with specular
         /// materials; [`specular_paths`]).
         pub specular_paths: u32 => "uint",
+        /// 1: glossy lobes at or above `GLOSSY_ROUGHNESS_MIN` take their indirect light from the
+        /// radiance records (pass built with radiance; docs/radiance-caching.md §6.2).
+        pub radiance_cache: u32 => "uint",
+        /// Padding.
+        pub pad0: u32 => "uint",
+        /// Padding.
+        pub pad1: u32 => "uint",
+        /// Padding.
+        pub pad2: u32 => "uint",
     }
 }
 
@@ -39,6 +49,8 @@ pub fn specular_paths(direct_samples: u32) -> u32 {
 pub struct DirectPass {
     pipeline: Pipeline,
     rays: Buffer,
+    /// Bound for the glossy weights and table when the pass has no glossy splat to write for.
+    placeholder: Buffer,
 }
 
 impl std::fmt::Debug for DirectPass {
@@ -58,9 +70,26 @@ impl DirectPass {
         sky: SkyLight,
         emitters: EmitterLight,
     ) -> Result<DirectPass> {
+        Self::with_radiance(ctx, shaders, scene, sky, emitters, false)
+    }
+
+    /// As [`DirectPass::new`]; with `radiance` the pass can leave glossy lobes' indirect light to
+    /// the radiance records (`HAS_RADIANCE_CACHE`), writing each such pixel's glossy world
+    /// weights ([`DirectPass::record_glossy`]).
+    pub fn with_radiance(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        scene: &GpuScene,
+        sky: SkyLight,
+        emitters: EmitterLight,
+        radiance: bool,
+    ) -> Result<DirectPass> {
         let mut defines = scene.defines();
         defines.extend(sky.define(scene.has_constant_environment()));
         defines.extend(emitters.define(scene.plan().analytic_emitters));
+        if radiance {
+            defines.push(("HAS_RADIANCE_CACHE", "1"));
+        }
         let spirv = shaders.compile("passes/direct.comp", &defines)?;
         let pipeline = Pipeline::compute(
             ctx,
@@ -79,7 +108,21 @@ impl DirectPass {
                 alignment: 0,
             },
         )?;
-        Ok(DirectPass { pipeline, rays })
+        let placeholder = Buffer::new(
+            ctx,
+            &BufferDesc {
+                name: "direct.placeholder",
+                size: 16,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::GpuOnly,
+                alignment: 0,
+            },
+        )?;
+        Ok(DirectPass {
+            pipeline,
+            rays,
+            placeholder,
+        })
     }
 
     /// Records `samples` estimates per pixel into the G-buffer's direct image for sub-frame
@@ -94,16 +137,42 @@ impl DirectPass {
         sub_frame: u32,
         seed: u32,
     ) -> Result<()> {
+        self.record_glossy(rec, scene, gbuffer, samples, sub_frame, seed, None)
+    }
+
+    /// As [`DirectPass::record`]; with `glossy` (a pass built with radiance), pixels whose lobe
+    /// is rough enough leave their specular indirect light to the radiance records and write
+    /// their world weights into `glossy.weights`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_glossy(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        samples: u32,
+        sub_frame: u32,
+        seed: u32,
+        glossy: Option<&GlossySplatPass>,
+    ) -> Result<()> {
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
         rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
         let mut bindings = scene.bindings();
         bindings.extend(gbuffer.bindings());
         bindings.push((b::RAY_COUNT, Resource::Buffer(&self.rays)));
+        let (weights, table) = glossy.map_or((&self.placeholder, &self.placeholder), |g| {
+            (&g.weights, &g.table)
+        });
+        bindings.push((b::GLOSSY_WEIGHTS, Resource::Buffer(weights)));
+        bindings.push((b::GLOSSY_TABLE, Resource::Buffer(table)));
         let push = DirectPush {
             samples: samples.max(1),
             seed,
             sub_frame,
             specular_paths: specular_paths(samples),
+            radiance_cache: u32::from(glossy.is_some()),
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         };
         let (w, h) = (gbuffer.width, gbuffer.height);
         rec.pass("direct", |rec| {

@@ -14,6 +14,7 @@ pub mod neighbours;
 pub mod path_trace;
 pub mod record;
 pub mod splat;
+pub mod splat_glossy;
 pub mod temporal;
 
 /// `shaders/shared/push.glsl`: every pass's push-constant struct, declared once in its pass

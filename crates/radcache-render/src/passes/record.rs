@@ -101,7 +101,10 @@ pub struct RecordPass {
     pipeline: Pipeline,
     rays: Buffer,
     no_samples: Buffer,
+    /// One vec4: too small for any record's radiance, so nothing is written there.
+    no_radiance: Buffer,
     params: IcParams,
+    radiance: bool,
 }
 
 impl std::fmt::Debug for RecordPass {
@@ -118,6 +121,7 @@ struct Io<'a> {
     counters: &'a Buffer,
     records: &'a Buffer,
     samples: &'a Buffer,
+    radiance: &'a Buffer,
 }
 
 impl RecordPass {
@@ -132,6 +136,20 @@ impl RecordPass {
         params: &IcParams,
         sky: SkyLight,
     ) -> Result<RecordPass> {
+        Self::with_radiance(ctx, shaders, scene, params, sky, false)
+    }
+
+    /// As [`RecordPass::new`]; with `radiance` the records also project their strata onto the
+    /// SH coefficients of the incoming radiance (`HAS_RADIANCE_CACHE`, docs/radiance-caching.md
+    /// §6.1), written by [`RecordPass::record_with_radiance`].
+    pub fn with_radiance(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        scene: &GpuScene,
+        params: &IcParams,
+        sky: SkyLight,
+        radiance: bool,
+    ) -> Result<RecordPass> {
         let (m, n) = (params.strata_m, params.strata_n);
         if m < 1 || n < 3 || m.saturating_mul(n) > MAX_STRATA {
             return Err(Error::Invalid(format!(
@@ -142,6 +160,9 @@ impl RecordPass {
         defines.extend(sky.define(scene.has_constant_environment()));
         if params.error_control == ErrorControl::Hessian {
             defines.push(("IC_HESSIAN", "1"));
+        }
+        if radiance {
+            defines.push(("HAS_RADIANCE_CACHE", "1"));
         }
         let spirv = shaders.compile(SHADER, &defines)?;
         let pipeline = Pipeline::compute(
@@ -168,13 +189,56 @@ impl RecordPass {
             rays: buffer("records.ray_count", MemoryLocation::GpuToCpu)?,
             // One vec4: too small for any request's strata, so nothing is dumped.
             no_samples: buffer("records.no_samples", MemoryLocation::GpuOnly)?,
+            no_radiance: buffer("records.no_radiance", MemoryLocation::GpuOnly)?,
             params: *params,
+            radiance,
         })
     }
 
     /// The parameters the pass was built with.
     pub fn params(&self) -> &IcParams {
         &self.params
+    }
+
+    /// Whether the pass projects radiance coefficients ([`RecordPass::with_radiance`]).
+    pub fn radiance(&self) -> bool {
+        self.radiance
+    }
+
+    /// As [`RecordPass::record`], and (when built [`RecordPass::with_radiance`]) record `r`
+    /// also writes its `RADIANCE_VEC4S` vec4 of radiance coefficients at `radiance[r·12..]`
+    /// when `radiance` holds them.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_with_radiance(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        requests: &Buffer,
+        counters: &Buffer,
+        records: &Buffer,
+        radiance: &Buffer,
+        level: u32,
+        sub_frame: u32,
+        seed: u32,
+    ) -> Result<()> {
+        let io = Io {
+            requests,
+            counters,
+            records,
+            samples: &self.no_samples,
+            radiance,
+        };
+        self.record_io(
+            rec,
+            scene,
+            gbuffer,
+            &io,
+            level,
+            sub_frame,
+            seed,
+            RecordSource::Pixels,
+        )
     }
 
     /// Records computing the pending batch in a pass named `records`: request `i` of `requests`
@@ -233,6 +297,7 @@ impl RecordPass {
             counters,
             records,
             samples: &self.no_samples,
+            radiance: &self.no_radiance,
         };
         self.record_io(
             rec,
@@ -268,6 +333,7 @@ impl RecordPass {
             counters,
             records,
             samples,
+            radiance: &self.no_radiance,
         };
         self.record_io(
             rec,
@@ -326,6 +392,7 @@ impl RecordPass {
             (b::RECORDS, Resource::Buffer(io.records)),
             (b::RAY_COUNT, Resource::Buffer(&self.rays)),
             (b::SAMPLES, Resource::Buffer(io.samples)),
+            (b::RADIANCE, Resource::Buffer(io.radiance)),
         ]);
         rec.pass("records", |rec| {
             rec.bind_pipeline(&self.pipeline);

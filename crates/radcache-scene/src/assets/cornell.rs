@@ -360,6 +360,74 @@ pub fn write_metal_spheres(dir: &Path) -> Result<PathBuf> {
 
 /// A UV sphere of `rings` × `segments` quads (triangle fans at the poles) with smooth normals,
 /// counter-clockwise seen from outside.
+/// The Cornell room (its tall block, no short block) with glossy objects for radiance caching
+/// (docs/radiance-caching.md): a rough gold-coloured metal sphere (roughness 0.7) on the right,
+/// a rough blue plastic sphere (a dielectric, 0.8) on the left, a smaller white metal sphere
+/// sharper than the records' threshold (0.4: its specular light stays path traced per pixel)
+/// between them, and a glossy grey metal plate (0.65) over the floor, 1 mm above it.
+pub fn glossy_room_builder() -> GltfBuilder {
+    let mut b = GltfBuilder::new();
+    let m = add_materials(&mut b);
+    let mut roots = add_room(&mut b, m);
+    let plate = b.add_material(&MaterialDesc::metal_rough(
+        "floor_metal_0.65",
+        [0.8, 0.8, 0.8],
+        1.0,
+        0.65,
+    ));
+    let mut soup = QuadSoup::default();
+    let y = 0.001;
+    soup.quad(
+        [
+            Vec3::new(0.005, y, 0.005),
+            Vec3::new(0.55, y, 0.005),
+            Vec3::new(0.55, y, 0.554),
+            Vec3::new(0.005, y, 0.554),
+        ],
+        Vec3::Y,
+    );
+    let mesh = b.add_mesh("floor_plate", &[soup.primitive(plate)]);
+    roots.push(node(&mut b, "floor_plate", mesh));
+    for (name, base, metallic, roughness, centre, r) in [
+        (
+            "gold_0.7",
+            [0.95, 0.7, 0.35],
+            1.0f32,
+            0.7f32,
+            Vec3::new(0.17, 0.101, 0.14),
+            0.1f32,
+        ),
+        (
+            "plastic_0.8",
+            [0.15, 0.3, 0.7],
+            0.0,
+            0.8,
+            Vec3::new(0.40, 0.101, 0.16),
+            0.1,
+        ),
+        (
+            "metal_0.4",
+            [1.0, 1.0, 1.0],
+            1.0,
+            0.4,
+            Vec3::new(0.29, 0.061, 0.30),
+            0.06,
+        ),
+    ] {
+        let material = b.add_material(&MaterialDesc::metal_rough(name, base, metallic, roughness));
+        let mesh = b.add_mesh(name, &[uv_sphere(centre, r, 32, 64, material)]);
+        roots.push(node(&mut b, name, mesh));
+    }
+    roots.push(add_camera(&mut b, "camera"));
+    b.add_scene("glossy_room", &roots, None);
+    b
+}
+
+/// Writes `dir/glossy_room/glossy_room.gltf` (+ `.bin`).
+pub fn write_glossy_room(dir: &Path) -> Result<PathBuf> {
+    write_named(&glossy_room_builder(), dir, "glossy_room")
+}
+
 fn uv_sphere(centre: Vec3, r: f32, rings: u32, segments: u32, material: usize) -> PrimitiveDesc {
     let (mut positions, mut normals, mut indices) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..=rings {

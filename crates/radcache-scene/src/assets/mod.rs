@@ -9,6 +9,8 @@
 //!   9 materials, foliage, a sun and a sky, a 5 s camera fly-through; see `courtyard.rs`).
 //! - `cornell_fly/cornell_fly.gltf`: the Cornell box with a 2 s camera path and nothing else
 //!   moving (the static fly-through of `radcache cache build`).
+//! - `glossy_room/glossy_room.gltf`: the Cornell room with rough metal and plastic spheres and a
+//!   glossy metal floor plate (radiance caching, docs/radiance-caching.md).
 //! - `metal_spheres/metal_spheres.gltf`: the Cornell room with two white GGX metal spheres
 //!   (roughness 0.3 and 0.6), the metallic-roughness BRDF's scene for `bench peer`.
 //!
@@ -28,8 +30,9 @@ use crate::writer::{BufferLayout, GltfBuilder, MaterialDesc, NodeDesc, Primitive
 
 pub use animated::{animated_builder, write_animated, ANIMATED_DURATION};
 pub use cornell::{
-    cornell_builder, cornell_fly_builder, cornell_scaled_builder, metal_spheres_builder,
-    write_cornell, write_cornell_fly, write_metal_spheres, CORNELL_FLY_DURATION, CORNELL_YFOV,
+    cornell_builder, cornell_fly_builder, cornell_scaled_builder, glossy_room_builder,
+    metal_spheres_builder, write_cornell, write_cornell_fly, write_glossy_room,
+    write_metal_spheres, CORNELL_FLY_DURATION, CORNELL_YFOV,
 };
 pub use courtyard::{courtyard_builder, write_courtyard, COURTYARD_DURATION};
 
@@ -149,7 +152,7 @@ pub fn write_furnace(dir: &Path, albedo: f32, emission: f32) -> Result<PathBuf> 
 }
 
 /// Writes the bundled assets under `dir` and returns their `.gltf` paths
-/// (cornell, furnace, animated, cornell_fly, courtyard, metal_spheres).
+/// (cornell, furnace, animated, cornell_fly, courtyard, metal_spheres, glossy_room).
 pub fn write_bundled_assets(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(vec![
         write_cornell(dir)?,
@@ -158,5 +161,6 @@ pub fn write_bundled_assets(dir: &Path) -> Result<Vec<PathBuf>> {
         write_cornell_fly(dir)?,
         write_courtyard(dir)?,
         write_metal_spheres(dir)?,
+        write_glossy_room(dir)?,
     ])
 }

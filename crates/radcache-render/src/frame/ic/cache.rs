@@ -79,6 +79,8 @@ impl IcRenderer {
             .collect();
         self.state
             .upload(ctx, &cache.records, &cache.temporal, &marks)?;
+        // The file holds no radiance coefficients: glossy lobes go back to per-pixel paths.
+        self.glossy_valid = false;
         if let Some(t) = self.temporal.as_mut() {
             t.forget();
         }

@@ -237,9 +237,23 @@ impl IcRenderer {
             let mut rec = ctx.begin("ic.create")?;
             let (requests, counters) = (&state.requests, &state.counters);
             let records = &state.records;
-            self.records.record(
-                &mut rec, gpu, gbuffer, requests, counters, records, level, k, seed,
-            )?;
+            match &self.glossy {
+                Some(g) => self.records.record_with_radiance(
+                    &mut rec,
+                    gpu,
+                    gbuffer,
+                    requests,
+                    counters,
+                    records,
+                    &g.radiance,
+                    level,
+                    k,
+                    seed,
+                )?,
+                None => self.records.record(
+                    &mut rec, gpu, gbuffer, requests, counters, records, level, k, seed,
+                )?,
+            }
             self.state.record_end_batch(&mut rec)?;
             self.neighbours
                 .record(&mut rec, &self.state, gpu.scene_scale())?;
@@ -273,13 +287,15 @@ impl IcRenderer {
         let (gbuffer, state) = (&self.gbuffer, &self.state);
         let mut rec = ctx.begin("ic.shade")?;
         self.gbuffer_pass.record(&mut rec, gpu, gbuffer, jitter)?;
-        self.direct.record(
+        let glossy = self.glossy();
+        self.direct.record_glossy(
             &mut rec,
             gpu,
             gbuffer,
             settings.direct_samples,
             k,
             settings.seed,
+            glossy,
         )?;
         self.splat.record(
             &mut rec,
@@ -290,6 +306,9 @@ impl IcRenderer {
             state,
             &final_weights,
         )?;
+        if let Some(g) = glossy {
+            g.record(&mut rec, gpu, gbuffer, state, &final_weights)?;
+        }
         self.state.record_begin_level(&mut rec)?;
         self.holes.record(
             &mut rec,
@@ -300,7 +319,7 @@ impl IcRenderer {
         )?;
         let debug = settings.debug_aovs;
         self.composite
-            .record(&mut rec, gpu, gbuffer, &self.splat, jitter, debug)?;
+            .record_glossy(&mut rec, gpu, gbuffer, &self.splat, glossy, jitter, debug)?;
         run.clock.submit(ctx, rec)?;
         run.add_rays("direct", self.direct.rays()?);
         let c = self.state.read_counters()?;

@@ -1,0 +1,163 @@
+//! Glossy splatting (`shaders/passes/splat.vert` + `splat_glossy.frag`, docs/radiance-caching.md
+//! §6.2): the radiance records for glossy lobes. It owns what the other passes read and write
+//! for them:
+//! * the records' SH coefficients (`RADIANCE_VEC4S` vec4 per record; the record pass writes
+//!   them);
+//! * each pixel's glossy world weights (the direct pass writes them per sub-frame);
+//! * the lobe table;
+//! * the glossy target.
+//!
+//! Per record and pixel the fragment adds `(w·Σ_i c_i ⊙ W_i, w)` to the RGBA32F target with
+//! (ONE, ONE) blending, `w` being the splat's own weight; the composite adds the target's
+//! `rgb/a`. The convolution is linear, so weighting each record by the pixel's world weights
+//! equals convolving the blended coefficients. It costs one target of 16 bytes per pixel
+//! (plus 192 bytes of weights), not the 12 targets of 196 bytes that splatting the coefficients
+//! themselves would need.
+
+use radcache_material::glossy::{glossy_table, GLOSSY_TABLE_STRATA};
+use radcache_shared::consts::RADIANCE_VEC4S;
+use radcache_vk::{
+    vk, Blend, Buffer, BufferDesc, ColorTarget, Context, GraphicsDesc, Image, ImageDesc, ImageUse,
+    MemoryLocation, Pipeline, Recorder, Resource, ShaderCompiler,
+};
+
+use crate::bindings::{splat_glossy as b, FRAME};
+use crate::error::Result;
+use crate::passes::gbuffer::GBuffer;
+use crate::passes::splat::SplatWeights;
+use crate::scene::GpuScene;
+use crate::state::IcState;
+
+/// Bytes of radiance coefficients per record (`RADIANCE_VEC4S` vec4).
+pub const RADIANCE_BYTES_PER_RECORD: u64 = RADIANCE_VEC4S as u64 * 16;
+
+/// The glossy splat's pipeline, target and buffers.
+pub struct GlossySplatPass {
+    pipeline: Pipeline,
+    /// Σ w·L_glossy (rgb) and Σ w (a) per pixel.
+    pub sum: Image,
+    /// The records' radiance coefficients (`RADIANCE_VEC4S` vec4 per record).
+    pub radiance: Buffer,
+    /// Each pixel's glossy world weights (`RADIANCE_VEC4S` vec4 per pixel).
+    pub weights: Buffer,
+    /// The lobe table ([`glossy_table`]).
+    pub table: Buffer,
+}
+
+impl std::fmt::Debug for GlossySplatPass {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GlossySplatPass").finish_non_exhaustive()
+    }
+}
+
+impl GlossySplatPass {
+    /// Compiles the pass and allocates the target and the weights for `width × height` pixels,
+    /// the coefficients for `record_capacity` records, and the table.
+    pub fn new(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        width: u32,
+        height: u32,
+        record_capacity: u32,
+    ) -> Result<Self> {
+        let vertex = shaders.compile("passes/splat.vert", &[])?;
+        // The pixels' roughness is in the G-buffer of specular scenes only.
+        let fragment = shaders.compile("passes/splat_glossy.frag", &[("HAS_SPECULAR", "1")])?;
+        let format = vk::Format::R32G32B32A32_SFLOAT;
+        let pipeline = Pipeline::graphics(
+            ctx,
+            &GraphicsDesc {
+                name: "splat.glossy",
+                vertex: &vertex,
+                fragment: &fragment,
+                bindings: &b::layout(),
+                push_constant_size: std::mem::size_of::<SplatWeights>() as u32,
+                color_formats: &[format],
+                depth: None,
+                blend: Blend::Additive,
+                cull: vk::CullModeFlags::NONE,
+                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+            },
+        )?;
+        let sum = Image::new(
+            ctx,
+            &ImageDesc {
+                name: "splat.glossy.sum",
+                width,
+                height,
+                format,
+                usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE,
+            },
+        )?;
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let buffer = |name, size: u64| {
+            Buffer::new(
+                ctx,
+                &BufferDesc {
+                    name,
+                    size: size.max(16),
+                    usage: storage,
+                    location: MemoryLocation::GpuOnly,
+                    alignment: 0,
+                },
+            )
+        };
+        let pixels = u64::from(width) * u64::from(height);
+        let table: Vec<f32> = glossy_table(GLOSSY_TABLE_STRATA);
+        Ok(GlossySplatPass {
+            pipeline,
+            sum,
+            radiance: buffer(
+                "splat.glossy.radiance",
+                u64::from(record_capacity) * RADIANCE_BYTES_PER_RECORD,
+            )?,
+            weights: buffer("splat.glossy.weights", pixels * RADIANCE_BYTES_PER_RECORD)?,
+            table: ctx.create_buffer_init("splat.glossy.table", storage, &table)?,
+        })
+    }
+
+    /// Records the glossy splat of every record with `weights` (the final splat's, without
+    /// marking), after the direct pass wrote the pixels' world weights.
+    pub fn record(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        state: &IcState,
+        weights: &SplatWeights,
+    ) -> Result<()> {
+        for image in gbuffer.images() {
+            rec.use_image(image, ImageUse::FragmentStorage);
+        }
+        rec.use_image(&self.sum, ImageUse::ColorAttachment);
+        let push = SplatWeights {
+            mark_frame: 0,
+            ..*weights
+        };
+        let mut bindings = vec![scene.bindings()[FRAME as usize]];
+        bindings.extend(gbuffer.bindings());
+        bindings.extend([
+            (b::RECORDS, Resource::Buffer(&state.records)),
+            (b::LAST_USED, Resource::Buffer(&state.last_used)),
+            (b::RADIANCE, Resource::Buffer(&self.radiance)),
+            (b::GLOSSY_WEIGHTS, Resource::Buffer(&self.weights)),
+        ]);
+        rec.pass("splat.glossy", |rec| {
+            rec.begin_rendering(
+                &[ColorTarget {
+                    image: &self.sum,
+                    clear: Some([0.0; 4]),
+                }],
+                None,
+            );
+            rec.bind_pipeline(&self.pipeline);
+            rec.push_bindings(&bindings);
+            rec.push_constants(&push);
+            // The draw of every record (IcCounters::draw, as SplatScope::All).
+            rec.draw_indirect(&state.counters, 32, 1);
+            rec.end_rendering();
+        });
+        rec.use_image(&self.sum, ImageUse::ComputeStorage);
+        Ok(())
+    }
+}
