@@ -450,7 +450,11 @@ mod tests {
             ]
         );
         assert!(paths.iter().all(|c| c.glossy == GlossyLight::Paths));
-        let presets = cases.iter().filter(|c| c.ladder == Ladder::Preset);
-        assert!(presets.clone().count() == 3 && presets.all(|c| c.glossy == GlossyLight::Records));
+        let presets: Vec<&IcCase> = cases
+            .iter()
+            .filter(|c| c.ladder == Ladder::Preset)
+            .collect();
+        assert_eq!(presets.len(), 3);
+        assert!(presets.iter().all(|c| c.glossy == GlossyLight::Records));
     }
 }
