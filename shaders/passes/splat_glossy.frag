@@ -8,6 +8,11 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
+// The pass runs in specular scenes only, whose G-buffer holds the roughness.
+#ifndef HAS_SPECULAR
+#define HAS_SPECULAR 1
+#endif
+
 #include "../shared/layouts.glsl"
 #include "../shared/bindings.glsl"
 #include "../common/gbuffer.glsl"

@@ -679,6 +679,7 @@ fn every_pass_compiles_with_every_material_define() {
         ("HAS_LIGHTS", "1"),
         ("HAS_ENV_CONSTANT", "1"),
         ("HAS_ENV_MAP", "1"),
+        ("HAS_RADIANCE_CACHE", "1"),
     ];
     let compiler = shaders();
     let out = temp_dir("uv-defines");

@@ -450,9 +450,12 @@ fn damaged_helmet_needs_the_full_brdf_and_has_an_unused_occlusion_map() {
 fn bundled_scenes_are_lambertian() {
     let files = write_bundled_assets(&temp_dir("lambert")).unwrap();
     assert!(files.len() >= 5);
-    for path in files.iter().filter(|p| {
-        p.extension().is_some_and(|e| e == "gltf") && !p.ends_with("metal_spheres.gltf")
-    }) {
+    let specular =
+        |p: &std::path::Path| p.ends_with("metal_spheres.gltf") || p.ends_with("glossy_room.gltf");
+    for path in files
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "gltf") && !specular(p))
+    {
         let (s, _) = load(path);
         for m in &s.materials {
             assert!(m.is_lambertian(), "{}: {m:?}", path.display());
@@ -467,11 +470,21 @@ fn bundled_scenes_are_lambertian() {
             .to_string()
             .contains("materials: lambertian only (no specular code compiled)"));
     }
-    // The one bundled scene with specular materials.
+    // The bundled scenes with specular materials.
     let spheres = files.iter().find(|p| p.ends_with("metal_spheres.gltf"));
     let (s, _) = load(spheres.expect("metal_spheres is bundled"));
     assert!(s.plan().specular);
     assert_eq!(s.materials.iter().filter(|m| m.metallic == 1.0).count(), 2);
+    assert_eq!(s.plan().glossy_materials, 1, "the 0.6 sphere");
+    let glossy = files.iter().find(|p| p.ends_with("glossy_room.gltf"));
+    let (s, _) = load(glossy.expect("glossy_room is bundled"));
+    let plan = s.plan();
+    assert!(plan.specular && plan.radiance_cache());
+    // Gold 0.7, plastic 0.8 and the floor plate 0.65; the 0.4 sphere stays below the threshold.
+    assert_eq!(plan.glossy_materials, 3);
+    assert!(plan
+        .to_string()
+        .contains("glossy lobes: radiance records for roughness ≥ 0.6 (3 materials"));
     // Cornell box, as bundled in the repository.
     let cornell =
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/cornell/cornell.gltf");

@@ -61,8 +61,7 @@ impl GlossySplatPass {
         record_capacity: u32,
     ) -> Result<Self> {
         let vertex = shaders.compile("passes/splat.vert", &[])?;
-        // The pixels' roughness is in the G-buffer of specular scenes only.
-        let fragment = shaders.compile("passes/splat_glossy.frag", &[("HAS_SPECULAR", "1")])?;
+        let fragment = shaders.compile("passes/splat_glossy.frag", &[])?;
         let format = vk::Format::R32G32B32A32_SFLOAT;
         let pipeline = Pipeline::graphics(
             ctx,
