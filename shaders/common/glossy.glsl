@@ -13,34 +13,6 @@
 
 #ifndef GLOSSY_TABLE_BINDING
 #error "define GLOSSY_TABLE_BINDING (the glossy table's binding) before including glossy.glsl"
-void glossy_world_weights(Material m, vec3 n, vec3 v, out vec3 w[SH_COEFFS]) {
-    for (int i = 0; i < int(SH_COEFFS); ++i) {
-        w[i] = vec3(0.0);
-    }
-    float nv = dot(n, v);
-    if (!(nv > 0.0)) {
-        return;
-    }
-    vec3 t, b;
-    sh_view_frame(n, v, t, b);
-    float g[2 * SH_COEFFS];
-    glossy_lookup(m.roughness, nv, g);
-    float k1;
-    vec3 k0 = glossy_weights(m, k1);
-    for (int k = 0; k < int(SH_COEFFS); ++k) {
-        vec3 d = sh_frame_dir(k);
-        float y[SH_COEFFS];
-        sh_basis(t * d.x + b * d.y + n * d.z, y);
-        vec3 gk = k0 * g[k] + vec3(k1 * g[int(SH_COEFFS) + k]);
-        uint band = sh_band(uint(k));
-        for (int i = 0; i < int(SH_COEFFS); ++i) {
-            if (sh_band(uint(i)) == band) {
-                w[i] += gk * y[i];
-            }
-        }
-    }
-}
-
 #endif
 layout(binding = GLOSSY_TABLE_BINDING, std430) readonly buffer GlossyTable { float glossy_table[]; };
 
@@ -79,26 +51,6 @@ vec3 glossy_weights(Material m, out float k1) {
     return base * metallic + f0_d * ((1.0 - metallic) * s);
 }
 
-vec3 glossy_radiance(Material m, vec3 n, vec3 v, vec3 c[SH_COEFFS]) {
-    float nv = dot(n, v);
-    if (!(nv > 0.0)) {
-        return vec3(0.0);
-    }
-    vec3 t, b;
-    sh_view_frame(n, v, t, b);
-    vec3 values[SH_COEFFS];
-    sh_frame_values(c, t, b, n, values);
-    float g[2 * SH_COEFFS];
-    glossy_lookup(m.roughness, nv, g);
-    float k1;
-    vec3 k0 = glossy_weights(m, k1);
-    vec3 result = vec3(0.0);
-    for (int k = 0; k < int(SH_COEFFS); ++k) {
-        result += values[k] * (k0 * g[k] + vec3(k1 * g[int(SH_COEFFS) + k]));
-    }
-    return max(result, vec3(0.0));
-}
-
 void glossy_world_weights(Material m, vec3 n, vec3 v, out vec3 w[SH_COEFFS]) {
     for (int i = 0; i < int(SH_COEFFS); ++i) {
         w[i] = vec3(0.0);
@@ -125,6 +77,16 @@ void glossy_world_weights(Material m, vec3 n, vec3 v, out vec3 w[SH_COEFFS]) {
             }
         }
     }
+}
+
+vec3 glossy_radiance(Material m, vec3 n, vec3 v, vec3 c[SH_COEFFS]) {
+    vec3 w[SH_COEFFS];
+    glossy_world_weights(m, n, v, w);
+    vec3 result = vec3(0.0);
+    for (int i = 0; i < int(SH_COEFFS); ++i) {
+        result += c[i] * w[i];
+    }
+    return max(result, vec3(0.0));
 }
 
 #endif

@@ -24,8 +24,7 @@ use crate::fresnel::dielectric_f0;
 use crate::ggx::{alpha_from_roughness, ggx_d, smith_v_correlated};
 use crate::sampling::{ggx_reflection_pdf, reflect, sample_ggx_vndf};
 use crate::sh::{
-    sh_band, sh_basis, sh_frame_values, sh_frame_weights, sh_view_frame, ShRgb, SH_COEFFS,
-    SH_FRAME_DIRS,
+    sh_band, sh_basis, sh_frame_weights, sh_view_frame, ShRgb, SH_COEFFS, SH_FRAME_DIRS,
 };
 use crate::Material;
 use radcache_shared::consts::{GLOSSY_NV_MIN, GLOSSY_TABLE_NV, GLOSSY_TABLE_ROUGHNESS};
@@ -141,23 +140,17 @@ pub fn glossy_weights(m: &Material) -> (Vec3, f32) {
 
 /// The radiance the specular lobe of material `m` reflects towards `v` (world, unit) at a
 /// point with shading normal `n` (world, unit) under the incident radiance `c` (world-space
-/// coefficients): `Σ_k (K0·gA_k + K1·gB_k) · value_k` with the values of
-/// [`sh_frame_values`]. 0 where `n·v` is below the table's range start, [`GLOSSY_NV_MIN`]
-/// (clamped there, not extrapolated, between it and 0).
+/// coefficients): `Σ_i c_i ⊙ W_i` with the weights of [`glossy_world_weights`] (equal to
+/// `Σ_k (K0·gA_k + K1·gB_k) · value_k` with the values of [`crate::sh::sh_frame_values`]),
+/// clamped at 0
+/// (a truncated product can dip below it). 0 where `n·v ≤ 0`; between 0 and the table's first
+/// column, [`GLOSSY_NV_MIN`], the lookup is clamped there, not extrapolated.
 pub fn glossy_radiance(table: &[f32], m: &Material, n: Vec3, v: Vec3, c: &ShRgb) -> Vec3 {
-    let nv = n.dot(v);
-    if nv <= 0.0 {
-        return Vec3::ZERO;
-    }
-    let (t, b, n) = sh_view_frame(n, v);
-    let values = sh_frame_values(c, t, b, n);
-    let g = glossy_lookup(table, m.roughness, nv);
-    let (k0, k1) = glossy_weights(m);
-    let mut out = Vec3::ZERO;
-    for k in 0..SH_COEFFS {
-        out += values[k] * (k0 * g[k] + Vec3::splat(k1 * g[SH_COEFFS + k]));
-    }
-    out.max(Vec3::ZERO)
+    let w = glossy_world_weights(table, m, n, v);
+    c.iter()
+        .zip(&w)
+        .fold(Vec3::ZERO, |acc, (ci, wi)| acc + *ci * *wi)
+        .max(Vec3::ZERO)
 }
 
 /// The world-space weights `W` of the glossy lobe for one pixel: `Σ_i c_i ⊙ W_i` is
@@ -195,8 +188,8 @@ pub fn glossy_world_weights(table: &[f32], m: &Material, n: Vec3, v: Vec3) -> Sh
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sh::{sh_reconstruct, sh_sphere_linear};
-    use crate::{brdf_eval_lobes, Material};
+    use crate::brdf_eval_lobes;
+    use crate::sh::{sh_frame_values, sh_reconstruct, sh_sphere_linear};
 
     /// `∫ L(l)·specular(v, l)·(n·l) dl` by brute-force quadrature in the local frame
     /// (midpoint in cos θ and φ, refined near the mirror direction by sheer count).
@@ -241,7 +234,7 @@ mod tests {
                     < 1e-4 * (1.0 + direct.abs().max_element())
             );
             assert_eq!(
-                direct.max(Vec3::ZERO),
+                by_weights.max(Vec3::ZERO),
                 glossy_radiance(&table, &m, n, v, &c)
             );
         }

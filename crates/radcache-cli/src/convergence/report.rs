@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 
 use super::ladder::{accuracy_of, preset_name, weight_name, Ladder, Point};
+use super::model::Match;
 
 /// The CSV's header: one column per field, in order.
 pub const CSV_HEADER: &str = "method,ladder,label,preset,weight,accuracy,weight_param,strata,spp,\
@@ -78,6 +79,25 @@ pub fn csv(points: &[Point]) -> String {
 }
 
 /// The Markdown summary.
+/// The table cells of a time to the same error and its speed-up over `wall_s`.
+fn match_cells(matched: Option<Match>, wall_s: f64) -> (String, String) {
+    match matched {
+        Some(m) => (
+            format!(
+                "{:.3}{}",
+                m.time_s,
+                if m.extrapolated {
+                    " (extrapolated)"
+                } else {
+                    ""
+                }
+            ),
+            format!("{:.2}×", m.time_s / wall_s),
+        ),
+        None => ("within the reference's noise".into(), "–".into()),
+    }
+}
+
 pub fn summary(info: &RunInfo, points: &[Point]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# Convergence: error against run time\n");
@@ -166,21 +186,7 @@ pub fn summary(info: &RunInfo, points: &[Point]) -> String {
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
     for p in points.iter().filter(|p| p.ic.is_some()) {
-        let (pt, ratio) = match p.matched {
-            Some(m) => (
-                format!(
-                    "{:.3}{}",
-                    m.time_s,
-                    if m.extrapolated {
-                        " (extrapolated)"
-                    } else {
-                        ""
-                    }
-                ),
-                format!("{:.2}×", m.time_s / p.wall_s),
-            ),
-            None => ("within the reference's noise".into(), "–".into()),
-        };
+        let (pt, ratio) = match_cells(p.matched, p.wall_s);
         let _ = writeln!(
             s,
             "| {} | {} | {:.3} | {:.3} | {} | {:.3e} | {:.3e} | {} | {pt} | {ratio} |",
@@ -210,21 +216,7 @@ pub fn summary(info: &RunInfo, points: &[Point]) -> String {
         );
         let _ = writeln!(s, "|---|---|---|---|---|");
         for p in points.iter().filter(|p| p.ladder == Ladder::Preset) {
-            let (t, ratio) = match p.matched_paths {
-                Some(m) => (
-                    format!(
-                        "{:.3}{}",
-                        m.time_s,
-                        if m.extrapolated {
-                            " (extrapolated)"
-                        } else {
-                            ""
-                        }
-                    ),
-                    format!("{:.2}×", m.time_s / p.wall_s),
-                ),
-                None => ("within the reference's noise".into(), "–".into()),
-            };
+            let (t, ratio) = match_cells(p.matched_paths, p.wall_s);
             let _ = writeln!(
                 s,
                 "| {} | {:.3} | {:.3e} | {t} | {ratio} |",

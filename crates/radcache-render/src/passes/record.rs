@@ -229,16 +229,7 @@ impl RecordPass {
             samples: &self.no_samples,
             radiance,
         };
-        self.record_io(
-            rec,
-            scene,
-            gbuffer,
-            &io,
-            level,
-            sub_frame,
-            seed,
-            RecordSource::Pixels,
-        )
+        self.record_pixels(rec, scene, gbuffer, &io, level, sub_frame, seed)
     }
 
     /// Records computing the pending batch in a pass named `records`: request `i` of `requests`
@@ -335,16 +326,23 @@ impl RecordPass {
             samples,
             radiance: &self.no_radiance,
         };
-        self.record_io(
-            rec,
-            scene,
-            gbuffer,
-            &io,
-            level,
-            sub_frame,
-            seed,
-            RecordSource::Pixels,
-        )
+        self.record_pixels(rec, scene, gbuffer, &io, level, sub_frame, seed)
+    }
+
+    /// [`RecordPass::record_io`] for requests of pixels.
+    #[allow(clippy::too_many_arguments)]
+    fn record_pixels(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        io: &Io<'_>,
+        level: u32,
+        sub_frame: u32,
+        seed: u32,
+    ) -> Result<()> {
+        let source = RecordSource::Pixels;
+        self.record_io(rec, scene, gbuffer, io, level, sub_frame, seed, source)
     }
 
     #[allow(clippy::too_many_arguments)]
