@@ -64,6 +64,7 @@ mod scene;
 mod summary;
 pub mod tangent;
 pub mod texture;
+pub mod texture_transform;
 pub mod writer;
 
 pub use alias::AliasTable;
