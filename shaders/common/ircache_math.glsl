@@ -164,6 +164,39 @@ vec3 wall_term(vec3 l_cur, vec3 l_prev, float r_cur, float r_prev, float r_eps) 
     return vec3(0.0);
 }
 
+// ---- radiance records (radcache_cache::radiance, docs/radiance-caching.md §7) ----
+
+float stratum_solid_angle(uint j, uint m, uint n) {
+    uint mm = max(m, 1u);
+    float jf = float(min(j, mm - 1u));
+    float mf = float(mm);
+    float cos_lo = sqrt(max(1.0 - jf / mf, 0.0));
+    float cos_hi = sqrt(max(1.0 - (jf + 1.0) / mf, 0.0));
+    return (IC_TAU / float(max(n, 1u))) * (cos_lo - cos_hi);
+}
+
+vec3 radiance_sample(vec3 l, float r) { return r < IC_FAR ? l : vec3(0.0); }
+
+vec3 radiance_polar_wall_coeff(uint j, uint k, uint m, uint n) {
+    uint mm = max(m, 1u);
+    if (j == 0u || j >= mm) {
+        return vec3(0.0);
+    }
+    float s2 = float(j) / float(mm);
+    float c = (IC_TAU / float(max(n, 1u))) * sqrt(s2) * sqrt(max(1.0 - s2, 0.0));
+    return horizontal_u(stratum_phi_centre(k, n)) * c;
+}
+
+vec3 radiance_azimuthal_wall_coeff(uint j, uint k, uint m, uint n) {
+    uint mm = max(m, 1u);
+    float jf = float(min(j, mm - 1u));
+    float mf = float(mm);
+    float s2c = (jf + 0.5) / mf;
+    float cos_lo = sqrt(max(1.0 - jf / mf, 0.0));
+    float cos_hi = sqrt(max(1.0 - (jf + 1.0) / mf, 0.0));
+    return horizontal_v(stratum_phi_start(k, n)) * ((cos_lo - cos_hi) / sqrt(s2c));
+}
+
 // NaN fails every comparison, so it is rejected too (where the driver keeps NaN).
 bool irradiance_is_valid(vec3 e) { return all(greaterThanEqual(e, vec3(0.0))) && all(lessThan(e, vec3(3.0e38))); }
 

@@ -41,13 +41,18 @@
 // fails), R_orig = IC_FAR (it clamps no neighbour) and R⁻ = R⁺ = R_FLOOR (its splat is empty);
 // it is flagged and counted in rejected_records. No field is ever NaN or Inf.
 //
-// Radiance records (HAS_RADIANCE_CACHE, docs/radiance-caching.md §6.1): the same strata are
+// Radiance records (HAS_RADIANCE_CACHE, docs/radiance-caching.md §6.1, §7): the same strata are
 // projected a second time, onto the 16 real SH coefficients of the incoming radiance per channel
-// (common/sh.glsl, world space), each stratum weighted by its solid angle
-// (2π/N)·(√(1 − j/M) − √(1 − (j+1)/M)) at its (folded) direction; strata that escaped are left
-// out (the light straight from the sky is the direct pass's for the specular lobe). Invocation
-// i < SH_COEFFS sums coefficient i; they go to B_RECORD_RADIANCE at RADIANCE_VEC4S·index when
-// that buffer is large enough. A non-finite coefficient is stored as 0.
+// (common/sh.glsl, world space), each stratum weighted by its solid angle stratum_solid_angle at
+// its (folded) direction; strata that escaped are left out (radiance_sample: the light straight
+// from the sky is the direct pass's for the specular lobe). The coefficients' translational
+// gradients are the moving-walls sums of radcache_cache::radiance::compute_radiance
+// (radiance_polar_wall_coeff, radiance_azimuthal_wall_coeff at the walls' midpoints). They go to
+// B_RECORD_RADIANCE at RECORD_RADIANCE_VEC4S·index when that buffer is large enough: the
+// RADIANCE_VEC4S vec4 of f32 coefficients (coefficient i's channel c at float 3i + c), the
+// gradients' scale s (the largest |gradient|, f32), then the gradients along x, y and z divided
+// by s, packed the same way as f16 pairs (radcache_shared::consts::RECORD_RADIANCE_VEC4S). A
+// non-finite coefficient is stored as 0, with zero gradients; a non-finite gradient as 0.
 //
 // Optional sample dump (tests): when the buffer bound at B_GBUFFER_END + 4 holds at least
 // (i + 1)·M·N vec4, request i writes (L_jk, r_jk) of its strata at i·M·N + j·N + k.
@@ -75,7 +80,7 @@ layout(push_constant) uniform Push { RecordPush pc; };
 
 #ifdef HAS_RADIANCE_CACHE
 #include "../common/sh.glsl"
-layout(binding = B_RECORD_RADIANCE, std430) writeonly buffer Radiance { vec4 radiance[]; };
+layout(binding = B_RECORD_RADIANCE, std430) writeonly buffer Radiance { uvec4 radiance[]; };
 #endif
 
 // Level and sub-frame of the record being written (a refreshed record keeps its own).
@@ -176,33 +181,125 @@ vec3 stratum_direction(uint i, uint n, uint m, vec3 t, vec3 b, vec3 nn, vec3 ng,
 }
 
 #ifdef HAS_RADIANCE_CACHE
-// Invocation lid < SH_COEFFS: coefficient lid of record `index`'s radiance (see the header).
-void project_radiance(uint lid, uint index, uint m, uint n, vec3 t, vec3 b, vec3 nn, vec3 ng,
-                      uint record_seed) {
-    if (lid >= SH_COEFFS || uint(radiance.length()) < (index + 1u) * RADIANCE_VEC4S) {
-        return;
+// The gradient sums of the wall invocations: part p (0 polar walls, 1 azimuthal walls) of
+// coefficient i at (p·SH_COEFFS + i)·9, axis-major (x, y, z), RGB each.
+shared float s_rgrad[2u * SH_COEFFS * 9u];
+// The gradients' totals, axis-major (float 3i + c of axis a at 48a + 3i + c), and each
+// coefficient's largest |total| (the block's scale is their maximum).
+shared float s_gtot[3u * 3u * SH_COEFFS];
+shared float s_gmax[SH_COEFFS];
+
+// The radiance of stratum i as the projection sees it (radiance_sample: 0 where it escaped).
+vec3 stratum_radiance(uint i) {
+    return radiance_sample(stratum_l(i), s_r[i]);
+}
+
+// Adds wall (coefficient `coeff`, midpoint direction `dir`, both local) times basis function
+// `ci` to the gradient g: g[axis] += d · coeff_world[axis] · Y_ci(dir_world).
+void add_wall(inout vec3 g[3], uint ci, vec3 coeff, vec3 dir, vec3 d, vec3 t, vec3 b, vec3 nn) {
+    vec3 cw = frame_to_world(coeff, t, b, nn);
+    float y = sh_basis_one(ci, frame_to_world(dir, t, b, nn));
+    for (int a = 0; a < 3; ++a) {
+        g[a] += d * (cw[a] * y);
     }
+}
+
+// Record `index`'s radiance coefficients and their gradients (see the header), reduced by 3 ·
+// SH_COEFFS invocations: invocation lid sums part lid / SH_COEFFS (0 the projection, 1 the polar
+// walls, 2 the azimuthal walls) of coefficient lid % SH_COEFFS; after a barrier the projection's
+// invocation adds the two wall parts and stores all. Called by every invocation of the group.
+void project_radiance(uint lid, uint index, uint m, uint n, vec3 t, vec3 b, vec3 nn, vec3 ng,
+                      uint record_seed, float r_eps) {
+    if (uint(radiance.length()) < (index + 1u) * RECORD_RADIANCE_VEC4S) {
+        return;  // uniform over the group
+    }
+    uint ci = lid % SH_COEFFS;
+    uint part = lid / SH_COEFFS;
     vec3 acc = vec3(0.0);
-    float d_phi = 2.0 * IC_PI / float(n);
-    for (uint j = 0u; j < m; ++j) {
-        float omega = d_phi * (sqrt(max(1.0 - float(j) / float(m), 0.0)) -
-                               sqrt(max(1.0 - float(j + 1u) / float(m), 0.0)));
-        for (uint k = 0u; k < n; ++k) {
-            uint i = stratum_index(j, k, n);
-            if (s_r[i] >= IC_FAR) {
-                continue;
+    vec3 g[3] = vec3[](vec3(0.0), vec3(0.0), vec3(0.0));
+    if (part == 0u) {
+        for (uint j = 0u; j < m; ++j) {
+            float omega = stratum_solid_angle(j, m, n);
+            for (uint k = 0u; k < n; ++k) {
+                uint i = stratum_index(j, k, n);
+                if (s_r[i] >= IC_FAR) {
+                    continue;
+                }
+                vec3 dir = stratum_direction(i, n, m, t, b, nn, ng, record_seed);
+                acc += stratum_l(i) * (omega * sh_basis_one(ci, dir));
             }
-            vec3 dir = stratum_direction(i, n, m, t, b, nn, ng, record_seed);
-            acc += stratum_l(i) * (omega * sh_basis_one(lid, dir));
+        }
+    } else if (part == 1u) {
+        for (uint j = 1u; j < m; ++j) {
+            for (uint k = 0u; k < n; ++k) {
+                uint i = stratum_index(j, k, n), ip = stratum_index(j - 1u, k, n);
+                vec3 d = wall_term(stratum_radiance(i), stratum_radiance(ip), s_r[i], s_r[ip], r_eps);
+                vec3 dir = stratum_direction_local(j, k, m, n, 0.0, 0.5);
+                add_wall(g, ci, radiance_polar_wall_coeff(j, k, m, n), dir, d, t, b, nn);
+            }
+        }
+    } else if (part == 2u) {
+        for (uint j = 0u; j < m; ++j) {
+            for (uint k = 0u; k < n; ++k) {
+                uint i = stratum_index(j, k, n);
+                uint ip = stratum_index(j, k == 0u ? n - 1u : k - 1u, n);
+                vec3 d = wall_term(stratum_radiance(i), stratum_radiance(ip), s_r[i], s_r[ip], r_eps);
+                vec3 dir = stratum_direction_local(j, k, m, n, 0.5, 0.0);
+                add_wall(g, ci, radiance_azimuthal_wall_coeff(j, k, m, n), dir, d, t, b, nn);
+            }
         }
     }
-    if (any(isnan(acc)) || any(isinf(acc))) {
-        acc = vec3(0.0);
+    if (part == 1u || part == 2u) {
+        uint at = ((part - 1u) * SH_COEFFS + ci) * 9u;
+        for (uint a = 0u; a < 3u; ++a) {
+            for (uint c = 0u; c < 3u; ++c) {
+                s_rgrad[at + 3u * a + c] = g[a][c];
+            }
+        }
     }
-    uint base = index * RADIANCE_VEC4S;
-    for (uint c = 0u; c < 3u; ++c) {
-        uint f = 3u * lid + c;
-        radiance[base + f / 4u][f % 4u] = acc[c];
+    barrier();
+    uint base = index * RECORD_RADIANCE_VEC4S;
+    if (part == 0u) {
+        bool finite = !(any(isnan(acc)) || any(isinf(acc)));
+        for (uint c = 0u; c < 3u; ++c) {
+            uint f = 3u * ci + c;
+            radiance[base + f / 4u][f % 4u] = floatBitsToUint(finite ? acc[c] : 0.0);
+        }
+        float largest = 0.0;
+        for (uint a = 0u; a < 3u; ++a) {
+            vec3 ga;
+            for (uint c = 0u; c < 3u; ++c) {
+                ga[c] = s_rgrad[ci * 9u + 3u * a + c] + s_rgrad[(SH_COEFFS + ci) * 9u + 3u * a + c];
+            }
+            // A gradient is kept only beside a finite coefficient, and only when finite itself.
+            bool ok = finite && !(any(isnan(ga)) || any(isinf(ga)));
+            for (uint c = 0u; c < 3u; ++c) {
+                float v = ok ? ga[c] : 0.0;
+                s_gtot[3u * SH_COEFFS * a + 3u * ci + c] = v;
+                largest = max(largest, abs(v));
+            }
+        }
+        s_gmax[ci] = largest;
+    }
+    barrier();
+    // The scale s: the largest |gradient| of the record; the gradients are stored as f16 of
+    // g/s (in [−1, 1]), so neither the scene's scale nor its radiance can overflow them.
+    float scale = 0.0;
+    for (uint i = 0u; i < SH_COEFFS; ++i) {
+        scale = max(scale, s_gmax[i]);
+    }
+    scale = scale > 1.0e-30 ? scale : 0.0;
+    float inv = scale > 0.0 ? 1.0 / scale : 0.0;
+    if (lid == 0u) {
+        radiance[base + RADIANCE_VEC4S] = uvec4(floatBitsToUint(scale), 0u, 0u, 0u);
+    }
+    // Word w of the gradients (axis w / 24, floats 2(w % 24) and 2(w % 24) + 1 of that axis).
+    uint words = 3u * 3u * SH_COEFFS / 2u;
+    for (uint w = lid; w < words; w += RECORD_GROUP) {
+        uint a = w / (words / 3u), pair = w % (words / 3u);
+        uint at = 3u * SH_COEFFS * a + 2u * pair;
+        vec2 h = clamp(vec2(s_gtot[at], s_gtot[at + 1u]) * inv, vec2(-1.0), vec2(1.0));
+        radiance[base + RADIANCE_VEC4S + 1u + w / 4u][w % 4u] = packHalf2x16(h);
     }
 }
 #endif
@@ -374,7 +471,7 @@ void main() {
     atomicAdd(s_rays, rays_traced);
     barrier();
 #ifdef HAS_RADIANCE_CACHE
-    project_radiance(lid, index, m, n, t, b, nn, ng, record_seed);
+    project_radiance(lid, index, m, n, t, b, nn, ng, record_seed, pc.r_eps_rel * frame.camera_position.w);
 #endif
 #ifdef IC_HESSIAN
     vec4 share = hessian_share(lid, m, n, record_seed, pc.r_eps_rel * frame.camera_position.w);

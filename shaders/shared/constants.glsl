@@ -90,7 +90,7 @@ const uint GLOSSY_TABLE_ROUGHNESS = 16u;
 const uint GLOSSY_TABLE_NV = 16u;
 const float GLOSSY_NV_MIN = 0.02;
 const uint RADIANCE_VEC4S = 12u;
-const uint RECORD_RADIANCE_VEC4S = 48u;
+const uint RECORD_RADIANCE_VEC4S = 32u;
 const float GLOSSY_ROUGHNESS_MIN = 0.6;
 
 const uint SH_TWIN_BASIS = 0u;

@@ -32,7 +32,7 @@ uint bits(float x) { return floatBitsToUint(x); }
 float from_bits(uint u) { return uintBitsToFloat(u); }
 
 // in: 0 (j, k, m, n) bits; 1 (xi, psi, seed bits, index bits); 2 normal; 3 (azimuth u, hash input
-// bits, unit-float input bits, -).
+// bits, unit-float input bits, hit distance r).
 void sampling(Row i, inout Row o) {
     uint j = bits(i.v[0].x), k = bits(i.v[0].y), m = bits(i.v[0].z), n = bits(i.v[0].w);
     vec3 d = stratum_direction_local(j, k, m, n, i.v[1].x, i.v[1].y);
@@ -58,6 +58,15 @@ void sampling(Row i, inout Row o) {
     o.v[11] = vec4(world_to_frame(w, t, b, nn), 0.0);
     o.v[12] = vec4(horizontal_u(i.v[1].x * 6.0 - 3.0), 0.0);
     o.v[13] = vec4(horizontal_v(i.v[1].y * 6.0 - 3.0), 0.0);
+    // Radiance records: the stratum's solid angle, the sample the projection sees (l = the
+    // normal input, r = in 3.w), the solid-angle wall coefficients.
+    o.v[0].w = stratum_solid_angle(j, m, n);
+    vec3 rs = radiance_sample(i.v[2].xyz, i.v[3].w);
+    o.v[5].w = rs.x;
+    o.v[6].w = rs.y;
+    o.v[7].w = rs.z;
+    o.v[14] = vec4(radiance_polar_wall_coeff(j, k, m, n), 0.0);
+    o.v[15] = vec4(radiance_azimuthal_wall_coeff(j, k, m, n), 0.0);
 }
 
 // in: 0 p; 1 n; 2 p_i; 3 n_i; 4 (r_i, a, kappa, front tolerance); 5 (w_min, hole threshold, -, -).

@@ -6,6 +6,7 @@
 
 pub mod geometry;
 pub mod ic_fixture;
+pub mod record_fixture;
 pub mod scenes;
 pub mod shader_check;
 pub mod stiff;

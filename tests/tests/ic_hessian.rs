@@ -132,8 +132,10 @@ fn hessian_records_match_the_cpu_twin() {
         rec.update_buffer(&state.counters, 0, &[counters]);
         rec.barrier(Access::ALL_WRITES, Access::ALL);
         let (rq, ct, rc) = (&state.requests, &state.counters, &state.records);
-        pass.record_with_samples(&mut rec, &gpu, &gbuffer, rq, ct, rc, 1, 0, seed, &samples)
-            .unwrap();
+        pass.record_with_samples(
+            &mut rec, &gpu, &gbuffer, rq, ct, rc, 1, 0, seed, &samples, None,
+        )
+        .unwrap();
         ctx.submit(rec).unwrap().wait().unwrap();
         let records: Vec<GpuRecord> = ctx.read_buffer(rc, k as usize).unwrap();
         let dumped: Vec<[f32; 4]> = ctx.read_buffer(&samples, per * points.len()).unwrap();

@@ -9,148 +9,21 @@
 //! (Cornell box), within 5 standard errors taken from the per-stratum spread (treating the strata
 //! as independent samples, which overestimates the error of a stratified estimate).
 
-use bytemuck::Zeroable;
 use glam::Vec3;
-use radcache_cache::radius::{finalize_radius, pixel_footprint};
+use radcache_cache::radius::finalize_radius;
 use radcache_cache::record::*;
 use radcache_cache::sampling::*;
 use radcache_cache::{IcParams, IC_FAR, R_FLOOR};
-use radcache_render::{record_seed, GBuffer, GpuScene, IcState, RecordPass, SkyLight, R_EPS_REL};
+use radcache_render::{RecordPass, SkyLight};
 use radcache_render::{RECORD_FLAGS_MASK, RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE};
 use radcache_render::{RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED};
 use radcache_scene::Scene;
-use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
+use radcache_shared::gpu::{GpuRecord, IcCounters};
 use radcache_tests::geometry::intersect;
-use radcache_tests::ic_fixture::{fill_gbuffer_points, GbufferPoint};
+use radcache_tests::ic_fixture::GbufferPoint;
+use radcache_tests::record_fixture::*;
 use radcache_tests::scenes::{load, temp_dir};
-use radcache_tests::{context, finish, shaders};
-use radcache_vk::ShaderCompiler;
-use radcache_vk::{vk, Access, BindingKind, BindingLayout, Context, Pipeline};
 use std::f32::consts::PI;
-
-const W: u32 = 32;
-const H: u32 = 32;
-/// Record slots the tests look at (the pass must leave the others alone).
-const SLOTS: usize = 16;
-
-fn point(x: u32, y: u32, p: Vec3, n: Vec3) -> GbufferPoint {
-    let mut q = GbufferPoint::zeroed();
-    (q.pixel, q.p, q.n, q.ng, q.footprint) = ([x, y, 0, 0], p, n, n, 0.01);
-    q
-}
-
-fn point_index(q: &GbufferPoint) -> u32 {
-    q.pixel[1] * W + q.pixel[0]
-}
-
-struct Fixture {
-    ctx: Context,
-    shaders: ShaderCompiler,
-    gpu: GpuScene,
-    gbuffer: GBuffer,
-    state: IcState,
-    fill: Pipeline,
-    tris: Vec<[Vec3; 3]>,
-    r_eps: f32,
-}
-
-fn fixture(scene: &Scene) -> Fixture {
-    let (ctx, shaders) = (context(), shaders());
-    let mut gpu = GpuScene::new(&ctx, scene, None).unwrap();
-    gpu.set_time(scene, 0.0).unwrap();
-    gpu.set_view(&scene.camera_at(0.0), W, H, 0, 0).unwrap();
-    let spirv = shaders.compile("tests/gbuffer_fill.comp", &[]).unwrap();
-    let image = |b| BindingLayout::new(b, BindingKind::StorageImage);
-    let texels = BindingLayout::new(3, BindingKind::StorageBuffer);
-    let layout = [image(0), image(1), image(2), texels];
-    let mut tris = Vec::new();
-    for (inst, m) in scene.instances.iter().zip(scene.instance_transforms(0.0)) {
-        let mesh = &scene.meshes[inst.mesh];
-        let world = |t| mesh.triangle(t).map(|p| m.transform_point3(p));
-        tris.extend((0..mesh.triangle_count()).map(world));
-    }
-    Fixture {
-        fill: Pipeline::compute(&ctx, "gbuffer_fill", &spirv, &layout, 4).unwrap(),
-        gbuffer: GBuffer::new(&ctx, W, H).unwrap(),
-        state: IcState::new(&ctx, &shaders, 64, 64).unwrap(),
-        r_eps: R_EPS_REL * gpu.constants().camera_position[3],
-        tris,
-        gpu,
-        shaders,
-        ctx,
-    }
-}
-
-fn end(f: Fixture) {
-    drop((f.gpu, f.gbuffer, f.state, f.fill));
-    finish(f.ctx);
-}
-
-/// What one dispatch left behind.
-struct Run {
-    records: Vec<GpuRecord>,
-    samples: Vec<[f32; 4]>,
-    counters: IcCounters,
-    rays: u64,
-}
-
-/// A value the pass never writes, in every record slot before a dispatch.
-fn sentinel() -> GpuRecord {
-    bytemuck::cast([0xdead_beef_u32; 44])
-}
-
-/// One batch: `requests` over a G-buffer holding `points` (every other pixel is background),
-/// with `counters` as given.
-#[allow(clippy::too_many_arguments)]
-fn run(
-    f: &mut Fixture,
-    pass: &RecordPass,
-    points: &[GbufferPoint],
-    requests: &[u32],
-    counters: IcCounters,
-    seed: u32,
-    level: u32,
-    sub_frame: u32,
-) -> Run {
-    let per = pass.params().sample_count() as usize;
-    let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-    let zeros = vec![[0.0f32; 4]; requests.len() * per];
-    let samples = f.ctx.create_buffer_init("test.samples", storage, &zeros);
-    let texels = f.ctx.create_buffer_init("test.texels", storage, points);
-    let (samples, texels) = (samples.unwrap(), texels.unwrap());
-    let (g, st) = (&f.gbuffer, &f.state);
-    let mut rec = f.ctx.begin("test.records").unwrap();
-    f.gpu.record_update(&f.ctx, &mut rec).unwrap();
-    fill_gbuffer_points(&mut rec, &f.fill, g, &texels, points.len() as u32);
-    rec.update_buffer(&st.requests, 0, requests);
-    rec.update_buffer(&st.counters, 0, &[counters]);
-    rec.update_buffer(&st.records, 0, &[sentinel(); SLOTS]);
-    rec.barrier(Access::ALL_WRITES, Access::ALL);
-    let (requests, counters, records) = (&st.requests, &st.counters, &st.records);
-    pass.record_with_samples(
-        &mut rec, &f.gpu, g, requests, counters, records, level, sub_frame, seed, &samples,
-    )
-    .unwrap();
-    let timings = f.ctx.submit(rec).unwrap().wait().unwrap();
-    assert!(timings.iter().any(|t| t.name == "records"), "no scope");
-    Run {
-        records: f.ctx.read_buffer(records, SLOTS).unwrap(),
-        samples: f.ctx.read_buffer(&samples, zeros.len()).unwrap(),
-        counters: st.read_counters().unwrap(),
-        rays: pass.rays().unwrap(),
-    }
-}
-
-fn counters(base: u32, requests: u32, groups: u32, capacity: u32) -> IcCounters {
-    IcCounters {
-        record_count: base,
-        requested: requests,
-        batch_first: base,
-        dispatch: DispatchArgs::groups(groups),
-        draw: DrawArgs::quads(base, 0),
-        ..IcCounters::reset(capacity, 64)
-    }
-}
 
 fn xyz(v: [f32; 4]) -> Vec3 {
     Vec3::new(v[0], v[1], v[2])
@@ -257,18 +130,6 @@ fn check_record(
     assert_eq!(own_flags, flags, "{rec:?}");
     assert_eq!(rec.info[..3], [point_index(q), level, sub_frame]);
     est
-}
-
-/// The gather direction of stratum `i` as the pass must generate it, and whether it was folded.
-fn direction(q: &GbufferPoint, m: u32, n: u32, seed: u32, i: u32) -> (Vec3, bool) {
-    let nn = normalize_or_z(q.n);
-    let (t, b) = basis_from_normal(nn);
-    let (xi, psi) = stratum_jitter(record_seed(point_index(q), seed), i);
-    let local = stratum_direction_local(i / n, i % n, m, n, xi, psi);
-    let d = frame_to_world(local, t, b, nn);
-    let below = d.dot(q.ng);
-    let folded = (d - 2.0 * below * q.ng).normalize();
-    (if below <= 0.0 { folded } else { d }, below <= 0.0)
 }
 
 /// Compares every gather distance with a CPU ray cast; returns (mismatches, folded directions).
@@ -403,28 +264,6 @@ fn invalid_irradiance_background_and_overflow_are_guarded() {
     assert_eq!(out.counters, expected, "dropped 1, rejected 3");
     drop(pass);
     end(f);
-}
-
-/// The first surface hit through the centre of pixel `(x, y)`, computed on the CPU.
-fn surface_at_pixel(f: &Fixture, scene: &Scene, x: u32, y: u32) -> GbufferPoint {
-    let view = scene.camera_at(0.0);
-    let tan_half = (view.perspective.yfov * 0.5).tan();
-    let sx = ((x as f32 + 0.5) / W as f32 * 2.0 - 1.0) * tan_half * W as f32 / H as f32;
-    let sy = (1.0 - (y as f32 + 0.5) / H as f32 * 2.0) * tan_half;
-    let d = (view.forward + view.right * sx + view.up * sy).normalize();
-    let o = view.position;
-    let hits = f.tris.iter().filter_map(|tri| {
-        let hit = intersect(o.as_dvec3(), d.as_dvec3(), *tri, 0.0);
-        hit.filter(|h| h.t > 0.0).map(|h| (h.t, tri))
-    });
-    let (t, tri) = hits.min_by(|a, b| a.0.total_cmp(&b.0)).expect("a surface");
-    let ng = (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize();
-    let ng = if ng.dot(d) > 0.0 { -ng } else { ng };
-    let p = (o.as_dvec3() + d.as_dvec3() * t).as_vec3();
-    let mut q = point(x, y, p, ng);
-    let depth = t as f32 * d.dot(view.forward);
-    q.footprint = pixel_footprint(depth, tan_half, H as f32, ng.dot(-d));
-    q
 }
 
 #[test]

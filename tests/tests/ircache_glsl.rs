@@ -15,6 +15,7 @@
 
 use glam::Vec3;
 use radcache_cache::extrapolate::{clamp_extrapolation, extrapolate_irradiance};
+use radcache_cache::radiance::*;
 use radcache_cache::radius::*;
 use radcache_cache::record::*;
 use radcache_cache::sampling::*;
@@ -54,7 +55,13 @@ fn sampling(rng: &mut Rng) -> Vec<Case> {
         row[0] = [ub(j), ub(k), ub(m), ub(n)];
         row[1] = [xi, psi, ub(seed), ub(index)];
         row[2] = v4(normal, 0.0);
-        row[3] = [u, ub(h), ub(bits), 0.0];
+        // Hit distances: a hit, IC_FAR itself (a miss), beyond it, and random ones.
+        let r = match i % 4 {
+            0 => IC_FAR,
+            1 => IC_FAR * 2.0,
+            _ => rng.range(0.0, 10.0),
+        };
+        row[3] = [u, ub(h), ub(bits), r];
         let mut e = Expect::new();
         let d = stratum_direction_local(j, k, m, n, xi, psi);
         e.v(0, d, 1.0);
@@ -85,6 +92,15 @@ fn sampling(rng: &mut Rng) -> Vec<Case> {
         e.v(11, world_to_frame(w, t, b, nn), 1.0);
         e.v(12, horizontal_u(xi * 6.0 - 3.0), 1.0);
         e.v(13, horizontal_v(psi * 6.0 - 3.0), 1.0);
+        e.f(0, 3, stratum_solid_angle(j, m, n), 1.0);
+        let rs = radiance_sample(normal, r);
+        for (slot, c) in [(5, 0), (6, 1), (7, 2)] {
+            e.exact(slot, 3, rs[c]);
+        }
+        let rpw = radiance_polar_wall_coeff(j, k, m, n);
+        e.v(14, rpw, rpw.length());
+        let raw = radiance_azimuthal_wall_coeff(j, k, m, n);
+        e.v(15, raw, raw.length());
         cases.push((row, e));
     }
     cases

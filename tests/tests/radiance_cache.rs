@@ -3,7 +3,9 @@
 //! blue plastic sphere of 0.8, a white metal sphere of 0.4 — below the records' threshold, so
 //! path traced per pixel — and a glossy metal floor plate of 0.65), rendered with the cache frame
 //! (the rough lobes' indirect light from the radiance records) against the path tracer; and the
-//! same frame with the per-pixel specular paths (`GlossyLight::Paths`) against it.
+//! same frame with the records' coefficients held constant over their zones
+//! (`GlossyLight::RecordsWithoutGradients`) and with the per-pixel specular paths
+//! (`GlossyLight::Paths`) against it.
 
 use radcache_cache::IcParams;
 use radcache_image::{compare, Image};
@@ -38,7 +40,12 @@ fn glossy_lobes_from_radiance_records_match_the_path_tracer() {
     let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
     let reference = render(&ctx, &shaders, &scene, &mut gpu, size, 4096, 1);
     let mut results = Vec::new();
-    for glossy in [GlossyLight::Records, GlossyLight::Paths] {
+    let methods = [
+        GlossyLight::Records,
+        GlossyLight::RecordsWithoutGradients,
+        GlossyLight::Paths,
+    ];
+    for glossy in methods {
         let settings = IcSettings {
             width: size.0,
             height: size.1,

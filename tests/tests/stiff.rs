@@ -286,6 +286,8 @@ fn hard_scenes_match_the_path_tracer() {
         ("tiny_bright", 0.005, 0.05),
         ("grazing", 0.015, 0.05),
         ("degenerate", 0.01, 0.05),
+        ("glossy_bright", 0.01, 0.05),
+        ("glossy_grazing", 0.01, 0.05),
     ];
     for (name, max_relmse, max_block) in cases {
         let presets: &[Preset] = if matches!(name, "tiny_bright" | "degenerate") {

@@ -8,6 +8,7 @@
 //! |---|---|---|
 //! | [`sampling`] | orthonormal basis, stratified cosine-weighted directions, per-stratum jitter | §2.1, §2.2, §2.3, §7.3 |
 //! | [`record`] | irradiance, harmonic-mean / minimum distance, rotational and translational gradients | §2.5, §2.6, §3.1, §3.2 |
+//! | [`radiance`] | radiance records: SH projection of the strata, translational gradients of the coefficients | `docs/radiance-caching.md` §7 |
 //! | [`radius`] | gradient limit, pixel footprint, screen-space clamp, gradient attenuation, neighbour clamping, `finalize_radius` | §4.2–§4.7 |
 //! | [`weight`] | Ward and Tabellion–Lamorlette weights with in-front and normal tests, weight cap, splat radius | §5.1–§5.4, §5.6, §7.2 |
 //! | [`extrapolate`] | gradient extrapolation with the negative/exploding guards | §6.1, §6.2 |
@@ -22,7 +23,7 @@
 //! test can evaluate both sides over a table of inputs; functions returning several values return
 //! a tuple or small struct here and use `out` parameters, in field order, in GLSL. RGB gradients
 //! are three world-space vectors, one per colour channel (`[Vec3; 3]` here, three `vec3` arguments
-//! in GLSL). Only [`compute_record`], [`compute_hessian`] (slices; the GPU pass reduces the per-stratum terms in shared
+//! in GLSL). Only [`compute_record`], [`compute_hessian`], [`radiance::compute_radiance`] (slices; the GPU pass reduces the per-stratum terms in shared
 //! memory) and the test helper `sampling::stratum_contains` have no twin. `tests/glsl.rs` checks
 //! names, arities and constants and compiles the GLSL when `glslangValidator` is installed.
 //!
@@ -42,6 +43,7 @@ pub mod cache_file;
 pub mod extrapolate;
 pub mod hessian;
 pub mod params;
+pub mod radiance;
 pub mod radius;
 pub mod record;
 pub mod sampling;

@@ -16,7 +16,7 @@ use radcache_shared::glsl_twin::{
 };
 
 /// Rust functions with no GLSL twin (slices / test helpers) and their reason.
-const RUST_ONLY: [(&str, &str); 3] = [
+const RUST_ONLY: [(&str, &str); 4] = [
     (
         "compute_record",
         "takes slices; the GPU pass reduces the per-stratum terms",
@@ -24,6 +24,10 @@ const RUST_ONLY: [(&str, &str); 3] = [
     (
         "compute_hessian",
         "takes slices; the GPU pass sums the per-cell terms",
+    ),
+    (
+        "compute_radiance",
+        "takes slices; the GPU pass sums coefficients and walls per invocation",
     ),
     ("stratum_contains", "test helper"),
 ];

@@ -250,10 +250,13 @@ gpu_consts! {
     /// vec4s per record of the radiance coefficients (`3·SH_COEFFS` floats, packed: coefficient
     /// `i`'s channel `c` at float `3i + c`).
     pub const RADIANCE_VEC4S: u32 = 3 * SH_COEFFS / 4;
-    /// vec4s per record in the radiance buffer: its coefficients (`RADIANCE_VEC4S`), then their
-    /// translational gradients along world x, y and z (`RADIANCE_VEC4S` each, packed as the
-    /// coefficients; docs/radiance-caching.md §7): 768 bytes per record.
-    pub const RECORD_RADIANCE_VEC4S: u32 = 4 * RADIANCE_VEC4S;
+    /// vec4s (uvec4 words) per record in the radiance buffer (docs/radiance-caching.md §7.2):
+    /// its coefficients as f32 (`RADIANCE_VEC4S`), then the gradients' scale `s` (one f32, in
+    /// lane 0 of vec4 `RADIANCE_VEC4S`), then the translational gradients along world x, y and z
+    /// divided by `s`, as f16 pairs (`packHalf2x16`; 24 words per axis, floats packed as the
+    /// coefficients, from vec4 `RADIANCE_VEC4S + 1`), and one vec4 of padding: 512 bytes, so
+    /// 2¹⁸ records fit the 128 MiB a storage buffer binding may span on lavapipe.
+    pub const RECORD_RADIANCE_VEC4S: u32 = 32;
     /// The smallest roughness whose specular lobe is taken from radiance records: from here up
     /// the 4-band product errs by at most 10 % in a room (7.5 % at 0.6, 11.8 % at 0.55;
     /// docs/radiance-caching.md §4); sharper lobes stay path traced per pixel.

@@ -52,6 +52,9 @@ pub enum Glossy {
     /// Radiance records for lobes of roughness ≥ 0.6 (default; where the plan has such
     /// materials, see `radcache info`), sharper lobes path traced per pixel.
     Records,
+    /// As `records`, each record's coefficients constant over its zone (no gradients): for
+    /// measuring what the gradients bring.
+    RecordsNoGradients,
     /// Every lobe's indirect light path traced per pixel.
     Paths,
 }
@@ -132,6 +135,7 @@ impl IcArgs {
     pub fn glossy_light(&self) -> GlossyLight {
         match self.glossy {
             Glossy::Records => GlossyLight::Records,
+            Glossy::RecordsNoGradients => GlossyLight::RecordsWithoutGradients,
             Glossy::Paths => GlossyLight::Paths,
         }
     }

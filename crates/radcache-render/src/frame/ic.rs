@@ -101,15 +101,12 @@ impl IcRenderer {
         }
         let params = settings.params;
         let temporal = settings.time_step_s > 0.0 || settings.settle_records;
-        let radiance =
-            gpu.plan().radiance_cache() && !temporal && settings.glossy == GlossyLight::Records;
+        let radiance = gpu.plan().radiance_cache() && !temporal && settings.glossy.records();
         let glossy = if radiance {
+            let gradients = settings.glossy == GlossyLight::Records;
+            let capacity = settings.record_capacity;
             Some(GlossySplatPass::new(
-                ctx,
-                shaders,
-                w,
-                h,
-                settings.record_capacity,
+                ctx, shaders, w, h, capacity, gradients,
             )?)
         } else {
             None

@@ -70,8 +70,22 @@ pub enum GlossyLight {
     /// otherwise) as [`GlossyLight::Paths`].
     #[default]
     Records,
+    /// As [`GlossyLight::Records`] with each record's coefficients taken as constant over its
+    /// zone (no translational gradients): for measuring what the gradients bring
+    /// (docs/radiance-caching.md §7).
+    RecordsWithoutGradients,
     /// BRDF-sampled paths per pixel and sub-frame (docs/materials.md §10).
     Paths,
+}
+
+impl GlossyLight {
+    /// Glossy lobes take their light from radiance records (with or without gradients).
+    pub fn records(self) -> bool {
+        matches!(
+            self,
+            GlossyLight::Records | GlossyLight::RecordsWithoutGradients
+        )
+    }
 }
 
 /// How the cache's direct pass estimates the light of emissive triangles (docs/cache-frame.md

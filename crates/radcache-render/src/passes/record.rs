@@ -206,8 +206,8 @@ impl RecordPass {
     }
 
     /// As [`RecordPass::record`], and (when built [`RecordPass::with_radiance`]) record `r`
-    /// also writes its `RADIANCE_VEC4S` vec4 of radiance coefficients at `radiance[r·12..]`
-    /// when `radiance` holds them.
+    /// also writes its `RECORD_RADIANCE_VEC4S` vec4 of radiance coefficients and their
+    /// gradients at `radiance[r·48..]` when `radiance` holds them.
     #[allow(clippy::too_many_arguments)]
     pub fn record_with_radiance(
         &self,
@@ -262,6 +262,7 @@ impl RecordPass {
             sub_frame,
             seed,
             &self.no_samples,
+            None,
         )
     }
 
@@ -304,7 +305,8 @@ impl RecordPass {
 
     /// As [`RecordPass::record`], and request `i` also writes the samples of its strata,
     /// `(L_jk.rgb, r_jk)` as `[f32; 4]`, at `samples[i·M·N + j·N + k]`, when `samples` holds at
-    /// least `(i + 1)·M·N` of them (for tests and diagnostics).
+    /// least `(i + 1)·M·N` of them (for tests and diagnostics); with `radiance`, as
+    /// [`RecordPass::record_with_radiance`].
     #[allow(clippy::too_many_arguments)]
     pub fn record_with_samples(
         &self,
@@ -318,13 +320,14 @@ impl RecordPass {
         sub_frame: u32,
         seed: u32,
         samples: &Buffer,
+        radiance: Option<&Buffer>,
     ) -> Result<()> {
         let io = Io {
             requests,
             counters,
             records,
             samples,
-            radiance: &self.no_radiance,
+            radiance: radiance.unwrap_or(&self.no_radiance),
         };
         self.record_pixels(rec, scene, gbuffer, &io, level, sub_frame, seed)
     }

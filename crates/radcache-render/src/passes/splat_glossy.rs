@@ -1,8 +1,8 @@
 //! Glossy splatting (`shaders/passes/splat.vert` + `splat_glossy.frag`, docs/radiance-caching.md
 //! §6.2): the radiance records for glossy lobes. It owns what the other passes read and write
 //! for them:
-//! * the records' SH coefficients (`RADIANCE_VEC4S` vec4 per record; the record pass writes
-//!   them);
+//! * the records' SH coefficients and their translational gradients (`RECORD_RADIANCE_VEC4S`
+//!   vec4 per record; the record pass writes them);
 //! * each pixel's glossy world weights (the direct pass writes them per sub-frame);
 //! * the lobe table;
 //! * the glossy target.
@@ -15,7 +15,7 @@
 //! themselves would need.
 
 use radcache_material::glossy::{glossy_table, GLOSSY_TABLE_STRATA};
-use radcache_shared::consts::RADIANCE_VEC4S;
+use radcache_shared::consts::{RADIANCE_VEC4S, RECORD_RADIANCE_VEC4S};
 use radcache_vk::{
     vk, Blend, Buffer, BufferDesc, ColorTarget, Context, GraphicsDesc, Image, ImageDesc, ImageUse,
     MemoryLocation, Pipeline, Recorder, Resource, ShaderCompiler,
@@ -28,15 +28,18 @@ use crate::passes::splat::SplatWeights;
 use crate::scene::GpuScene;
 use crate::state::IcState;
 
-/// Bytes of radiance coefficients per record (`RADIANCE_VEC4S` vec4).
-pub const RADIANCE_BYTES_PER_RECORD: u64 = RADIANCE_VEC4S as u64 * 16;
+/// Bytes of radiance coefficients and their gradients per record (`RECORD_RADIANCE_VEC4S` vec4).
+pub const RADIANCE_BYTES_PER_RECORD: u64 = RECORD_RADIANCE_VEC4S as u64 * 16;
+/// Bytes of glossy world weights per pixel (`RADIANCE_VEC4S` vec4).
+pub const WEIGHT_BYTES_PER_PIXEL: u64 = RADIANCE_VEC4S as u64 * 16;
 
 /// The glossy splat's pipeline, target and buffers.
 pub struct GlossySplatPass {
     pipeline: Pipeline,
     /// Σ w·L_glossy (rgb) and Σ w (a) per pixel.
     pub sum: Image,
-    /// The records' radiance coefficients (`RADIANCE_VEC4S` vec4 per record).
+    /// The records' radiance coefficients and their gradients (`RECORD_RADIANCE_VEC4S` vec4 per
+    /// record).
     pub radiance: Buffer,
     /// Each pixel's glossy world weights (`RADIANCE_VEC4S` vec4 per pixel).
     pub weights: Buffer,
@@ -52,16 +55,23 @@ impl std::fmt::Debug for GlossySplatPass {
 
 impl GlossySplatPass {
     /// Compiles the pass and allocates the target and the weights for `width × height` pixels,
-    /// the coefficients for `record_capacity` records, and the table.
+    /// the coefficients for `record_capacity` records, and the table; `gradients` extrapolates
+    /// the coefficients by their translational gradients (docs/radiance-caching.md §7).
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
         width: u32,
         height: u32,
         record_capacity: u32,
+        gradients: bool,
     ) -> Result<Self> {
         let vertex = shaders.compile("passes/splat.vert", &[])?;
-        let fragment = shaders.compile("passes/splat_glossy.frag", &[])?;
+        let defines: &[(&str, &str)] = if gradients {
+            &[("GLOSSY_GRADIENTS", "1")]
+        } else {
+            &[]
+        };
+        let fragment = shaders.compile("passes/splat_glossy.frag", defines)?;
         let format = vk::Format::R32G32B32A32_SFLOAT;
         let pipeline = Pipeline::graphics(
             ctx,
@@ -110,7 +120,7 @@ impl GlossySplatPass {
                 "splat.glossy.radiance",
                 u64::from(record_capacity) * RADIANCE_BYTES_PER_RECORD,
             )?,
-            weights: buffer("splat.glossy.weights", pixels * RADIANCE_BYTES_PER_RECORD)?,
+            weights: buffer("splat.glossy.weights", pixels * WEIGHT_BYTES_PER_PIXEL)?,
             table: ctx.create_buffer_init("splat.glossy.table", storage, &table)?,
         })
     }

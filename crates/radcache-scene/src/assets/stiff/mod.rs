@@ -13,6 +13,7 @@
 //! | scale (`extreme.rs`) | `cornell_1e-3`, `cornell_1e4`: the Cornell box scaled | the path tracer on `cornell_1` |
 //! | radiometry (`extreme.rs`) | `tiny_bright`: a 1 cm emitter of radiance 1e6 | path tracer |
 //! | views (`extreme.rs`) | `grazing`: a 200 m floor seen from 30 cm, with a plank crossing the near plane | path tracer |
+//! | glossy lobes (`extreme.rs`) | `glossy_bright`: a rough metal floor (0.65) under a 4 cm emitter of radiance 1e4; `glossy_grazing`: a rough metal floor (0.7) under a sky seen from 30 cm | path tracer |
 //! | degenerate input (`degenerate.rs`) | `degenerate`: zero-area, repeated-index and needle triangles, duplicated vertices, inward normals, zero-length normals, a zero-area emitter | warnings with counts; path tracer |
 //! | | `inside_object`: the camera inside a closed cube | black (leak) |
 //! | | `nan_vertex`, `inf_vertex` | a load error naming the file and the accessor |
