@@ -118,34 +118,6 @@ fn glossy_bright() -> GltfBuilder {
     b
 }
 
-/// [`grazing`]'s floor and boxes with the floor a rough white metal (roughness 0.7) and no
-/// plank: the floor's lobes point towards the horizon, where the boxes stand.
-fn glossy_grazing() -> GltfBuilder {
-    let mut b = GltfBuilder::new();
-    let metal = b.add_material(&MaterialDesc::metal_rough("floor", [0.9; 3], 1.0, 0.7));
-    let white = b.add_material(&MaterialDesc::diffuse("box", [0.8, 0.7, 0.6]));
-    let mut floor = QuadSoup::default();
-    floor.quad(rect(1, 0.0, [-100.0, 100.0], [-100.0, 100.0]), Vec3::Y);
-    let mut boxes = QuadSoup::default();
-    for (i, z) in [2.0f32, 5.0, 10.0, 20.0, 40.0].into_iter().enumerate() {
-        let x = if i % 2 == 0 { -0.8 } else { 0.9 };
-        boxes.cuboid(Vec3::new(x, 0.5, -z), Vec3::splat(0.5), false);
-    }
-    let floor = b.add_mesh("floor", &[floor.primitive(metal)]);
-    let boxes = b.add_mesh("boxes", &[boxes.primitive(white)]);
-    let nodes = vec![
-        mesh_node(&mut b, "floor", floor),
-        mesh_node(&mut b, "boxes", boxes),
-        camera(&mut b, Vec3::new(0.0, 0.3, 0.0), 0.0, -5.0, 60.0, 0.05),
-    ];
-    b.add_scene(
-        "glossy_grazing",
-        &nodes,
-        Some(json!({"environment": {"radiance": [1.0, 1.0, 1.0]}})),
-    );
-    b
-}
-
 /// A 4 m × 3 m × 4 m room (albedo 0.5, inward) with a 1 cm × 1 cm emitter of radiance 1e6 just
 /// below the ceiling, facing down; the camera looks across the room.
 fn tiny_bright() -> GltfBuilder {
@@ -171,8 +143,20 @@ fn tiny_bright() -> GltfBuilder {
 /// the view at 2–40 m, and a plank (0.18 m × 0.06 m × 2 m) from behind the camera into the view,
 /// crossing the near plane (0.05 m). The camera sits 0.3 m above the floor, pitched 5° down.
 fn grazing() -> GltfBuilder {
+    grazing_floor("grazing", &MaterialDesc::diffuse("floor", [0.5; 3]), true)
+}
+
+/// [`grazing`]'s floor and boxes with the floor a rough white metal (roughness 0.7) and no
+/// plank: the floor's lobes point towards the horizon, where the boxes stand.
+fn glossy_grazing() -> GltfBuilder {
+    let metal = MaterialDesc::metal_rough("floor", [0.9; 3], 1.0, 0.7);
+    grazing_floor("glossy_grazing", &metal, false)
+}
+
+/// The grazing scenes: the floor of material `floor`, the boxes, the plank if asked, the sky.
+fn grazing_floor(name: &str, floor_material: &MaterialDesc, plank: bool) -> GltfBuilder {
     let mut b = GltfBuilder::new();
-    let grey = b.add_material(&MaterialDesc::diffuse("floor", [0.5; 3]));
+    let grey = b.add_material(floor_material);
     let white = b.add_material(&MaterialDesc::diffuse("box", [0.8, 0.7, 0.6]));
     let mut floor = QuadSoup::default();
     floor.quad(rect(1, 0.0, [-100.0, 100.0], [-100.0, 100.0]), Vec3::Y);
@@ -181,11 +165,13 @@ fn grazing() -> GltfBuilder {
         let x = if i % 2 == 0 { -0.8 } else { 0.9 };
         boxes.cuboid(Vec3::new(x, 0.5, -z), Vec3::splat(0.5), false);
     }
-    boxes.cuboid(
-        Vec3::new(0.11, 0.23, -0.5),
-        Vec3::new(0.09, 0.03, 1.0),
-        false,
-    );
+    if plank {
+        boxes.cuboid(
+            Vec3::new(0.11, 0.23, -0.5),
+            Vec3::new(0.09, 0.03, 1.0),
+            false,
+        );
+    }
     let floor = b.add_mesh("floor", &[floor.primitive(grey)]);
     let boxes = b.add_mesh("boxes", &[boxes.primitive(white)]);
     let nodes = vec![
@@ -194,7 +180,7 @@ fn grazing() -> GltfBuilder {
         camera(&mut b, Vec3::new(0.0, 0.3, 0.0), 0.0, -5.0, 60.0, 0.05),
     ];
     b.add_scene(
-        "grazing",
+        name,
         &nodes,
         Some(json!({"environment": {"radiance": [1.0, 1.0, 1.0]}})),
     );
