@@ -9,6 +9,7 @@ pub mod ic_fixture;
 pub mod record_fixture;
 pub mod scenes;
 pub mod shader_check;
+pub mod sliding_box;
 pub mod stiff;
 pub mod twin;
 

@@ -54,6 +54,7 @@ fn same_records(a: &CacheRecords, b: &CacheRecords) -> bool {
     bits(&a.records) == bits(&b.records)
         && bits(&a.temporal) == bits(&b.temporal)
         && a.last_used == b.last_used
+        && bits(&a.radiance) == bits(&b.radiance)
         && (a.frames, a.lifespans, a.sky) == (b.frames, b.lifespans, b.sky)
 }
 

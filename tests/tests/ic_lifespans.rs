@@ -4,121 +4,27 @@
 //! rendered with kept records stays as close to a path-traced reference of that frame as a
 //! fresh cache.
 
-use glam::{Quat, Vec3};
+use glam::Vec3;
 use radcache_cache::temporal::temporal_lifespan;
 use radcache_cache::IcParams;
 use radcache_image::{compare, Image};
 use radcache_render::{
     render_path, Budget, GpuScene, IcRenderer, IcSettings, IcStats, PathSettings,
 };
-use radcache_scene::writer::{ChannelDesc, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
-use radcache_scene::{AnimationKind, Interpolation, Property, Scene};
+use radcache_scene::Scene;
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
-use radcache_tests::geometry::room;
-use radcache_tests::scenes::{camera_node, cube, plane_y, temp_dir, write_and_load};
+use radcache_tests::sliding_box::{self, box_centre, distance_to_path, FAR, HALF, NEAR};
 use radcache_tests::{context, finish, shaders};
 use radcache_vk::Context;
 
 const SIZE: u32 = 48;
-const FPS: f32 = 24.0;
-const HALF: f32 = 0.25;
-const Z_BOX: f32 = -1.6;
-/// Records this far from the box's path (m; the room is 4 m × 6 m) see it under a small solid
-/// angle: their indirect light changes by well under 1 % per frame.
-const FAR: f32 = 3.0;
-/// Records this close to the box's path see it large (m).
-const NEAR: f32 = 0.8;
-
-/// The box's centre at time `t`: x from −1.6 to −0.4 over 0.5 s (0.1 m per frame at 24 fps).
-fn box_centre(t: f32) -> Vec3 {
-    let s = (t / 0.5).clamp(0.0, 1.0);
-    Vec3::new(-1.6 + 1.2 * s, HALF, Z_BOX)
-}
-
-/// Distance from `p` to the segment the box's centre sweeps.
-fn distance_to_path(p: Vec3) -> f32 {
-    let (a, b) = (box_centre(0.0), box_centre(1.0));
-    let s = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
-    (p - (a + (b - a) * s)).length()
-}
-
-/// A 4 × 2.5 × 6 m grey room lit by a ceiling panel, a red box sliding along the floor, and a
-/// static camera near one wall looking across the room.
-fn sliding_box_scene(tag: &str) -> Scene {
-    let mut b = GltfBuilder::new();
-    let grey = b.add_material(&MaterialDesc::diffuse("grey", [0.7; 3]));
-    let red = b.add_material(&MaterialDesc::diffuse("red", [0.8, 0.15, 0.1]));
-    let mut light = MaterialDesc::diffuse("light", [0.0; 3]);
-    light.emissive = [6.0; 3];
-    let light = b.add_material(&light);
-    let walls = room(Vec3::new(-2.0, 0.0, -2.0), Vec3::new(2.0, 2.5, 4.0));
-    let corners: Vec<[f32; 3]> = walls.positions.iter().map(|p| p.to_array()).collect();
-    let room_mesh = b.add_mesh(
-        "room",
-        &[PrimitiveDesc::triangles(
-            corners,
-            None,
-            walls.indices,
-            Some(grey),
-        )],
-    );
-    let boxy = b.add_mesh("box", &[cube(HALF, red)]);
-    let panel = b.add_mesh("panel", &[plane_y([-0.5, 0.5], [-0.5, 0.5], 0.0, light)]);
-    let room_node = b.add_node(&NodeDesc {
-        mesh: Some(room_mesh),
-        ..Default::default()
-    });
-    let box_node = b.add_node(&NodeDesc {
-        name: Some("box".into()),
-        mesh: Some(boxy),
-        translation: Some(box_centre(0.0).to_array()),
-        ..Default::default()
-    });
-    let panel_node = b.add_node(&NodeDesc {
-        mesh: Some(panel),
-        translation: Some([0.0, 2.45, 0.0]),
-        rotation: Some(Quat::from_rotation_x(std::f32::consts::PI).to_array()),
-        ..Default::default()
-    });
-    let camera = camera_node(
-        &mut b,
-        Vec3::new(0.0, 1.6, 3.9),
-        Quat::from_rotation_x(-0.45),
-        1.2,
-    );
-    let (a, e) = (box_centre(0.0), box_centre(0.5));
-    b.add_animation(
-        "slide",
-        &[ChannelDesc {
-            node: box_node,
-            property: Property::Translation,
-            interpolation: Interpolation::Linear,
-            times: vec![0.0, 0.5],
-            values: [a, e].iter().flat_map(|v| v.to_array()).collect(),
-        }],
-    );
-    b.add_scene("slide", &[room_node, box_node, panel_node, camera], None);
-    let scene = write_and_load(&b, &temp_dir(tag), "slide");
-    assert_eq!(scene.plan().animation.kind, AnimationKind::Geometry);
-    assert!(scene.plan().needs_lifespans());
-    scene
-}
 
 fn settings(frame: u32) -> IcSettings {
-    IcSettings {
-        width: SIZE,
-        height: SIZE,
-        params: IcParams::draft(),
-        sub_frames: 4,
-        direct_samples: 4,
-        seed: 3,
-        frame,
-        time: (frame - 1) as f32 / FPS,
-        record_capacity: 1 << 14,
-        settle_records: true,
-        time_step_s: 1.0 / FPS,
-        ..IcSettings::default()
-    }
+    sliding_box::settings(SIZE, frame)
+}
+
+fn sliding_box_scene(tag: &str) -> Scene {
+    sliding_box::sliding_box_scene(tag, false)
 }
 
 struct Cache {

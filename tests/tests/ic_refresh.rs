@@ -38,6 +38,7 @@ fn refresh(
         &state.requests,
         &state.counters,
         &state.records,
+        None,
         seed,
     )
     .unwrap();

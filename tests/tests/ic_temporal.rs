@@ -1,5 +1,5 @@
-//! Records kept across frames (`IcRenderer`) on lavapipe: a static scene renders identical
-//! frames without creating records; under camera motion, later frames create few records and
+//! Records kept across frames (`IcRenderer`) on lavapipe: a static scene (with or without
+//! radiance records for glossy lobes) renders identical frames without creating records; under camera motion, later frames create few records and
 //! the kept ones keep their irradiance and gradients bit for bit (their radius takes the new
 //! view's clamp); `forget` rebuilds.
 
@@ -113,20 +113,25 @@ fn records(ctx: &Context, r: &IcRenderer, n: u64) -> Vec<GpuRecord> {
     ctx.read_buffer(&r.state().records, n as usize).unwrap()
 }
 
-#[test]
-fn a_static_scene_renders_identical_frames_from_kept_records() {
-    let scene = load(&std::path::PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../assets/cornell/cornell.gltf"
-    )));
+/// A bundled scene by name (`assets/<name>/<name>.gltf`).
+fn bundled(name: &str) -> Scene {
+    load(
+        &std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("../assets/{name}/{name}.gltf")),
+    )
+}
+
+/// Frames 2 and 3 of static `scene` create no record and equal frame 1 bit for bit; after
+/// `forget` the rebuilt cache gives frame 1 again up to round-off. Returns the records.
+fn static_frames_are_identical(scene: &Scene) -> u64 {
     assert_eq!(scene.plan().animation.kind, AnimationKind::None);
     let (ctx, shaders) = (context(), shaders());
-    let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
+    let mut gpu = GpuScene::new(&ctx, scene, None).unwrap();
     let mut r = IcRenderer::new(&ctx, &shaders, &gpu, &settings(0.0, 1)).unwrap();
-    let (first, s1) = frame(&ctx, &scene, &mut gpu, &mut r, 0.0, 1);
+    let (first, s1) = frame(&ctx, scene, &mut gpu, &mut r, 0.0, 1);
     assert!(created(&s1) > 50 && s1.records_kept == 0, "{s1:?}");
     for n in 2..=3 {
-        let (image, s) = frame(&ctx, &scene, &mut gpu, &mut r, 0.0, n);
+        let (image, s) = frame(&ctx, scene, &mut gpu, &mut r, 0.0, n);
         assert_eq!(created(&s), 0, "frame {n}: {s:?}");
         assert_eq!(s.records_kept, s1.records);
         assert!(image == first, "frame {n} differs from frame 1");
@@ -135,11 +140,26 @@ fn a_static_scene_renders_identical_frames_from_kept_records() {
     // round-off (records are created in the order GPU atomics hand out, which sets the order of
     // the splat's additions).
     r.forget();
-    let (rebuilt, s) = frame(&ctx, &scene, &mut gpu, &mut r, 0.0, 4);
+    let (rebuilt, s) = frame(&ctx, scene, &mut gpu, &mut r, 0.0, 4);
     assert_eq!((s.records_kept, created(&s)), (0, s1.records));
     assert_close(&rebuilt, &first);
     drop((r, gpu));
     finish(ctx);
+    s1.records
+}
+
+#[test]
+fn a_static_scene_renders_identical_frames_from_kept_records() {
+    static_frames_are_identical(&bundled("cornell"));
+}
+
+/// The glossy lobes of kept radiance records (docs/radiance-caching.md §8): their blocks stay
+/// with the records, so the frames of a static glossy scene are identical too.
+#[test]
+fn a_static_glossy_scene_renders_identical_frames_from_kept_radiance_records() {
+    let scene = bundled("glossy_room");
+    assert!(scene.plan().radiance_cache(), "{}", scene.plan());
+    static_frames_are_identical(&scene);
 }
 
 #[test]

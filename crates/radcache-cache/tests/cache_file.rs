@@ -5,7 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use radcache_cache::cache_file::{
-    CacheFile, CacheFileError, CacheIdentity, CacheRecords, CacheSettings, Refusal, HEADER_LEN,
+    CacheFile, CacheFileError, CacheIdentity, CacheRecords, CacheSettings, RadianceBlock, Refusal,
+    BYTES_PER_RECORD, HEADER_LEN, RADIANCE_BYTES_PER_RECORD,
 };
 use radcache_cache::{ErrorControl, IcParams};
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
@@ -47,7 +48,30 @@ fn records(n: usize) -> CacheRecords {
         frames: 7,
         lifespans: false,
         sky: true,
+        radiance: Vec::new(),
     }
+}
+
+/// `records(n)` with a radiance block per record, every word distinct (NaN patterns included).
+fn records_with_radiance(n: usize) -> CacheRecords {
+    let mut r = records(n);
+    r.radiance = (0..n)
+        .map(|i| {
+            let mut block: RadianceBlock = bytemuck::Zeroable::zeroed();
+            let w: &mut [u32] = bytemuck::cast_slice_mut(&mut block);
+            for (k, w) in w.iter_mut().enumerate() {
+                *w = (i * 10_000 + k) as u32 | (0x7f80_0000 * (k % 11 == 3) as u32);
+            }
+            block
+        })
+        .collect();
+    r
+}
+
+/// Rewrites the header checksum after an edit of bytes 0..120.
+fn reseal_header(b: &mut [u8]) {
+    let crc = crc32fast::hash(&b[..HEADER_LEN - 4]);
+    b[HEADER_LEN - 4..HEADER_LEN].copy_from_slice(&crc.to_le_bytes());
 }
 
 fn dir() -> PathBuf {
@@ -125,19 +149,23 @@ fn a_file_that_is_not_a_cache_file_is_refused() {
 
 #[test]
 fn another_format_version_is_refused() {
-    let mut b = bytes(3);
-    b[8..12].copy_from_slice(&2u32.to_le_bytes());
-    let (r, text) = refusal(&write("version.rcache", &b), &identity());
-    assert!(
-        matches!(
-            r,
-            Refusal::Version {
-                found: 2,
-                supported: 1
-            }
-        ),
-        "{text}"
-    );
+    for version in [0u32, 3] {
+        let mut b = bytes(3);
+        b[8..12].copy_from_slice(&version.to_le_bytes());
+        let (r, text) = refusal(&write("version.rcache", &b), &identity());
+        assert!(
+            matches!(
+                r,
+                Refusal::Version {
+                    found,
+                    oldest: 1,
+                    newest: 2
+                } if found == version
+            ),
+            "{text}"
+        );
+        assert!(text.contains("reads versions 1 to 2"), "{text}");
+    }
 }
 
 #[test]
@@ -276,4 +304,71 @@ fn a_missing_file_is_an_io_error_naming_it() {
     let err = CacheFile::read(&path).unwrap_err();
     assert!(matches!(err, CacheFileError::Io { .. }));
     assert!(err.to_string().contains("absent.rcache"), "{err}");
+}
+
+#[test]
+fn radiance_blocks_round_trip_and_are_checked_like_the_records() {
+    let original = records_with_radiance(5);
+    let b = CacheFile::new(identity(), original.clone()).encode();
+    assert_eq!(
+        b.len() as u64,
+        HEADER_LEN as u64 + 5 * (BYTES_PER_RECORD + RADIANCE_BYTES_PER_RECORD)
+    );
+    let path = write("radiance.rcache", &b);
+    let file = CacheFile::load(&path, &identity(), 5).unwrap();
+    assert!(file.header.radiance);
+    assert_eq!(
+        bytemuck::cast_slice::<RadianceBlock, u8>(&file.records.radiance),
+        bytemuck::cast_slice::<RadianceBlock, u8>(&original.radiance)
+    );
+    assert_eq!(file.records.last_used, original.last_used);
+    let text = file.header.describe();
+    assert!(text.contains("radiance coefficients: yes"), "{text}");
+    let plain = CacheFile::decode(&bytes(5)).unwrap();
+    assert!(!plain.header.radiance && plain.records.radiance.is_empty());
+    assert!(plain
+        .header
+        .describe()
+        .contains("radiance coefficients: no"));
+
+    // A flipped word in a block fails the payload checksum; a cut block is truncation.
+    let mut bad = b.clone();
+    let last = bad.len() - 7;
+    bad[last] ^= 0x10;
+    let (r, text) = refusal(&write("radiance-bad.rcache", &bad), &identity());
+    assert!(matches!(r, Refusal::Corrupt(_)), "{text}");
+    let cut = &b[..b.len() - 100];
+    let (r, text) = refusal(&write("radiance-cut.rcache", cut), &identity());
+    assert!(matches!(r, Refusal::Truncated { .. }), "{text}");
+    // The flag without the blocks' bytes (header resealed) is a length mismatch.
+    let mut lie = bytes(5);
+    let flags = u32::from_le_bytes(lie[96..100].try_into().unwrap()) | 8;
+    lie[96..100].copy_from_slice(&flags.to_le_bytes());
+    reseal_header(&mut lie);
+    let (r, text) = refusal(&write("radiance-lie.rcache", &lie), &identity());
+    assert!(matches!(r, Refusal::Corrupt(_)), "{text}");
+    assert!(text.contains("payload bytes"), "{text}");
+}
+
+#[test]
+fn a_version_1_file_is_read_and_cannot_claim_radiance_blocks() {
+    // Version 1 is version 2 without the radiance flag: the same bytes with the old number.
+    let mut v1 = bytes(4);
+    v1[8..12].copy_from_slice(&1u32.to_le_bytes());
+    reseal_header(&mut v1);
+    let file = CacheFile::load(&write("v1.rcache", &v1), &identity(), 4).unwrap();
+    assert_eq!(file.header.version, 1);
+    assert_eq!(file.records.records.len(), 4);
+    assert!(!file.header.radiance && file.records.radiance.is_empty());
+    let original = records(4);
+    assert_eq!(
+        bytemuck::cast_slice::<GpuRecord, u8>(&file.records.records),
+        bytemuck::cast_slice::<GpuRecord, u8>(&original.records)
+    );
+    // A version-1 header with the radiance flag is not a file version 1 ever wrote.
+    let mut claim = CacheFile::new(identity(), records_with_radiance(4)).encode();
+    claim[8..12].copy_from_slice(&1u32.to_le_bytes());
+    reseal_header(&mut claim);
+    let (r, text) = refusal(&write("v1-claim.rcache", &claim), &identity());
+    assert!(matches!(r, Refusal::Corrupt(_)), "{text}");
 }

@@ -144,6 +144,8 @@ fn info(args: &InfoArgs) -> Result<ExitCode> {
             "records": h.record_count,
             "frames": h.frames,
             "lifespans": h.lifespans,
+            "sky": h.sky,
+            "radiance": h.radiance,
             "payload_bytes": h.payload_len,
             "payload_crc32": format!("{:08x}", h.payload_crc),
         });

@@ -47,4 +47,4 @@ pub use passes::temporal::{Lifespans, TemporalPass};
 pub use scene::env_map::{gpu_alias, texel_solid_angle, EnvMap};
 pub use scene::upload::vulkan_clip_from_view;
 pub use scene::{GpuScene, UploadStats, REFITS_PER_REBUILD};
-pub use state::IcState;
+pub use state::{IcState, RadianceBlock, RADIANCE_BYTES_PER_RECORD};

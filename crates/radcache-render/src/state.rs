@@ -1,5 +1,6 @@
 //! The irradiance cache's GPU state: the record buffer, the request list, the neighbour grid, the
-//! records' temporal state and the counters with the indirect arguments (`IcCounters`), which the
+//! records' temporal state, their radiance blocks (where the scene has glossy lobes from the
+//! cache) and the counters with the indirect arguments (`IcCounters`), which the
 //! bookkeeping pass ([`crate::passes::ic_counters`]) keeps consistent on the GPU, so the host never
 //! reads a count to size a dispatch or a draw.
 
@@ -11,6 +12,7 @@ use radcache_vk::{
 use crate::error::{Error, Result};
 use crate::passes::ic_counters::{CounterStep, IcCountersPass};
 
+pub use radcache_cache::cache_file::{RadianceBlock, RADIANCE_BYTES_PER_RECORD};
 pub use radcache_shared::consts::{GRID_LEVELS, GRID_SLOTS};
 
 /// Buckets of the neighbour grid for `record_capacity` records: the power of two at or above
@@ -43,6 +45,10 @@ pub struct IcState {
     /// `GpuRecordTemporal[record_capacity]`: each record's temporal state (temporal caching,
     /// `crate::temporal`).
     pub temporal: Buffer,
+    /// `RadianceBlock[record_capacity]`: each record's radiance coefficients and their
+    /// gradients (docs/radiance-caching.md §7.2; the record pass writes them, the glossy splat
+    /// reads them), in scenes with glossy lobes from the cache ([`IcState::with_radiance`]).
+    pub radiance: Option<Buffer>,
     record_capacity: u32,
     request_capacity: u32,
 }
@@ -63,6 +69,17 @@ impl IcState {
         shaders: &ShaderCompiler,
         record_capacity: u32,
         request_capacity: u32,
+    ) -> Result<IcState> {
+        Self::with_radiance(ctx, shaders, record_capacity, request_capacity, false)
+    }
+
+    /// As [`IcState::new`]; with `radiance` also a radiance block per record.
+    pub fn with_radiance(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        record_capacity: u32,
+        request_capacity: u32,
+        radiance: bool,
     ) -> Result<IcState> {
         let bookkeeping = IcCountersPass::new(ctx, shaders)?;
         let buffer = |name, size: u64, usage, location| {
@@ -122,6 +139,18 @@ impl IcState {
                 storage | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuOnly,
             )?,
+            radiance: if radiance {
+                Some(buffer(
+                    "ic.radiance",
+                    u64::from(record_capacity.max(1)) * RADIANCE_BYTES_PER_RECORD,
+                    storage
+                        | vk::BufferUsageFlags::TRANSFER_SRC
+                        | vk::BufferUsageFlags::TRANSFER_DST,
+                    MemoryLocation::GpuOnly,
+                )?)
+            } else {
+                None
+            },
             record_capacity,
             request_capacity,
         })
@@ -161,8 +190,8 @@ impl IcState {
     }
 
     /// Keeps the records `keep` selects (by index and last use) and drops the others, moving the
-    /// kept ones (with their temporal state) to the front in their order; returns how many were dropped. The caller must
-    /// rebuild the neighbour grid afterwards. Rare (eviction), so it goes through the host.
+    /// kept ones (with their temporal state and radiance blocks) to the front in their order;
+    /// returns how many were dropped. The caller must rebuild the neighbour grid afterwards. Rare (eviction), so it goes through the host.
     pub fn compact(&self, ctx: &Context, keep: impl Fn(usize, u32) -> bool) -> Result<u32> {
         let counters = self.read_counters()?;
         let count = counters.record_count.min(self.record_capacity) as usize;
@@ -177,6 +206,10 @@ impl IcState {
         }
         let records: Vec<GpuRecord> = ctx.read_buffer(&self.records, count)?;
         let temporal: Vec<GpuRecordTemporal> = ctx.read_buffer(&self.temporal, count)?;
+        let blocks: Vec<RadianceBlock> = match &self.radiance {
+            Some(b) => ctx.read_buffer(b, count)?,
+            None => Vec::new(),
+        };
         let mut rec = ctx.begin("ic.compact")?;
         let n = kept.len() as u32;
         let mut staging = Vec::new();
@@ -195,6 +228,13 @@ impl IcState {
             let bytes = std::mem::size_of_val(&new_temporal[..]) as u64;
             rec.copy_buffer(&t, 0, &self.temporal, 0, bytes);
             staging.extend([r, u, t]);
+            if let Some(radiance) = &self.radiance {
+                let new_blocks: Vec<RadianceBlock> = kept.iter().map(|&i| blocks[i]).collect();
+                let b = ctx.create_buffer_init("ic.compact.radiance", src, &new_blocks)?;
+                let bytes = std::mem::size_of_val(&new_blocks[..]) as u64;
+                rec.copy_buffer(&b, 0, radiance, 0, bytes);
+                staging.push(b);
+            }
         }
         // Slots past the kept records start again as never used.
         rec.fill_buffer(
@@ -309,6 +349,49 @@ impl IcState {
         rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
         ctx.submit(rec)?.wait()?;
         drop(staging);
+        Ok(())
+    }
+
+    /// The radiance blocks of the first `count` records (after the last submission's fence);
+    /// none without radiance blocks.
+    pub fn download_radiance(&self, ctx: &Context) -> Result<Vec<RadianceBlock>> {
+        let Some(radiance) = &self.radiance else {
+            return Ok(Vec::new());
+        };
+        let count = self.read_counters()?.record_count.min(self.record_capacity) as usize;
+        if count == 0 {
+            return Ok(Vec::new());
+        }
+        Ok(ctx.read_buffer(radiance, count)?)
+    }
+
+    /// Writes `blocks` as the radiance blocks of the first `blocks.len()` records (after
+    /// [`IcState::upload`] of as many records). An error without radiance blocks or with more
+    /// blocks than the capacity.
+    pub fn upload_radiance(&self, ctx: &Context, blocks: &[RadianceBlock]) -> Result<()> {
+        let Some(radiance) = &self.radiance else {
+            return Err(Error::Invalid(
+                "radiance blocks for a cache made without radiance records".into(),
+            ));
+        };
+        if blocks.len() > self.record_capacity as usize {
+            return Err(Error::Invalid(format!(
+                "{} radiance blocks do not fit in the cache's capacity of {}",
+                blocks.len(),
+                self.record_capacity
+            )));
+        }
+        if blocks.is_empty() {
+            return Ok(());
+        }
+        let src = vk::BufferUsageFlags::TRANSFER_SRC;
+        let b = ctx.create_buffer_init("ic.upload.radiance", src, blocks)?;
+        let mut rec = ctx.begin("ic.upload.radiance")?;
+        rec.barrier(Access::ALL, Access::TRANSFER_WRITE);
+        rec.copy_buffer(&b, 0, radiance, 0, std::mem::size_of_val(blocks) as u64);
+        rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
+        ctx.submit(rec)?.wait()?;
+        drop(b);
         Ok(())
     }
 

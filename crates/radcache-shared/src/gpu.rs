@@ -347,6 +347,12 @@ pub fn generated_glsl() -> String {
     s
 }
 
+/// One record's block of the radiance buffer (`consts::RECORD_RADIANCE_VEC4S` uvec4, 512
+/// bytes, docs/radiance-caching.md §7.2): its SH coefficients as f32 bits, the gradients' scale
+/// and the f16-packed translational gradients, as the record pass writes them. The host moves
+/// blocks as opaque words (compaction, cache files).
+pub type RadianceBlock = [[u32; 4]; crate::consts::RECORD_RADIANCE_VEC4S as usize];
+
 #[cfg(test)]
 mod tests {
     use super::*;

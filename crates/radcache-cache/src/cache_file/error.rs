@@ -9,13 +9,17 @@ pub enum Refusal {
     /// The file does not start with the cache file's magic.
     #[error("not a radcache cache file (it does not start with \"RADCACHE\")")]
     NotACacheFile,
-    /// Written by another format version.
-    #[error("format version {found}, this radcache reads version {supported} (write it again)")]
+    /// Written by a format version this build cannot read.
+    #[error(
+        "format version {found}, this radcache reads versions {oldest} to {newest} (write it again)"
+    )]
     Version {
         /// The file's version.
         found: u32,
-        /// The version this build reads and writes.
-        supported: u32,
+        /// The oldest version this build reads.
+        oldest: u32,
+        /// The version this build writes (the newest it reads).
+        newest: u32,
     },
     /// Shorter than its header says.
     #[error("truncated: {len} bytes, the header says {expected}")]

@@ -1,28 +1,33 @@
 //! Cache files (`radcache render --cache-out/--cache-in`, `radcache cache build|info`): a cache's
-//! records with their temporal state and last-use marks, behind a versioned header that says
-//! what they were made for, so they are never used for another scene or other parameters.
+//! records with their temporal state and last-use marks (and, where the scene has glossy lobes
+//! from the cache, their radiance blocks), behind a versioned header that says what they were
+//! made for, so they are never used for another scene or other parameters.
 //!
 //! Layout (little-endian; every record field is a 4-byte word):
 //!
 //! | bytes | field |
 //! |---|---|
 //! | 0..8 | magic `RADCACHE` |
-//! | 8..12 | format version ([`FORMAT_VERSION`]) |
+//! | 8..12 | format version ([`FORMAT_VERSION`]; versions from [`OLDEST_VERSION`] are read) |
 //! | 12..20 | scene content hash (`radcache_scene::Scene::content_hash`, FNV-1a 64) |
 //! | 20..32 | settings: width, height (u32), time step in s (f32) |
 //! | 32..36 | CRC-32 of the settings' 12 bytes (the settings hash) |
 //! | 36..88 | [`IcParams`], 13 words in declaration order (`weight_kind` as its GLSL constant) |
 //! | 88..92 | record count n |
 //! | 92..96 | the renderer's frame count at export (the clock of the last-use marks and of the temporal state's frame numbers) |
-//! | 96..100 | flags (bit 0: the records carry lifespans; bit 1: they hold a constant environment's light, the sky; bit 2: the Hessian error control sized them, `IcParams::error_control`) |
+//! | 96..100 | flags (bit 0: the records carry lifespans; bit 1: they hold a constant environment's light, the sky; bit 2: the Hessian error control sized them, `IcParams::error_control`; bit 3, from version 2: the payload holds their radiance blocks) |
 //! | 100..108 | `size_of::<GpuRecord>()`, `size_of::<GpuRecordTemporal>()` (u32 each) |
-//! | 108..116 | payload length in bytes (u64) = n · (176 + 96 + 4) |
+//! | 108..116 | payload length in bytes (u64) = n · (176 + 96 + 4), plus n · 512 with radiance blocks |
 //! | 116..120 | CRC-32 of the payload |
 //! | 120..124 | CRC-32 of bytes 0..120 |
-//! | 124.. | payload: n `GpuRecord`, n `GpuRecordTemporal`, n last-use marks (u32) |
+//! | 124.. | payload: n `GpuRecord`, n `GpuRecordTemporal`, n last-use marks (u32), then with bit 3 n [`RadianceBlock`]s |
 //!
-//! [`CacheFile::decode`] refuses, in this order: a file that does not start with the magic, another
-//! format version, a file shorter than its header or payload (truncated), a header or payload
+//! Version 1 had no bit 3 (its records never carry radiance blocks); it is read as it was
+//! written. A file with the flag but a renderer without radiance records, or the reverse, is the
+//! renderer's to settle (`radcache_render::IcRenderer::import_cache`).
+//!
+//! [`CacheFile::decode`] refuses, in this order: a file that does not start with the magic, a
+//! format version it cannot read, a file shorter than its header or payload (truncated), a header or payload
 //! whose checksum or lengths are wrong (corrupted); [`CacheHeader::check`] then refuses a file made
 //! for another scene, with other cache parameters or settings, or holding more records than the
 //! renderer's capacity. Every refusal is a [`Refusal`]; read through a path it names the file.
@@ -32,6 +37,8 @@ mod params;
 
 use std::path::Path;
 
+use radcache_shared::consts::RECORD_RADIANCE_VEC4S;
+pub use radcache_shared::gpu::RadianceBlock;
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
 
 use crate::params::{ErrorControl, IcParams};
@@ -43,17 +50,32 @@ use params::{param_words, params_from_words};
 
 /// The first eight bytes of a cache file.
 pub const MAGIC: [u8; 8] = *b"RADCACHE";
-/// The format version this build reads and writes.
-pub const FORMAT_VERSION: u32 = 1;
+/// The format version this build writes.
+pub const FORMAT_VERSION: u32 = 2;
+/// The oldest format version this build reads (version 1: no radiance blocks).
+pub const OLDEST_VERSION: u32 = 1;
 /// Bytes of the header (the payload starts here).
 pub const HEADER_LEN: usize = 124;
 /// Payload bytes per record: the record, its temporal state and its last-use mark.
 pub const BYTES_PER_RECORD: u64 =
     (std::mem::size_of::<GpuRecord>() + std::mem::size_of::<GpuRecordTemporal>() + 4) as u64;
+/// Bytes of one record's radiance block (`RECORD_RADIANCE_VEC4S` uvec4).
+pub const RADIANCE_BYTES_PER_RECORD: u64 = RECORD_RADIANCE_VEC4S as u64 * 16;
+
+/// Payload bytes per record, with or without its radiance block.
+pub fn payload_bytes_per_record(radiance: bool) -> u64 {
+    BYTES_PER_RECORD
+        + if radiance {
+            RADIANCE_BYTES_PER_RECORD
+        } else {
+            0
+        }
+}
 
 const FLAG_LIFESPANS: u32 = 1;
 const FLAG_SKY: u32 = 2;
 const FLAG_HESSIAN: u32 = 4;
+const FLAG_RADIANCE: u32 = 8;
 
 /// The settings besides the cache parameters that the records depend on (not the camera).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -92,7 +114,8 @@ pub struct CacheIdentity {
     pub params: IcParams,
 }
 
-/// A cache's records as a renderer exports and imports them (same length each).
+/// A cache's records as a renderer exports and imports them (same length each; `radiance` is
+/// empty or of the same length too).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CacheRecords {
     /// The records.
@@ -107,6 +130,8 @@ pub struct CacheRecords {
     pub lifespans: bool,
     /// The records hold a constant environment's light (the sky; `radcache_render::SkyLight`).
     pub sky: bool,
+    /// Their radiance blocks (same index), or none: records without radiance coefficients.
+    pub radiance: Vec<RadianceBlock>,
 }
 
 /// The header of a cache file.
@@ -126,6 +151,8 @@ pub struct CacheHeader {
     pub lifespans: bool,
     /// The records hold the sky's light.
     pub sky: bool,
+    /// The payload holds the records' radiance blocks.
+    pub radiance: bool,
     /// Payload bytes.
     pub payload_len: u64,
     /// CRC-32 of the payload.
@@ -171,12 +198,18 @@ impl Reader<'_> {
 
 impl CacheFile {
     /// A file of `records` made for `identity`. Panics when the record, temporal and mark
-    /// vectors differ in length (a renderer's export always gives equal lengths).
+    /// vectors differ in length, or the radiance blocks are neither absent nor one per record
+    /// (a renderer's export always gives equal lengths).
     pub fn new(identity: CacheIdentity, records: CacheRecords) -> CacheFile {
         let n = records.records.len();
         assert!(
             records.temporal.len() == n && records.last_used.len() == n,
             "a cache's records, temporal states and marks differ in number"
+        );
+        let radiance = !records.radiance.is_empty();
+        assert!(
+            !radiance || records.radiance.len() == n,
+            "a cache's records and radiance blocks differ in number"
         );
         let header = CacheHeader {
             version: FORMAT_VERSION,
@@ -186,7 +219,8 @@ impl CacheFile {
             frames: records.frames,
             lifespans: records.lifespans,
             sky: records.sky,
-            payload_len: n as u64 * BYTES_PER_RECORD,
+            radiance,
+            payload_len: n as u64 * payload_bytes_per_record(radiance),
             payload_crc: 0,
         };
         let mut file = CacheFile { header, records };
@@ -200,6 +234,7 @@ impl CacheFile {
         push_words(&mut out, &r.records);
         push_words(&mut out, &r.temporal);
         push_words(&mut out, &r.last_used);
+        push_words(&mut out, &r.radiance);
         out
     }
 
@@ -223,6 +258,7 @@ impl CacheFile {
             (h.lifespans, FLAG_LIFESPANS),
             (h.sky, FLAG_SKY),
             (hessian, FLAG_HESSIAN),
+            (h.radiance, FLAG_RADIANCE),
         ];
         word(&mut out, flags.iter().filter(|f| f.0).map(|f| f.1).sum());
         word(&mut out, std::mem::size_of::<GpuRecord>() as u32);
@@ -261,7 +297,8 @@ impl CacheFile {
         }
         let n = header.record_count as usize;
         let (records, rest) = payload.split_at(n * std::mem::size_of::<GpuRecord>());
-        let (temporal, marks) = rest.split_at(n * std::mem::size_of::<GpuRecordTemporal>());
+        let (temporal, rest) = rest.split_at(n * std::mem::size_of::<GpuRecordTemporal>());
+        let (marks, blocks) = rest.split_at(n * 4);
         let records = CacheRecords {
             records: bytemuck::cast_slice::<u32, GpuRecord>(&words(records)).to_vec(),
             temporal: bytemuck::cast_slice::<u32, GpuRecordTemporal>(&words(temporal)).to_vec(),
@@ -269,6 +306,7 @@ impl CacheFile {
             frames: header.frames,
             lifespans: header.lifespans,
             sky: header.sky,
+            radiance: bytemuck::cast_slice::<u32, RadianceBlock>(&words(blocks)).to_vec(),
         };
         Ok(CacheFile { header, records })
     }
@@ -321,10 +359,11 @@ impl CacheHeader {
         }
         let mut r = Reader(&bytes[8..]);
         let version = r.u32();
-        if version != FORMAT_VERSION {
+        if !(OLDEST_VERSION..=FORMAT_VERSION).contains(&version) {
             return Err(Refusal::Version {
                 found: version,
-                supported: FORMAT_VERSION,
+                oldest: OLDEST_VERSION,
+                newest: FORMAT_VERSION,
             });
         }
         if bytes.len() < HEADER_LEN {
@@ -363,14 +402,18 @@ impl CacheHeader {
                 sizes.0, sizes.1, ours.0, ours.1
             )));
         }
-        if payload_len != u64::from(record_count) * BYTES_PER_RECORD {
+        let known = match version {
+            1 => FLAG_LIFESPANS | FLAG_SKY | FLAG_HESSIAN,
+            _ => FLAG_LIFESPANS | FLAG_SKY | FLAG_HESSIAN | FLAG_RADIANCE,
+        };
+        let radiance = flags & FLAG_RADIANCE != 0;
+        let per_record = payload_bytes_per_record(radiance);
+        if payload_len != u64::from(record_count) * per_record {
             return Err(Refusal::Corrupt(format!(
-                "{payload_len} payload bytes for {record_count} records of {BYTES_PER_RECORD}"
+                "{payload_len} payload bytes for {record_count} records of {per_record}"
             )));
         }
-        if settings_hash != settings.hash()
-            || flags & !(FLAG_LIFESPANS | FLAG_SKY | FLAG_HESSIAN) != 0
-        {
+        if settings_hash != settings.hash() || flags & !known != 0 {
             return Err(Refusal::Corrupt("inconsistent settings or flags".into()));
         }
         Ok(CacheHeader {
@@ -385,6 +428,7 @@ impl CacheHeader {
             frames,
             lifespans: flags & FLAG_LIFESPANS != 0,
             sky: flags & FLAG_SKY != 0,
+            radiance,
             payload_len,
             payload_crc,
         })
@@ -446,7 +490,8 @@ impl CacheHeader {
         let mut text = format!(
             "format version: {}\nscene content hash: {:016x}\nsettings: {}x{}, time step {} s \
              (hash {:08x})\nrecords: {} ({} payload bytes, checksum {:08x})\nrenderer frames: \
-             {}\nlifespans: {}\nsky in the records: {}\ncache parameters:\n",
+             {}\nlifespans: {}\nsky in the records: {}\nradiance coefficients: {}\ncache \
+             parameters:\n",
             self.version,
             id.scene_hash,
             s.width,
@@ -459,6 +504,7 @@ impl CacheHeader {
             self.frames,
             if self.lifespans { "yes" } else { "no" },
             if self.sky { "yes" } else { "no" },
+            if self.radiance { "yes" } else { "no" },
         );
         for (name, _, value) in param_words(&id.params) {
             text.push_str(&format!("  {name}: {value}\n"));

@@ -43,11 +43,11 @@ pub struct IcRenderer {
     direct: DirectPass,
     splat: SplatPass,
     /// Radiance records for glossy lobes (docs/radiance-caching.md §6): in scenes with
-    /// materials rough enough ([`radcache_scene::ScenePlan::radiance_cache`]) when records are
-    /// not kept across frames (temporal caching keeps irradiance records only, so far).
+    /// materials rough enough ([`radcache_scene::ScenePlan::radiance_cache`]); the blocks are
+    /// in `state.radiance`, kept across frames and in cache files with their records (§8).
     glossy: Option<GlossySplatPass>,
-    /// The records' radiance coefficients are theirs (false after [`IcRenderer::import_cache`]
-    /// until the records are made again: the files hold no coefficients).
+    /// The records' radiance blocks are theirs (false after [`IcRenderer::import_cache`] of a
+    /// file without blocks, until the records are made again).
     glossy_valid: bool,
     holes: HolePass,
     neighbours: NeighbourPass,
@@ -101,16 +101,14 @@ impl IcRenderer {
         }
         let params = settings.params;
         let temporal = settings.time_step_s > 0.0 || settings.settle_records;
-        let radiance = gpu.plan().radiance_cache() && !temporal && settings.glossy.records();
+        let radiance = gpu.plan().radiance_cache() && settings.glossy.records();
         let glossy = if radiance {
             let gradients = settings.glossy == GlossyLight::Records;
-            let capacity = settings.record_capacity;
-            Some(GlossySplatPass::new(
-                ctx, shaders, w, h, capacity, gradients,
-            )?)
+            Some(GlossySplatPass::new(ctx, shaders, w, h, gradients)?)
         } else {
             None
         };
+        let capacity = settings.record_capacity;
         Ok(IcRenderer {
             width: w,
             height: h,
@@ -133,11 +131,12 @@ impl IcRenderer {
             records: RecordPass::with_radiance(ctx, shaders, gpu, &params, settings.sky, radiance)?,
             composite: CompositePass::with_radiance(ctx, shaders, gpu, w, h, radiance)?,
             emission: EmissionPass::new(ctx, shaders, gpu)?,
-            state: IcState::new(ctx, shaders, settings.record_capacity, w * h)?,
-            temporal: if settings.time_step_s > 0.0 || settings.settle_records {
+            state: IcState::with_radiance(ctx, shaders, capacity, w * h, radiance)?,
+            temporal: if temporal {
                 let lifespans = settings.time_step_s > 0.0;
-                let capacity = settings.record_capacity;
-                Some(TemporalPass::new(ctx, shaders, gpu, capacity, lifespans)?)
+                Some(TemporalPass::with_radiance(
+                    ctx, shaders, gpu, capacity, lifespans, radiance,
+                )?)
             } else {
                 None
             },

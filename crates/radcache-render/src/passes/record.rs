@@ -272,7 +272,9 @@ impl RecordPass {
     /// pixel, level and sub-frame, and the pass seed [`creation_seed`]`(frame_seed, sub-frame)`,
     /// so under unchanged lighting its irradiance and gradients come out bit for bit as they were
     /// (its radius comes back before neighbour clamping). Rejected records are left as they are.
-    /// `gbuffer` is bound but not read.
+    /// With `radiance` (and a pass built [`RecordPass::with_radiance`]) the record's radiance
+    /// block is computed again too, at the same index of `radiance`. `gbuffer` is bound but not
+    /// read.
     #[allow(clippy::too_many_arguments)]
     pub fn record_refresh(
         &self,
@@ -282,6 +284,7 @@ impl RecordPass {
         requests: &Buffer,
         counters: &Buffer,
         records: &Buffer,
+        radiance: Option<&Buffer>,
         frame_seed: u32,
     ) -> Result<()> {
         let io = Io {
@@ -289,7 +292,7 @@ impl RecordPass {
             counters,
             records,
             samples: &self.no_samples,
-            radiance: &self.no_radiance,
+            radiance: radiance.unwrap_or(&self.no_radiance),
         };
         self.record_io(
             rec,

@@ -1,8 +1,7 @@
 //! Glossy splatting (`shaders/passes/splat.vert` + `splat_glossy.frag`, docs/radiance-caching.md
-//! §6.2): the radiance records for glossy lobes. It owns what the other passes read and write
-//! for them:
-//! * the records' SH coefficients and their translational gradients (`RECORD_RADIANCE_VEC4S`
-//!   vec4 per record; the record pass writes them);
+//! §6.2): the radiance records for glossy lobes. The records' SH coefficients and their
+//! translational gradients live with the records (`IcState::radiance`, so compaction, temporal
+//! reuse and cache files keep them beside their records); this pass owns the rest:
 //! * each pixel's glossy world weights (the direct pass writes them per sub-frame);
 //! * the lobe table;
 //! * the glossy target.
@@ -15,21 +14,19 @@
 //! themselves would need.
 
 use radcache_material::glossy::{glossy_table, GLOSSY_TABLE_STRATA};
-use radcache_shared::consts::{RADIANCE_VEC4S, RECORD_RADIANCE_VEC4S};
+use radcache_shared::consts::RADIANCE_VEC4S;
 use radcache_vk::{
     vk, Blend, Buffer, BufferDesc, ColorTarget, Context, GraphicsDesc, Image, ImageDesc, ImageUse,
     MemoryLocation, Pipeline, Recorder, Resource, ShaderCompiler,
 };
 
 use crate::bindings::{splat_glossy as b, FRAME};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::splat::SplatWeights;
 use crate::scene::GpuScene;
 use crate::state::IcState;
 
-/// Bytes of radiance coefficients and their gradients per record (`RECORD_RADIANCE_VEC4S` vec4).
-pub const RADIANCE_BYTES_PER_RECORD: u64 = RECORD_RADIANCE_VEC4S as u64 * 16;
 /// Bytes of glossy world weights per pixel (`RADIANCE_VEC4S` vec4).
 pub const WEIGHT_BYTES_PER_PIXEL: u64 = RADIANCE_VEC4S as u64 * 16;
 
@@ -38,9 +35,6 @@ pub struct GlossySplatPass {
     pipeline: Pipeline,
     /// Σ w·L_glossy (rgb) and Σ w (a) per pixel.
     pub sum: Image,
-    /// The records' radiance coefficients and their gradients (`RECORD_RADIANCE_VEC4S` vec4 per
-    /// record).
-    pub radiance: Buffer,
     /// Each pixel's glossy world weights (`RADIANCE_VEC4S` vec4 per pixel).
     pub weights: Buffer,
     /// The lobe table ([`glossy_table`]).
@@ -55,14 +49,13 @@ impl std::fmt::Debug for GlossySplatPass {
 
 impl GlossySplatPass {
     /// Compiles the pass and allocates the target and the weights for `width × height` pixels,
-    /// the coefficients for `record_capacity` records, and the table; `gradients` extrapolates
+    /// and the table; `gradients` extrapolates
     /// the coefficients by their translational gradients (docs/radiance-caching.md §7).
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
         width: u32,
         height: u32,
-        record_capacity: u32,
         gradients: bool,
     ) -> Result<Self> {
         let vertex = shaders.compile("passes/splat.vert", &[])?;
@@ -116,17 +109,14 @@ impl GlossySplatPass {
         Ok(GlossySplatPass {
             pipeline,
             sum,
-            radiance: buffer(
-                "splat.glossy.radiance",
-                u64::from(record_capacity) * RADIANCE_BYTES_PER_RECORD,
-            )?,
             weights: buffer("splat.glossy.weights", pixels * WEIGHT_BYTES_PER_PIXEL)?,
             table: ctx.create_buffer_init("splat.glossy.table", storage, &table)?,
         })
     }
 
     /// Records the glossy splat of every record with `weights` (the final splat's, without
-    /// marking), after the direct pass wrote the pixels' world weights.
+    /// marking), after the direct pass wrote the pixels' world weights; `state` must hold
+    /// radiance blocks ([`IcState::with_radiance`]).
     pub fn record(
         &self,
         rec: &mut Recorder,
@@ -135,6 +125,9 @@ impl GlossySplatPass {
         state: &IcState,
         weights: &SplatWeights,
     ) -> Result<()> {
+        let radiance = state.radiance.as_ref().ok_or_else(|| {
+            Error::Invalid("the glossy splat needs a cache with radiance blocks".into())
+        })?;
         for image in gbuffer.images() {
             rec.use_image(image, ImageUse::FragmentStorage);
         }
@@ -148,7 +141,7 @@ impl GlossySplatPass {
         bindings.extend([
             (b::RECORDS, Resource::Buffer(&state.records)),
             (b::LAST_USED, Resource::Buffer(&state.last_used)),
-            (b::RADIANCE, Resource::Buffer(&self.radiance)),
+            (b::RADIANCE, Resource::Buffer(radiance)),
             (b::GLOSSY_WEIGHTS, Resource::Buffer(&self.weights)),
         ]);
         rec.pass("splat.glossy", |rec| {

@@ -26,6 +26,15 @@
 //! ([`TemporalPass::record_shift`], the record pass on [`TemporalPass::lookahead`],
 //! [`TemporalPass::record_finish`]) with the scene at the next frame's time, and
 //! [`TemporalPass::record_keep_instances`] at the end.
+//!
+//! Radiance records (docs/radiance-caching.md §8) keep their SH coefficients in
+//! `IcState::radiance` and are evaluated ahead with the irradiance: the adopt step copies the
+//! blocks to [`TemporalPass::lookahead_radiance`], the look-ahead's record pass writes the listed
+//! records' new blocks there, and [`TemporalPass::record_promote_radiance`] copies them back
+//! after the frame's shading, so the next frame shows them. The coefficients get no rate (a
+//! record shows its last evaluation, not an extrapolation: the lifespan, from the irradiance's
+//! change, already bounds how stale it gets), and since they are in world space a kept record on
+//! a rotating instance keeps them unrotated until its refresh.
 
 use radcache_cache::IcParams;
 use radcache_scene::Scene;
@@ -38,7 +47,7 @@ use radcache_vk::{
 use crate::bindings::temporal as b;
 use crate::error::Result;
 use crate::scene::GpuScene;
-use crate::state::IcState;
+use crate::state::{IcState, RADIANCE_BYTES_PER_RECORD};
 
 radcache_shared::gpu_struct! {
     /// The push constants of the pass (`TemporalPush` in GLSL).
@@ -85,6 +94,11 @@ pub struct TemporalPass {
     pub list_counters: Buffer,
     /// The records evaluated at the next frame's time (same indices as the cache's).
     pub lookahead: Buffer,
+    /// Their radiance blocks (same indices), with lifespans in a cache with radiance blocks.
+    pub lookahead_radiance: Option<Buffer>,
+    /// Records whose look-ahead radiance blocks go to the cache after this frame's shading
+    /// ([`TemporalPass::record_promote_radiance`]); 0 = none pending.
+    promote: u32,
     previous: Buffer,
     /// Two vec4 per moving instance: bounding sphere (centre, radius) at the scene's current
     /// time, then (instance index, 0, 0, 0) (`temporal.comp`'s motion-aware expiry).
@@ -121,6 +135,19 @@ impl TemporalPass {
         scene: &GpuScene,
         record_capacity: u32,
         lifespans: bool,
+    ) -> Result<TemporalPass> {
+        Self::with_radiance(ctx, shaders, scene, record_capacity, lifespans, false)
+    }
+
+    /// As [`TemporalPass::new`]; with `lifespans` and `radiance` (the cache has radiance
+    /// blocks) also the look-ahead copy of the blocks.
+    pub fn with_radiance(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        scene: &GpuScene,
+        record_capacity: u32,
+        lifespans: bool,
+        radiance: bool,
     ) -> Result<TemporalPass> {
         let spirv = shaders.compile("passes/temporal.comp", &scene.defines())?;
         let pipeline = Pipeline::compute(
@@ -166,6 +193,19 @@ impl TemporalPass {
                 storage | vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuOnly,
             )?,
+            lookahead_radiance: if lifespans && radiance {
+                Some(buffer(
+                    "temporal.lookahead_radiance",
+                    u64::from(capacity) * RADIANCE_BYTES_PER_RECORD,
+                    storage
+                        | vk::BufferUsageFlags::TRANSFER_SRC
+                        | vk::BufferUsageFlags::TRANSFER_DST,
+                    MemoryLocation::GpuOnly,
+                )?)
+            } else {
+                None
+            },
+            promote: 0,
             previous: buffer(
                 "temporal.previous_instances",
                 u64::from(instances.max(1)) * std::mem::size_of::<GpuInstance>() as u64,
@@ -312,10 +352,11 @@ impl TemporalPass {
     /// Records listing the records `first .. records` (created this frame) after the expired ones
     /// and making every listed record born at `frame` (at the scene's current time); `listed` is
     /// the list's length afterwards (expired + new, at most the capacity). Then copies the
-    /// records to the look-ahead buffer.
+    /// records (and their radiance blocks, when both the cache and the pass have them) to the
+    /// look-ahead buffers.
     #[allow(clippy::too_many_arguments)]
     pub fn record_adopt(
-        &self,
+        &mut self,
         rec: &mut Recorder,
         scene: &GpuScene,
         state: &IcState,
@@ -336,9 +377,32 @@ impl TemporalPass {
         if bytes > 0 {
             rec.barrier(Access::ALL_WRITES, Access::TRANSFER_READ);
             rec.copy_buffer(&state.records, 0, &self.lookahead, 0, bytes);
+            self.promote = 0;
+            if let (Some(from), Some(to)) = (&state.radiance, &self.lookahead_radiance) {
+                if listed > 0 {
+                    let bytes = u64::from(records) * RADIANCE_BYTES_PER_RECORD;
+                    rec.copy_buffer(from, 0, to, 0, bytes);
+                    self.promote = records;
+                }
+            }
             rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
         }
         Ok(())
+    }
+
+    /// Records copying the radiance blocks the look-ahead computed (and the unlisted records'
+    /// unchanged ones) back to the cache, once the frame's shading has read the current ones;
+    /// nothing when no look-ahead is pending.
+    pub fn record_promote_radiance(&mut self, rec: &mut Recorder, state: &IcState) {
+        if let (Some(from), Some(to)) = (&self.lookahead_radiance, &state.radiance) {
+            if self.promote > 0 {
+                let bytes = u64::from(self.promote) * RADIANCE_BYTES_PER_RECORD;
+                rec.barrier(Access::ALL_WRITES, Access::TRANSFER_READ);
+                rec.copy_buffer(from, 0, to, 0, bytes);
+                rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
+            }
+        }
+        self.promote = 0;
     }
 
     /// Records moving the listed look-ahead records to the instances' current transforms (the
@@ -394,9 +458,11 @@ impl TemporalPass {
         self.lifespans
     }
 
-    /// Forgets the previous frame's instances (the next frame starts a new cache).
+    /// Forgets the previous frame's instances and any pending look-ahead (the next frame starts
+    /// a new cache).
     pub fn forget(&mut self) {
         self.has_previous = false;
+        self.promote = 0;
     }
 
     /// Listed records after the last submission (expired, then new).

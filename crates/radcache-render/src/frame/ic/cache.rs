@@ -1,6 +1,7 @@
 //! A cache's records in and out of an [`IcRenderer`] (cache files, `radcache_cache::cache_file`):
-//! the records with their temporal states, last-use marks and the renderer's frame count, so a
-//! fresh renderer continues where the exporting one stopped. Imported records take the path of
+//! the records with their temporal states, last-use marks, radiance blocks (where the renderer
+//! has radiance records) and the renderer's frame count, so a fresh renderer continues where the
+//! exporting one stopped. Imported records take the path of
 //! the records kept across a camera move: the next frame re-clamps their radii to its view
 //! (whatever the view they were made for) and fills only the holes they leave.
 
@@ -25,6 +26,12 @@ impl IcRenderer {
             });
         }
         let (records, temporal, last_used) = self.state.download(ctx)?;
+        // Blocks that are not the records' own (imported without them) are not exported.
+        let radiance = if self.glossy.is_some() && self.glossy_valid {
+            self.state.download_radiance(ctx)?
+        } else {
+            Vec::new()
+        };
         Ok(CacheRecords {
             records,
             temporal,
@@ -32,6 +39,7 @@ impl IcRenderer {
             frames: self.frames,
             lifespans,
             sky: self.sky_in_records,
+            radiance,
         })
     }
 
@@ -40,7 +48,9 @@ impl IcRenderer {
     /// previous frame, re-clamps them to its view and fills only the holes. Records with
     /// lifespans need a renderer made with a time step, records without one without. Marks
     /// later than the cache's frame count (impossible in a file this renderer wrote) count as
-    /// made at that frame.
+    /// made at that frame. The records' radiance blocks are uploaded where the renderer has
+    /// radiance records (and ignored where it has none); without them glossy lobes go back to
+    /// per-pixel paths until the records are made again.
     pub fn import_cache(
         &mut self,
         ctx: &Context,
@@ -68,9 +78,19 @@ impl IcRenderer {
                 if cache.sky { "records" } else { "direct" }
             )));
         }
+        let n = cache.records.len();
+        if !cache.radiance.is_empty() && cache.radiance.len() != n {
+            return Err(Error::Invalid(format!(
+                "the cache has {n} records but {} radiance blocks",
+                cache.radiance.len()
+            )));
+        }
+        let radiance = self.glossy.is_some();
         if self.temporal.is_none() {
             let capacity = self.state.record_capacity();
-            self.temporal = Some(TemporalPass::new(ctx, shaders, gpu, capacity, false)?);
+            self.temporal = Some(TemporalPass::with_radiance(
+                ctx, shaders, gpu, capacity, false, radiance,
+            )?);
         }
         let marks: Vec<u32> = cache
             .last_used
@@ -79,8 +99,11 @@ impl IcRenderer {
             .collect();
         self.state
             .upload(ctx, &cache.records, &cache.temporal, &marks)?;
-        // The file holds no radiance coefficients: glossy lobes go back to per-pixel paths.
-        self.glossy_valid = false;
+        let blocks = radiance && !cache.radiance.is_empty();
+        if blocks {
+            self.state.upload_radiance(ctx, &cache.radiance)?;
+        }
+        self.glossy_valid = blocks || n == 0;
         if let Some(t) = self.temporal.as_mut() {
             t.forget();
         }

@@ -237,18 +237,9 @@ impl IcRenderer {
             let mut rec = ctx.begin("ic.create")?;
             let (requests, counters) = (&state.requests, &state.counters);
             let records = &state.records;
-            match &self.glossy {
-                Some(g) => self.records.record_with_radiance(
-                    &mut rec,
-                    gpu,
-                    gbuffer,
-                    requests,
-                    counters,
-                    records,
-                    &g.radiance,
-                    level,
-                    k,
-                    seed,
+            match &state.radiance {
+                Some(radiance) => self.records.record_with_radiance(
+                    &mut rec, gpu, gbuffer, requests, counters, records, radiance, level, k, seed,
                 )?,
                 None => self.records.record(
                     &mut rec, gpu, gbuffer, requests, counters, records, level, k, seed,
@@ -333,7 +324,7 @@ impl IcRenderer {
     }
 
     /// **Finish**: the box-filtered emission, the instances kept for the next frame's motion,
-    /// the read-back of the mean over the sub-frames (and of the debug AOVs), the figures.
+    /// the look-ahead's radiance blocks promoted for the next frame, the read-back of the mean over the sub-frames (and of the debug AOVs), the figures.
     pub(super) fn finish(
         &mut self,
         ctx: &Context,
@@ -349,6 +340,7 @@ impl IcRenderer {
             .filter(|_| settings.time_step_s > 0.0)
         {
             t.record_keep_instances(&mut rec, gpu);
+            t.record_promote_radiance(&mut rec, &self.state);
         }
         run.clock.submit(ctx, rec)?;
         run.add_rays("emission", self.emission.rays()?);

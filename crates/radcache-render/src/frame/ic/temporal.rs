@@ -62,6 +62,7 @@ impl IcRenderer {
             &t.list,
             &t.list_counters,
             &t.lookahead,
+            t.lookahead_radiance.as_ref(),
             settings.seed,
         )?;
         let lifespans = Lifespans {
