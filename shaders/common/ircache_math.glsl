@@ -215,6 +215,19 @@ float gradient_limit_radius(float r, vec3 e, vec3 gt_r, vec3 gt_g, vec3 gt_b) {
     return out_r;
 }
 
+// The glossy gradient limit from its sums per channel (Σ c², Σ |∂c/∂x|²): the smallest
+// √(Σc²/Σg²) over the channels with a positive, finite Σg²; IC_FAR when none
+// (radcache_cache::radiance::glossy_gradient_limit_from_sums).
+float glossy_gradient_limit(vec3 coeff_sq, vec3 grad_sq) {
+    float out_r = IC_FAR;
+    for (int c = 0; c < 3; ++c) {
+        if (grad_sq[c] > 0.0 && !isinf(grad_sq[c])) {
+            out_r = min(out_r, sqrt(max(coeff_sq[c], 0.0) / grad_sq[c]));
+        }
+    }
+    return out_r;
+}
+
 float neighbour_clamp(float r_i, float r_j, float d_ij) { return min(sanitize_radius(r_i), sanitize_radius(r_j) + max(d_ij, 0.0)); }
 
 void neighbour_clamp_pair(float r_i, vec3 p_i, float r_j, vec3 p_j, out float new_r_i, out float new_r_j) {

@@ -188,6 +188,8 @@ shared float s_rgrad[2u * SH_COEFFS * 9u];
 // coefficient's largest |total| (the block's scale is their maximum).
 shared float s_gtot[3u * 3u * SH_COEFFS];
 shared float s_gmax[SH_COEFFS];
+// The coefficients as stored (0 where not finite), for the glossy gradient limit.
+shared vec3 s_coeff[SH_COEFFS];
 
 // The radiance of stratum i as the projection sees it (radiance_sample: 0 where it escaped).
 vec3 stratum_radiance(uint i) {
@@ -207,11 +209,14 @@ void add_wall(inout vec3 g[3], uint ci, vec3 coeff, vec3 dir, vec3 d, vec3 t, ve
 // Record `index`'s radiance coefficients and their gradients (see the header), reduced by 3 ·
 // SH_COEFFS invocations: invocation lid sums part lid / SH_COEFFS (0 the projection, 1 the polar
 // walls, 2 the azimuthal walls) of coefficient lid % SH_COEFFS; after a barrier the projection's
-// invocation adds the two wall parts and stores all. Called by every invocation of the group.
-void project_radiance(uint lid, uint index, uint m, uint n, vec3 t, vec3 b, vec3 nn, vec3 ng,
+// invocation adds the two wall parts and stores all. Called by every invocation of the group;
+// returns to invocation 0 the record's glossy gradient limit (also stored in lane 0 of the
+// block's last vec4; docs/radiance-caching.md §9), IC_FAR to the others and when nothing is
+// written.
+float project_radiance(uint lid, uint index, uint m, uint n, vec3 t, vec3 b, vec3 nn, vec3 ng,
                       uint record_seed, float r_eps) {
     if (uint(radiance.length()) < (index + 1u) * RECORD_RADIANCE_VEC4S) {
-        return;  // uniform over the group
+        return IC_FAR;  // uniform over the group
     }
     uint ci = lid % SH_COEFFS;
     uint part = lid / SH_COEFFS;
@@ -265,6 +270,7 @@ void project_radiance(uint lid, uint index, uint m, uint n, vec3 t, vec3 b, vec3
             uint f = 3u * ci + c;
             radiance[base + f / 4u][f % 4u] = floatBitsToUint(finite ? acc[c] : 0.0);
         }
+        s_coeff[ci] = finite ? acc : vec3(0.0);
         float largest = 0.0;
         for (uint a = 0u; a < 3u; ++a) {
             vec3 ga;
@@ -301,6 +307,19 @@ void project_radiance(uint lid, uint index, uint m, uint n, vec3 t, vec3 b, vec3
         vec2 h = clamp(vec2(s_gtot[at], s_gtot[at + 1u]) * inv, vec2(-1.0), vec2(1.0));
         radiance[base + RADIANCE_VEC4S + 1u + w / 4u][w % 4u] = packHalf2x16(h);
     }
+    if (lid != 0u) {
+        return IC_FAR;
+    }
+    vec3 coeff_sq = vec3(0.0), grad_sq = vec3(0.0);
+    for (uint i = 0u; i < SH_COEFFS; ++i) {
+        coeff_sq += s_coeff[i] * s_coeff[i];
+    }
+    for (uint f = 0u; f < 3u * 3u * SH_COEFFS; ++f) {
+        grad_sq[f % 3u] += s_gtot[f] * s_gtot[f];
+    }
+    float limit = glossy_gradient_limit(coeff_sq, grad_sq);
+    radiance[base + RECORD_RADIANCE_VEC4S - 1u] = uvec4(floatBitsToUint(limit), 0u, 0u, 0u);
+    return limit;
 }
 #endif
 
@@ -363,6 +382,8 @@ void main() {
     uint pixel_index;
     uint pass_seed = pc.seed;
     GSample g;
+    // The record serves a glossy lobe from the cache (RECORD_FLAG_GLOSSY).
+    bool glossy = false;
     g_level_subframe = pc.level_subframe;
     if (pc.source == RECORD_SOURCE_RECORDS) {
         // Refresh in place: the surface point, normal and footprint are the record's own, and
@@ -385,6 +406,7 @@ void main() {
         g.normal = old.normal_rorig.xyz;
         g.geometric = vec3(old.grad_r_red.w, old.grad_r_green.w, old.grad_r_blue.w);
         g.footprint = old.bounds.z;
+        glossy = (old.info.w & RECORD_FLAG_GLOSSY) != 0u;
     } else {
         index = counters.batch_first + request;
         if (index >= counters.record_capacity) {
@@ -404,6 +426,12 @@ void main() {
             return;
         }
         g = gbuffer_load(ivec2(pixel_index % width, row));
+#if defined(HAS_SPECULAR) && defined(HAS_RADIANCE_CACHE)
+        // As the plan counts glossy materials: not Lambertian, and rough enough for the records.
+        Material gm = gbuffer_material(g);
+        glossy = gm.roughness >= GLOSSY_ROUGHNESS_MIN
+                 && (gm.metallic > 0.0 || gm.specular_factor > 0.0);
+#endif
         g_instance_bits = (g.instance + 1u) << RECORD_INSTANCE_SHIFT;
         if (!g.surface) {
             if (lid == 0u) {
@@ -471,7 +499,8 @@ void main() {
     atomicAdd(s_rays, rays_traced);
     barrier();
 #ifdef HAS_RADIANCE_CACHE
-    project_radiance(lid, index, m, n, t, b, nn, ng, record_seed, pc.r_eps_rel * frame.camera_position.w);
+    float glossy_limit = project_radiance(lid, index, m, n, t, b, nn, ng, record_seed,
+                                          pc.r_eps_rel * frame.camera_position.w);
 #endif
 #ifdef IC_HESSIAN
     vec4 share = hessian_share(lid, m, n, record_seed, pc.r_eps_rel * frame.camera_position.w);
@@ -541,6 +570,18 @@ void main() {
     float r_raw = hessian_radius(hessian, g.footprint);
 #else
     float r_raw = max(r_harm, min(r_min_restricted, IC_FAR));
+#endif
+#ifdef HAS_RADIANCE_CACHE
+    // Records for glossy lobes from the cache are flagged, and with GLOSSY_DENSITY also obey
+    // the glossy gradient limit (§9 of docs/radiance-caching.md): density follows the incoming
+    // radiance's directional detail there, and only there. A refresh keeps the flag its
+    // creation set.
+    if (glossy) {
+        flags |= RECORD_FLAG_GLOSSY;
+#ifdef GLOSSY_DENSITY
+        r_raw = min(r_raw, glossy_limit);
+#endif
+    }
 #endif
     float r_lo, r_hi;
     radius_bounds(g.footprint, pc.min_px, pc.max_px, pc.v_scale, r_lo, r_hi);

@@ -21,6 +21,7 @@ const uint RECORD_FLAG_NO_SURFACE = 2u;
 const uint RECORD_FLAG_CLAMPED_UP = 4u;
 const uint RECORD_FLAG_CLAMPED_DOWN = 8u;
 const uint RECORD_FLAG_FOLDED = 16u;
+const uint RECORD_FLAG_GLOSSY = 32u;
 const uint RECORD_FLAGS_MASK = 255u;
 const uint RECORD_INSTANCE_SHIFT = 8u;
 const uint TEMPORAL_FLAG_ADOPTED = 1u;

@@ -13,8 +13,9 @@ pub mod sliding_box;
 pub mod stiff;
 pub mod twin;
 
+use std::cell::RefCell;
 use std::path::PathBuf;
-use std::sync::Once;
+use std::sync::{Mutex, MutexGuard, Once};
 
 use radcache_vk::{Context, ContextOptions, ShaderCompiler};
 
@@ -42,8 +43,38 @@ fn validation_disabled_by_user() -> bool {
     )
 }
 
-/// A context with validation on; panics with a clear message if the layer is missing.
+/// The Vulkan contexts of one test process, one at a time (see [`context`]).
+static ONE_CONTEXT_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+thread_local! {
+    /// This test thread's turn, held until the thread ends (a test's last `finish` or panic).
+    static TURN: RefCell<Option<MutexGuard<'static, ()>>> = const { RefCell::new(None) };
+}
+
+/// Waits until no other test thread of this process holds a Vulkan context, then keeps the
+/// turn until this thread ends. Two lavapipe devices under the validation layer, created, used
+/// and destroyed on two threads at once, crashed two CI runs out of many (glibc's heap check
+/// `malloc_consolidate(): unaligned fastbin chunk`, and a C++ exception thrown through Rust
+/// frames, both while one test shut its context down beside another's work). Neither
+/// reproduced on a developer's machine and no fault in radcache's own Vulkan code was found; the
+/// renderer itself creates one context per process, so the tests do the same: GPU tests of one binary run one after the other (lavapipe
+/// already spreads each over every core), CPU-only tests still in parallel.
+fn take_turn() {
+    TURN.with(|turn| {
+        let mut turn = turn.borrow_mut();
+        if turn.is_none() {
+            let guard = ONE_CONTEXT_AT_A_TIME
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner());
+            *turn = Some(guard);
+        }
+    });
+}
+
+/// A context with validation on; panics with a clear message if the layer is missing. Contexts
+/// of one test process are used one test at a time ([`take_turn`]).
 pub fn context() -> Context {
+    take_turn();
     init_log();
     let mut opts = ContextOptions::from_env();
     opts.validation = !validation_disabled_by_user();

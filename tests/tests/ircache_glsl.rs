@@ -254,6 +254,8 @@ fn radius(rng: &mut Rng) -> Vec<Case> {
         let s_diff = pixel_footprint_from_differentials(dpdx, dpdy);
         let (ri, rj) = neighbour_clamp_pair(r, p_i, r_j, p_j);
         e.s(3, [s_pin, s_diff, ri, rj], 0.0);
+        let glossy = glossy_gradient_limit_from_sums(e_i, gt[0]);
+        e.s(4, [glossy, 0.0, 0.0, 0.0], 0.0);
         cases.push((row, e));
     }
     cases

@@ -9,9 +9,12 @@
 
 use radcache_cache::IcParams;
 use radcache_image::{compare, Image};
-use radcache_render::{render_ic, FrameOutput, GlossyLight, GpuScene, IcSettings};
+use radcache_render::{
+    render_ic, FrameOutput, GlossyLight, GlossySpacing, GpuScene, IcRenderer, IcSettings,
+    RadianceBlock, RECORD_FLAG_GLOSSY, RECORD_FLAG_NO_SURFACE,
+};
 use radcache_scene::Scene;
-use radcache_shared::consts::GLOSSY_ROUGHNESS_MIN;
+use radcache_shared::consts::{GLOSSY_ROUGHNESS_MIN, RECORD_RADIANCE_VEC4S};
 use radcache_tests::scenes::{load, render};
 use radcache_tests::{context, finish, shaders};
 
@@ -72,4 +75,92 @@ fn glossy_lobes_from_radiance_records_match_the_path_tracer() {
             assert!((r - 1.0).abs() <= 0.02, "channel {c} mean ratio {r}");
         }
     }
+}
+
+/// Records and their radiance blocks after one frame of `scene` at 48² with `spacing`.
+fn records_with(
+    scene: &Scene,
+    spacing: GlossySpacing,
+) -> (Vec<radcache_shared::gpu::GpuRecord>, Vec<RadianceBlock>) {
+    let (ctx, shaders) = (context(), shaders());
+    let mut gpu = GpuScene::new(&ctx, scene, None).unwrap();
+    let settings = IcSettings {
+        width: 48,
+        height: 48,
+        params: IcParams::default(),
+        glossy_spacing: spacing,
+        ..IcSettings::default()
+    };
+    let mut r = IcRenderer::new(&ctx, &shaders, &gpu, &settings).unwrap();
+    let (out, _) = r
+        .render(&ctx, scene, &mut gpu, &settings, &mut |_| {})
+        .unwrap();
+    assert_eq!(out.nonfinite_pixels, 0);
+    let (records, _, _) = r.state().download(&ctx).unwrap();
+    let blocks = r.state().download_radiance(&ctx).unwrap();
+    drop((r, gpu));
+    finish(ctx);
+    (records, blocks)
+}
+
+/// Records for glossy lobes (docs/radiance-caching.md §9), flagged `RECORD_FLAG_GLOSSY` (made
+/// on a non-Lambertian pixel of roughness ≥ `GLOSSY_ROUGHNESS_MIN`): with `GlossySpacing::Lobe`
+/// their radius stays within their glossy gradient limit (which binds on some), there are more of
+/// them, and the other records hardly change in number; with `GlossySpacing::Irradiance` the
+/// limit is ignored (some exceed it).
+#[test]
+fn records_for_glossy_lobes_obey_the_glossy_gradient_limit_and_only_they_multiply() {
+    let scene = glossy_room();
+    let flagged = |r: &radcache_shared::gpu::GpuRecord| r.info[3] & RECORD_FLAG_GLOSSY != 0;
+    let valid = |r: &&radcache_shared::gpu::GpuRecord| r.info[3] & RECORD_FLAG_NO_SURFACE == 0;
+    let (plain, plain_blocks) = records_with(&scene, GlossySpacing::Irradiance);
+    let (lobe, blocks) = records_with(&scene, GlossySpacing::Lobe);
+    // Spaced by the irradiance, the glossy limit binds on none of them.
+    let stride = RECORD_RADIANCE_VEC4S as usize;
+    let below = plain
+        .iter()
+        .zip(&plain_blocks)
+        .filter(|(r, b)| flagged(r) && r.normal_rorig[3] > f32::from_bits(b[stride - 1][0]))
+        .count();
+    let (mut glossy, mut binding) = (0usize, 0usize);
+    for (i, (r, b)) in lobe.iter().zip(&blocks).enumerate() {
+        if !flagged(r) {
+            continue;
+        }
+        glossy += 1;
+        let limit = f32::from_bits(b[stride - 1][0]);
+        let r_orig = r.normal_rorig[3];
+        assert!(
+            r_orig <= limit * (1.0 + 1e-6),
+            "record {i}: R {r_orig} above its glossy limit {limit}"
+        );
+        binding += usize::from(r_orig >= limit * (1.0 - 1e-6));
+    }
+    let others = |v: &[radcache_shared::gpu::GpuRecord]| {
+        v.iter().filter(valid).filter(|r| !flagged(r)).count()
+    };
+    eprintln!(
+        "records: {} by the irradiance, {} by the lobe ({glossy} for glossy lobes, the limit \
+         binding on {binding}; {below} above it by the irradiance); others {} and {}",
+        plain.len(),
+        lobe.len(),
+        others(&plain),
+        others(&lobe)
+    );
+    assert!(
+        glossy > 50 && binding > 0,
+        "{glossy} glossy, {binding} binding"
+    );
+    assert!(
+        below > 0,
+        "the limit would bind on no record spaced by the irradiance"
+    );
+    assert!(
+        lobe.len() > plain.len(),
+        "{} vs {}",
+        lobe.len(),
+        plain.len()
+    );
+    let (a, b) = (others(&lobe) as f64, others(&plain) as f64);
+    assert!((a - b).abs() <= 0.1 * b, "other records: {a} vs {b}");
 }

@@ -3,7 +3,8 @@
 //! point by point: every record's 16 RGB coefficients and their translational gradients are
 //! compared with the CPU twin `radcache_cache::radiance::compute_radiance` applied to the samples
 //! the pass dumps, along the directions the CPU twin of the sampling predicts (folding
-//! included), in the buffer layout `RECORD_RADIANCE_VEC4S` documents; slots of records not in
+//! included), in the buffer layout `RECORD_RADIANCE_VEC4S` documents, with the glossy gradient
+//! limit (`glossy_gradient_limit`) in the last vec4; slots of records not in
 //! the batch stay untouched.
 //!
 //! Tolerance: `|gpu − cpu| <= 1e-4 · max(|cpu|, scale) + 1e-6`, `scale` the sum of the sizes of
@@ -13,12 +14,12 @@
 
 use glam::Vec3;
 use radcache_cache::radiance::{
-    compute_radiance, radiance_azimuthal_wall_coeff, radiance_polar_wall_coeff, radiance_sample,
-    stratum_solid_angle,
+    compute_radiance, glossy_gradient_limit, radiance_azimuthal_wall_coeff,
+    radiance_polar_wall_coeff, radiance_sample, stratum_solid_angle,
 };
 use radcache_cache::record::wall_term;
 use radcache_cache::sampling::stratum_index;
-use radcache_cache::IcParams;
+use radcache_cache::{IcParams, IC_FAR};
 use radcache_render::{RecordPass, SkyLight};
 use radcache_shared::consts::{RADIANCE_VEC4S, RECORD_RADIANCE_VEC4S, SH_COEFFS};
 use radcache_tests::record_fixture::*;
@@ -167,6 +168,15 @@ fn radiance_coefficients_and_gradients_match_the_cpu_twin() {
                 }
             }
         }
+        // The glossy gradient limit in lane 0 of the last vec4 (docs/radiance-caching.md §9):
+        // from the f32 sums, so only their rounding separates it from the CPU twin's.
+        let limit = glossy_gradient_limit(&est);
+        let gpu = float_at(block, 4 * (stride - 1));
+        assert!(
+            limit < IC_FAR && (gpu - limit).abs() <= 2e-3 * limit,
+            "record {i}: glossy limit GPU {gpu:e}, CPU {limit:e}"
+        );
+        assert_eq!(block[stride - 1][1..], [0.0; 3], "record {i}");
         // The walls light every point: band 0 is positive and some gradient is not zero.
         assert!(est.coeffs[0].min_element() > 0.0, "{:?}", est.coeffs[0]);
         let g: f32 = est.grad.iter().flatten().map(|v| v.length()).sum();

@@ -162,3 +162,77 @@ pub fn compute_radiance(
     }
     out
 }
+
+/// The glossy gradient limit from the sums it needs (docs/radiance-caching.md §9):
+/// `min_c √(Σ_i c_ic² / Σ_{a,i} (∂c_ic/∂x_a)²)` over the channels whose gradients are not all
+/// zero, [`IC_FAR`] when none is; `coeff_sq` and `grad_sq` hold those two sums per channel.
+/// `glossy_gradient_limit` in `shaders/common/ircache_math.glsl` is its GLSL twin.
+pub fn glossy_gradient_limit_from_sums(coeff_sq: Vec3, grad_sq: Vec3) -> f32 {
+    let mut out = IC_FAR;
+    for c in 0..3 {
+        if grad_sq[c] > 0.0 && grad_sq[c].is_finite() {
+            out = out.min((coeff_sq[c].max(0.0) / grad_sq[c]).sqrt());
+        }
+    }
+    out
+}
+
+/// The radius over which a record's radiance field, as its coefficients see it, changes to first
+/// order by its own size: per channel the L² norm of the coefficients over the L² (Frobenius)
+/// norm of their translational gradients, the smallest over the channels. By Parseval both
+/// norms are those of the band-limited functions on the sphere, so this is the glossy lobe's
+/// analogue of the irradiance's gradient limit `E/‖∇E‖` ([`crate::radius::gradient_limit_radius`]):
+/// a lobe that weighs the directions evenly changes at most as fast as the field (Cauchy–Schwarz
+/// bounds `|Σ ∇c_i·δx W_i|` by `‖∇c‖·|δx|·‖W‖`).
+pub fn glossy_gradient_limit(estimate: &RadianceEstimate) -> f32 {
+    let (mut coeff_sq, mut grad_sq) = (Vec3::ZERO, Vec3::ZERO);
+    for i in 0..SH_COEFFS {
+        coeff_sq += estimate.coeffs[i] * estimate.coeffs[i];
+        for axis in &estimate.grad {
+            grad_sq += axis[i] * axis[i];
+        }
+    }
+    glossy_gradient_limit_from_sums(coeff_sq, grad_sq)
+}
+
+#[cfg(test)]
+mod glossy_limit_tests {
+    use super::*;
+
+    fn estimate(c0: Vec3, g: Vec3) -> RadianceEstimate {
+        let mut e = RadianceEstimate {
+            coeffs: [Vec3::ZERO; SH_COEFFS],
+            grad: [[Vec3::ZERO; SH_COEFFS]; 3],
+        };
+        e.coeffs[0] = c0;
+        e.coeffs[3] = 0.5 * c0;
+        e.grad[0][0] = g;
+        e.grad[2][3] = 2.0 * g;
+        e
+    }
+
+    #[test]
+    fn the_limit_is_the_distance_at_which_the_linear_field_doubles() {
+        // ‖c‖ = √1.25·|c0|, ‖∇c‖ = √5·|g| per channel.
+        let e = estimate(Vec3::new(2.0, 4.0, 1.0), Vec3::new(1.0, 1.0, 1.0));
+        let expect = (1.25f32).sqrt() * 1.0 / 5f32.sqrt();
+        assert!((glossy_gradient_limit(&e) - expect).abs() <= 1e-6 * expect);
+        // The smallest channel wins: a steeper red gradient limits all three.
+        let mut steep = e;
+        steep.grad[0][0].x = 10.0;
+        let red = ((1.25f32 * 4.0) / (100.0 + 4.0)).sqrt();
+        assert!((glossy_gradient_limit(&steep) - red).abs() <= 1e-6 * red);
+    }
+
+    #[test]
+    fn no_gradient_means_no_limit_and_a_dark_channel_limits_nothing_it_lacks() {
+        let flat = estimate(Vec3::ONE, Vec3::ZERO);
+        assert_eq!(glossy_gradient_limit(&flat), IC_FAR);
+        // A channel without light but with a gradient limits to 0 (its first-order change is
+        // infinitely larger than its value), as the irradiance's limit does.
+        let dark_red = estimate(Vec3::new(0.0, 1.0, 1.0), Vec3::new(1.0, 0.0, 0.0));
+        assert_eq!(glossy_gradient_limit(&dark_red), 0.0);
+        let sums = glossy_gradient_limit_from_sums(Vec3::splat(4.0), Vec3::new(1.0, f32::NAN, 0.0));
+        assert_eq!(sums, 2.0);
+    }
+}

@@ -170,6 +170,7 @@ pub fn ic_settings(ic: &IcArgs, size: (u32, u32), seed: u32) -> Result<IcSetting
         direct_samples: ic.direct_samples.unwrap_or(defaults.direct_samples).max(1),
         sky: ic.sky_light(),
         glossy: ic.glossy_light(),
+        glossy_spacing: ic.glossy_spacing(),
         emitters: ic.emitter_light(),
         seed,
         ..defaults

@@ -25,7 +25,8 @@ pub use frame::clock::{Span, Track};
 pub use frame::ic::{render_ic, IcRenderer};
 pub use frame::path::{render_path, Budget, FrameOutput, PathSettings, Progress};
 pub use frame::settings::{
-    sub_frame_jitter, EmitterLight, GlossyLight, IcDebug, IcSettings, IcStats, SkyLight,
+    sub_frame_jitter, EmitterLight, GlossyLight, GlossySpacing, IcDebug, IcSettings, IcStats,
+    SkyLight,
 };
 pub use passes::aov::{render_aovs, AovPass, Aovs};
 pub use passes::composite::CompositePass;
@@ -37,7 +38,7 @@ pub use passes::neighbours::NeighbourPass;
 pub use passes::path_trace::PathTracer;
 pub use passes::record::{
     creation_seed, record_seed, DISPATCH_OFFSET, RECORD_BINDINGS_BASE, RECORD_FLAGS_MASK,
-    RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED,
+    RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED, RECORD_FLAG_GLOSSY,
     RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE, RECORD_INSTANCE_SHIFT,
 };
 pub use passes::record::{RecordPass, MAX_STRATA, R_EPS_REL};

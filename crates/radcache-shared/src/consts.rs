@@ -157,6 +157,11 @@ gpu_consts! {
     pub const RECORD_FLAG_CLAMPED_DOWN: u32 = 8;
     /// `GpuRecord.info.w`: the shading normal was folded toward the geometric one.
     pub const RECORD_FLAG_FOLDED: u32 = 16;
+    /// `GpuRecord.info.w`: made for a glossy lobe from the cache (on a pixel whose material is
+    /// not Lambertian and has a roughness of at least `GLOSSY_ROUGHNESS_MIN`); with
+    /// `GLOSSY_DENSITY` its radius also obeys the glossy gradient limit
+    /// (docs/radiance-caching.md §9), at creation and at every refresh.
+    pub const RECORD_FLAG_GLOSSY: u32 = 32;
     /// Bits of `GpuRecord.info.w` that hold flags; the mesh instance is stored above them.
     pub const RECORD_FLAGS_MASK: u32 = 0xff;
     /// Shift of the mesh instance in `GpuRecord.info.w`.
@@ -183,7 +188,7 @@ gpu_consts! {
 }
 
 const _: () = assert!(GRID_SLOTS == GRID_LEVELS + 1);
-const _: () = assert!(RECORD_FLAG_FOLDED <= RECORD_FLAGS_MASK);
+const _: () = assert!(RECORD_FLAG_GLOSSY <= RECORD_FLAGS_MASK);
 const _: () = assert!(RECORD_FLAGS_MASK == (1 << RECORD_INSTANCE_SHIFT) - 1);
 
 gpu_consts! {
@@ -254,7 +259,8 @@ gpu_consts! {
     /// its coefficients as f32 (`RADIANCE_VEC4S`), then the gradients' scale `s` (one f32, in
     /// lane 0 of vec4 `RADIANCE_VEC4S`), then the translational gradients along world x, y and z
     /// divided by `s`, as f16 pairs (`packHalf2x16`; 24 words per axis, floats packed as the
-    /// coefficients, from vec4 `RADIANCE_VEC4S + 1`), and one vec4 of padding: 512 bytes, so
+    /// coefficients, from vec4 `RADIANCE_VEC4S + 1`), and one vec4 holding the record's glossy
+    /// gradient limit in lane 0 (docs/radiance-caching.md §9; the rest zero): 512 bytes, so
     /// 2¹⁸ records fit the 128 MiB a storage buffer binding may span on lavapipe.
     pub const RECORD_RADIANCE_VEC4S: u32 = 32;
     /// The smallest roughness whose specular lobe is taken from radiance records: from here up

@@ -4,7 +4,7 @@
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 use radcache_cache::{ErrorControl, IcParams, Preset, WeightKind};
-use radcache_render::{EmitterLight, GlossyLight, SkyLight};
+use radcache_render::{EmitterLight, GlossyLight, GlossySpacing, SkyLight};
 
 /// Cache quality preset.
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -59,6 +59,16 @@ pub enum Glossy {
     Paths,
 }
 
+/// How records for glossy lobes from the cache are spaced (docs/radiance-caching.md §9).
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GlossySpacingArg {
+    /// Also by the glossy gradient limit: density follows the incoming radiance's directional
+    /// detail (default).
+    Lobe,
+    /// By the irradiance's rule alone, as every other record.
+    Irradiance,
+}
+
 /// The rule that sets a record's radius.
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ErrorControlArg {
@@ -107,6 +117,9 @@ pub struct IcArgs {
     /// Where glossy lobes take their indirect light from (`--method ic`).
     #[arg(long, value_enum, default_value_t = Glossy::Records)]
     pub glossy: Glossy,
+    /// How records for glossy lobes from the cache are spaced (`--method ic`).
+    #[arg(long, value_enum, default_value_t = GlossySpacingArg::Lobe)]
+    pub glossy_spacing: GlossySpacingArg,
 }
 
 fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T)> {
@@ -137,6 +150,14 @@ impl IcArgs {
             Glossy::Records => GlossyLight::Records,
             Glossy::RecordsNoGradients => GlossyLight::RecordsWithoutGradients,
             Glossy::Paths => GlossyLight::Paths,
+        }
+    }
+
+    /// How records for glossy lobes are spaced.
+    pub fn glossy_spacing(&self) -> GlossySpacing {
+        match self.glossy_spacing {
+            GlossySpacingArg::Lobe => GlossySpacing::Lobe,
+            GlossySpacingArg::Irradiance => GlossySpacing::Irradiance,
         }
     }
 

@@ -59,6 +59,21 @@ pub struct IcSettings {
     /// Where glossy lobes take their indirect light from. Must be set when the renderer is
     /// created.
     pub glossy: GlossyLight,
+    /// How records for glossy lobes from the cache are spaced. Must be set when the renderer is
+    /// created.
+    pub glossy_spacing: GlossySpacing,
+}
+
+/// How the records made for glossy lobes from the cache are spaced (docs/radiance-caching.md
+/// §9); records of every other pixel are spaced by the irradiance alone either way.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum GlossySpacing {
+    /// Their radius also obeys the glossy gradient limit (`GLOSSY_DENSITY`): density follows
+    /// the incoming radiance's directional detail.
+    #[default]
+    Lobe,
+    /// As every record: by the irradiance's rule alone.
+    Irradiance,
 }
 
 /// Where the specular lobe's indirect light comes from in a frame rendered with the cache
@@ -66,8 +81,7 @@ pub struct IcSettings {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum GlossyLight {
     /// Radiance records for lobes at or above `GLOSSY_ROUGHNESS_MIN`, where the plan has such
-    /// materials and records are not kept with temporal caching; sharper lobes (and every lobe
-    /// otherwise) as [`GlossyLight::Paths`].
+    /// materials; sharper lobes (and every lobe otherwise) as [`GlossyLight::Paths`].
     #[default]
     Records,
     /// As [`GlossyLight::Records`] with each record's coefficients taken as constant over its
@@ -152,6 +166,7 @@ impl Default for IcSettings {
             sky: SkyLight::Records,
             emitters: EmitterLight::Analytic,
             glossy: GlossyLight::Records,
+            glossy_spacing: GlossySpacing::Lobe,
         }
     }
 }

@@ -30,7 +30,7 @@ use radcache_vk::{
 
 use crate::bindings::record as b;
 use crate::error::{Error, Result};
-use crate::frame::settings::SkyLight;
+use crate::frame::settings::{GlossySpacing, SkyLight};
 use crate::passes::gbuffer::GBuffer;
 use crate::scene::GpuScene;
 use radcache_shared::consts::{RecordSource, SEED_SUB_FRAME_MUL};
@@ -47,7 +47,7 @@ pub const DISPATCH_OFFSET: u64 = std::mem::offset_of!(IcCounters, dispatch) as u
 
 pub use radcache_shared::consts::{
     MAX_STRATA, RECORD_FLAGS_MASK, RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP,
-    RECORD_FLAG_FOLDED, RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE,
+    RECORD_FLAG_FOLDED, RECORD_FLAG_GLOSSY, RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE,
     RECORD_INSTANCE_SHIFT,
 };
 
@@ -141,7 +141,8 @@ impl RecordPass {
 
     /// As [`RecordPass::new`]; with `radiance` the records also project their strata onto the
     /// SH coefficients of the incoming radiance (`HAS_RADIANCE_CACHE`, docs/radiance-caching.md
-    /// §6.1), written by [`RecordPass::record_with_radiance`].
+    /// §6.1), written by [`RecordPass::record_with_radiance`], and records for glossy lobes
+    /// obey the glossy gradient limit ([`GlossySpacing::Lobe`]).
     pub fn with_radiance(
         ctx: &Context,
         shaders: &ShaderCompiler,
@@ -149,6 +150,21 @@ impl RecordPass {
         params: &IcParams,
         sky: SkyLight,
         radiance: bool,
+    ) -> Result<RecordPass> {
+        let spacing = GlossySpacing::Lobe;
+        Self::with_glossy_spacing(ctx, shaders, scene, params, sky, radiance, spacing)
+    }
+
+    /// As [`RecordPass::with_radiance`], the records for glossy lobes spaced by `spacing`
+    /// (docs/radiance-caching.md §9; `GLOSSY_DENSITY` with [`GlossySpacing::Lobe`]).
+    pub fn with_glossy_spacing(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        scene: &GpuScene,
+        params: &IcParams,
+        sky: SkyLight,
+        radiance: bool,
+        spacing: GlossySpacing,
     ) -> Result<RecordPass> {
         let (m, n) = (params.strata_m, params.strata_n);
         if m < 1 || n < 3 || m.saturating_mul(n) > MAX_STRATA {
@@ -163,6 +179,9 @@ impl RecordPass {
         }
         if radiance {
             defines.push(("HAS_RADIANCE_CACHE", "1"));
+            if spacing == GlossySpacing::Lobe {
+                defines.push(("GLOSSY_DENSITY", "1"));
+            }
         }
         let spirv = shaders.compile(SHADER, &defines)?;
         let pipeline = Pipeline::compute(
