@@ -218,7 +218,7 @@ float gradient_limit_radius(float r, vec3 e, vec3 gt_r, vec3 gt_g, vec3 gt_b) {
 // The glossy gradient limit from its sums per channel (Σ c², Σ |∂c/∂x|²): the smallest
 // √(Σc²/Σg²) over the channels with a positive, finite Σg²; IC_FAR when none
 // (radcache_cache::radiance::glossy_gradient_limit_from_sums).
-float glossy_gradient_limit(vec3 coeff_sq, vec3 grad_sq) {
+float glossy_gradient_limit_from_sums(vec3 coeff_sq, vec3 grad_sq) {
     float out_r = IC_FAR;
     for (int c = 0; c < 3; ++c) {
         if (grad_sq[c] > 0.0 && !isinf(grad_sq[c])) {

@@ -317,7 +317,7 @@ float project_radiance(uint lid, uint index, uint m, uint n, vec3 t, vec3 b, vec
     for (uint f = 0u; f < 3u * 3u * SH_COEFFS; ++f) {
         grad_sq[f % 3u] += s_gtot[f] * s_gtot[f];
     }
-    float limit = glossy_gradient_limit(coeff_sq, grad_sq);
+    float limit = glossy_gradient_limit_from_sums(coeff_sq, grad_sq);
     radiance[base + RECORD_RADIANCE_VEC4S - 1u] = uvec4(floatBitsToUint(limit), 0u, 0u, 0u);
     return limit;
 }

@@ -96,7 +96,7 @@ void extrapolate(Row i, inout Row o) {
 
 // in: 0 (r, r_neighbour, r_lo, r_hi); 1 e; 2-4 grad_t (R, G, B); 5 (footprint, min_px, max_px,
 // v_scale); 6 (r_j, d_ij, -, -); 7 (depth, tan_half_fov_y, image_height, cos_view); 8 dpdx;
-// 9 dpdy; 10 p_i; 11 p_j. out 4: glossy_gradient_limit(e, grad_t R).
+// 9 dpdy; 10 p_i; 11 p_j. out 4: glossy_gradient_limit_from_sums(e, grad_t R).
 void radius(Row i, inout Row o) {
     float r = i.v[0].x, r_nb = i.v[0].y, r_lo = i.v[0].z, r_hi = i.v[0].w;
     vec3 e = i.v[1].xyz, g0 = i.v[2].xyz, g1 = i.v[3].xyz, g2 = i.v[4].xyz;
@@ -113,7 +113,7 @@ void radius(Row i, inout Row o) {
     o.v[3] = vec4(pixel_footprint(i.v[7].x, i.v[7].y, i.v[7].z, i.v[7].w),
                   pixel_footprint_from_differentials(i.v[8].xyz, i.v[9].xyz), ri, rj);
     // The glossy gradient limit on (e, grad_t R) as its two sums.
-    o.v[4] = vec4(glossy_gradient_limit(e, g0), 0.0, 0.0, 0.0);
+    o.v[4] = vec4(glossy_gradient_limit_from_sums(e, g0), 0.0, 0.0, 0.0);
 }
 
 // compute_record over one sample set: in 0 (normal, r_eps); 1 (m, n, first sample, -) bits.

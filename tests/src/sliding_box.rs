@@ -5,9 +5,13 @@
 
 use glam::{Quat, Vec3};
 use radcache_cache::IcParams;
-use radcache_render::IcSettings;
+use radcache_image::{compare, Image, Metrics};
+use radcache_render::{
+    render_path, Budget, FrameOutput, GpuScene, IcRenderer, IcSettings, PathSettings,
+};
 use radcache_scene::writer::{ChannelDesc, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
 use radcache_scene::{AnimationKind, Interpolation, Property, Scene};
+use radcache_vk::{Context, ShaderCompiler};
 
 use crate::geometry::room;
 use crate::scenes::{camera_node, cube, plane_y, temp_dir, write_and_load};
@@ -134,4 +138,42 @@ pub fn settings(size: u32, frame: u32) -> IcSettings {
         time_step_s: 1.0 / FPS,
         ..IcSettings::default()
     }
+}
+
+/// Frame `last` of a sequence (`kept`, rendered with kept records at `size`²) and a fresh cache
+/// of that frame, each against a 1024-spp path-traced reference: (kept, fresh), printed.
+pub fn against_fresh_cache(
+    ctx: &Context,
+    shaders: &ShaderCompiler,
+    scene: &Scene,
+    gpu: &mut GpuScene,
+    size: u32,
+    last: u32,
+    kept: &FrameOutput,
+) -> (Metrics, Metrics) {
+    let fresh_settings = IcSettings {
+        time_step_s: 0.0,
+        ..settings(size, last)
+    };
+    let mut fresh = IcRenderer::new(ctx, shaders, gpu, &fresh_settings).unwrap();
+    let (fresh_out, _) = fresh
+        .render(ctx, scene, gpu, &fresh_settings, &mut |_| {})
+        .unwrap();
+    drop(fresh);
+    let path = PathSettings {
+        width: size,
+        height: size,
+        budget: Budget::Samples(1024),
+        seed: 11,
+        frame: last,
+        time: settings(size, last).time,
+        ..PathSettings::default()
+    };
+    let reference = render_path(ctx, shaders, scene, gpu, &path, &mut |_| {}).unwrap();
+    let image = |o: &FrameOutput| Image::from_pixels(o.width, o.height, o.pixels.clone()).unwrap();
+    let reference = image(&reference);
+    let m_kept = compare(&reference, &image(kept)).unwrap();
+    let m_fresh = compare(&reference, &image(&fresh_out)).unwrap();
+    eprintln!("kept records: {m_kept}\nfresh cache: {m_fresh}");
+    (m_kept, m_fresh)
 }

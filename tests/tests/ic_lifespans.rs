@@ -7,10 +7,7 @@
 use glam::Vec3;
 use radcache_cache::temporal::temporal_lifespan;
 use radcache_cache::IcParams;
-use radcache_image::{compare, Image};
-use radcache_render::{
-    render_path, Budget, GpuScene, IcRenderer, IcSettings, IcStats, PathSettings,
-};
+use radcache_render::{GpuScene, IcRenderer, IcSettings, IcStats};
 use radcache_scene::Scene;
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
 use radcache_tests::sliding_box::{self, box_centre, distance_to_path, FAR, HALF, NEAR};
@@ -151,31 +148,8 @@ fn a_frame_with_kept_records_is_as_close_to_the_reference_as_a_fresh_cache() {
     }
     assert!(refreshed > 0);
     let out = out.unwrap();
-    let fresh_settings = IcSettings {
-        time_step_s: 0.0,
-        ..settings(last)
-    };
-    let mut fresh = IcRenderer::new(&ctx, &shaders, &gpu, &fresh_settings).unwrap();
-    let (fresh_out, _) = fresh
-        .render(&ctx, &scene, &mut gpu, &fresh_settings, &mut |_| {})
-        .unwrap();
-    let path = PathSettings {
-        width: SIZE,
-        height: SIZE,
-        budget: Budget::Samples(1024),
-        seed: 11,
-        frame: last,
-        time: settings(last).time,
-        ..PathSettings::default()
-    };
-    let reference = render_path(&ctx, &shaders, &scene, &mut gpu, &path, &mut |_| {}).unwrap();
-    let image = |o: &radcache_render::FrameOutput| {
-        Image::from_pixels(o.width, o.height, o.pixels.clone()).unwrap()
-    };
-    let reference = image(&reference);
-    let m_kept = compare(&reference, &image(&out)).unwrap();
-    let m_fresh = compare(&reference, &image(&fresh_out)).unwrap();
-    eprintln!("kept records: {m_kept}\nfresh cache: {m_fresh}");
+    let (m_kept, m_fresh) =
+        sliding_box::against_fresh_cache(&ctx, &shaders, &scene, &mut gpu, SIZE, last, &out);
     assert_eq!(m_kept.nonfinite_candidate, 0);
     assert!(m_kept.relmse <= 0.01, "relMSE {}", m_kept.relmse);
     assert!(
@@ -187,6 +161,6 @@ fn a_frame_with_kept_records_is_as_close_to_the_reference_as_a_fresh_cache() {
     for (c, r) in m_kept.mean_ratio.iter().enumerate() {
         assert!((r - 1.0).abs() <= 0.03, "channel {c} mean ratio {r}");
     }
-    drop((kept, fresh, gpu));
+    drop((kept, gpu));
     finish(ctx);
 }

@@ -12,10 +12,7 @@ use glam::Vec3;
 use radcache_cache::cache_file::{CacheFile, CacheIdentity, CacheSettings};
 use radcache_cache::IcParams;
 use radcache_image::{compare, Image};
-use radcache_render::{
-    render_path, Budget, FrameOutput, GpuScene, IcRenderer, IcSettings, IcState, PathSettings,
-    RadianceBlock,
-};
+use radcache_render::{FrameOutput, GpuScene, IcRenderer, IcState, RadianceBlock};
 use radcache_scene::Scene;
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
 use radcache_tests::ic_fixture::sequence_settings;
@@ -162,28 +159,8 @@ fn temporal_caching_keeps_unlisted_radiance_blocks_and_re_evaluates_the_changed_
 
     // The last frame against the path tracer, and against a fresh cache of that frame.
     let out = out.unwrap();
-    let fresh_settings = IcSettings {
-        time_step_s: 0.0,
-        ..settings(last)
-    };
-    let mut fresh = IcRenderer::new(&ctx, &shaders, &gpu, &fresh_settings).unwrap();
-    let (fresh_out, _) = fresh
-        .render(&ctx, &scene, &mut gpu, &fresh_settings, &mut |_| {})
-        .unwrap();
-    let path = PathSettings {
-        width: SIZE,
-        height: SIZE,
-        budget: Budget::Samples(1024),
-        seed: 11,
-        frame: last,
-        time: settings(last).time,
-        ..PathSettings::default()
-    };
-    let reference = render_path(&ctx, &shaders, &scene, &mut gpu, &path, &mut |_| {}).unwrap();
-    let reference = image(&reference);
-    let m_kept = compare(&reference, &image(&out)).unwrap();
-    let m_fresh = compare(&reference, &image(&fresh_out)).unwrap();
-    eprintln!("kept radiance records: {m_kept}\nfresh cache: {m_fresh}");
+    let (m_kept, m_fresh) =
+        sliding_box::against_fresh_cache(&ctx, &shaders, &scene, &mut gpu, SIZE, last, &out);
     assert_eq!(m_kept.nonfinite_candidate, 0);
     assert!(m_kept.relmse <= 0.01, "relMSE {}", m_kept.relmse);
     assert!(
@@ -192,7 +169,7 @@ fn temporal_caching_keeps_unlisted_radiance_blocks_and_re_evaluates_the_changed_
         m_kept.relmse,
         m_fresh.relmse
     );
-    drop((r, fresh, gpu));
+    drop((r, gpu));
     finish(ctx);
 }
 

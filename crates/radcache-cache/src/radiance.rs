@@ -166,7 +166,7 @@ pub fn compute_radiance(
 /// The glossy gradient limit from the sums it needs (docs/radiance-caching.md §9):
 /// `min_c √(Σ_i c_ic² / Σ_{a,i} (∂c_ic/∂x_a)²)` over the channels whose gradients are not all
 /// zero, [`IC_FAR`] when none is; `coeff_sq` and `grad_sq` hold those two sums per channel.
-/// `glossy_gradient_limit` in `shaders/common/ircache_math.glsl` is its GLSL twin.
+/// `glossy_gradient_limit_from_sums` in `shaders/common/ircache_math.glsl` is its GLSL twin.
 pub fn glossy_gradient_limit_from_sums(coeff_sq: Vec3, grad_sq: Vec3) -> f32 {
     let mut out = IC_FAR;
     for c in 0..3 {

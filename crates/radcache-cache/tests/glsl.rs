@@ -29,6 +29,10 @@ const RUST_ONLY: [(&str, &str); 4] = [
         "compute_radiance",
         "takes slices; the GPU pass sums coefficients and walls per invocation",
     ),
+    (
+        "glossy_gradient_limit",
+        "takes a record's estimate; the GPU pass sums it in shared memory and calls the twin of glossy_gradient_limit_from_sums",
+    ),
     ("stratum_contains", "test helper"),
 ];
 
