@@ -16,7 +16,7 @@ use radcache_shared::glsl_twin::{
 };
 
 /// Rust functions with no GLSL twin (slices / test helpers) and their reason.
-const RUST_ONLY: [(&str, &str); 4] = [
+const RUST_ONLY: [(&str, &str); 5] = [
     (
         "compute_record",
         "takes slices; the GPU pass reduces the per-stratum terms",
