@@ -5,7 +5,9 @@
 // environment along the camera ray; added with weight 1 to the frame accumulator (a = sub-frames
 // so far). The emission seen at the sub-frame's sample goes to a separate accumulator: the
 // emission pass replaces it by a finely supersampled box filter where emitters have edges.
-// A non-finite value is dropped and counted.
+// A non-finite value is dropped and counted. With IC_AA_MOMENTS (adaptive anti-aliasing,
+// docs/cache-frame.md §7.1) the squares of the sub-frame's radiance go to a second accumulator, from
+// which the host estimates the sampling error of the mean (radcache_render::frame::aa).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -22,6 +24,10 @@ layout(binding = B_COMPOSITE_EMISSION_ACCUM, std430) buffer EmissionAccum { vec4
 // Debug AOVs, two vec4 per pixel: indirect radiance (rgb) and Σw (a); records per pixel (x).
 layout(binding = B_COMPOSITE_DEBUG_ACCUM, std430) buffer DebugAccum { vec4 debug_accum[]; };
 layout(binding = B_COMPOSITE_SPLAT_COUNT, r32f) readonly uniform image2D splat_count;
+
+#ifdef IC_AA_MOMENTS
+layout(binding = B_COMPOSITE_ACCUM_SQ, std430) buffer AccumSq { vec4 accum_sq[]; };
+#endif
 
 layout(push_constant) uniform Push { CompositePush pc; };
 
@@ -81,5 +87,8 @@ void main() {
         atomicAdd(nonfinite, 1u);
     }
     accum[index] += vec4(l, 1.0);
+#ifdef IC_AA_MOMENTS
+    accum_sq[index] += vec4(l * l, 0.0);
+#endif
     emission_accum[index] += vec4(emitted, 1.0);
 }

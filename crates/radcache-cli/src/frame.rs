@@ -58,13 +58,16 @@ pub struct Rendered {
 }
 
 /// Renders `frame` at scene time `time`. The cache's renderer is created on the first frame and
-/// kept in `ic`; without `setup.temporal` it forgets its records before every frame.
+/// kept in `ic`; without `setup.temporal` it forgets its records before every frame. A
+/// `warm_up` frame (not written: only its records matter) shades the cache's sub-frames alone,
+/// without adaptive anti-aliasing, which changes no record.
 pub fn render(
     setup: &FrameSetup<'_>,
     gpu: &mut GpuScene,
     ic: &mut Option<IcRenderer>,
     frame: u32,
     time: f32,
+    warm_up: bool,
 ) -> Result<Rendered> {
     let args = setup.args;
     let (width, height) = setup.size;
@@ -138,6 +141,10 @@ pub fn render(
             if !setup.temporal {
                 renderer.forget();
             }
+            let settings = IcSettings {
+                anti_aliasing: settings.anti_aliasing.filter(|_| !warm_up),
+                ..settings
+            };
             let bar = FrameBar::new(format!("frame {frame}"), "sub-frame phases", args.quiet);
             let started = Instant::now();
             let (mut out, stats) =
@@ -172,6 +179,7 @@ pub fn ic_settings(ic: &IcArgs, size: (u32, u32), seed: u32) -> Result<IcSetting
         glossy: ic.glossy_light(),
         glossy_spacing: ic.glossy_spacing(),
         emitters: ic.emitter_light(),
+        anti_aliasing: ic.anti_aliasing()?,
         seed,
         ..defaults
     })
@@ -292,6 +300,9 @@ pub fn stats_entry(r: &Rendered, frame: u32, time: f32) -> Value {
         entry["dropped_requests"] = json!(ic.dropped_requests);
         entry["rejected_records"] = json!(ic.rejected_records);
         entry["phases_wall_s"] = json!(ic.phases_s);
+        if let Some(estimate) = ic.aa_relmse_estimate {
+            entry["aa_relmse_estimate"] = json!(estimate);
+        }
     }
     if let Some((from, to)) = r.created {
         // Creating the cache's renderer: shaders, pipelines and pass buffers (first frame only).

@@ -143,7 +143,8 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
             }
         }
         let t_frame = Instant::now();
-        let rendered = frame::render(&setup, &mut gpu, &mut ic, number, time)?;
+        let warm_up = step.action == Action::WarmUp;
+        let rendered = frame::render(&setup, &mut gpu, &mut ic, number, time, warm_up)?;
         if step.action == Action::WarmUp {
             warm.add(number, t_frame.elapsed().as_secs_f64());
             continue;

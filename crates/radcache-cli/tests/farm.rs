@@ -1,8 +1,8 @@
 //! `radcache farm` on a one-node Slurm cluster (scripts/slurm-local.sh, which needs root and
 //! installs Slurm where it is missing; the test fails when the cluster cannot start): 48 frames
 //! of the bundled animation in 4 chunks match a single-process render within noise, chunk
-//! boundaries flicker no more than 1.2× the pairs inside chunks, and a second run after two
-//! frames were deleted renders exactly those two.
+//! boundaries flicker no more than 1.15× the single process at the same frames, and a second
+//! run after two frames were deleted renders exactly those two.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -244,11 +244,19 @@ fn a_sequence_renders_on_a_local_slurm_cluster_and_resumes() {
         farm_error <= 1.2 * single_error,
         "farm relMSE {farm_error} > 1.2 × the single process's {single_error}"
     );
+    // The boundary pairs against the same pairs of the single process: what chunking adds,
+    // apart from what the animation does there (with adaptive anti-aliasing the single process
+    // itself flickers 1.15× more at these pairs than next to them; docs/farm.md).
+    let (single_across, single_inside) = boundary_and_inside_flicker(&single, &reference);
     let (across, inside) = boundary_and_inside_flicker(&dir, &reference);
-    eprintln!("flicker: across boundaries {across:.5}, inside chunks {inside:.5}");
+    eprintln!(
+        "flicker: across boundaries {across:.5} (single process {single_across:.5}), \
+         inside chunks {inside:.5} (single process {single_inside:.5})"
+    );
     assert!(
-        across <= 1.2 * inside,
-        "flicker across chunk boundaries {across} > 1.2 × inside chunks {inside}"
+        across <= 1.15 * single_across,
+        "flicker across chunk boundaries {across} > 1.15 × the single process's at the same \
+         frames {single_across}"
     );
 
     // Two frames deleted: the summary names them, and a second run renders exactly those.

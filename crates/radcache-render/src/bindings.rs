@@ -204,6 +204,9 @@ pass_bindings! {
         SPLAT_COUNT: StorageImage,
         /// Σw·L_glossy (rgb), Σw (a): the glossy splat's target (read with `HAS_RADIANCE_CACHE`).
         GLOSSY_SUM: StorageImage,
+        /// Σ radiance² (rgb) per pixel (`vec4[]`, written with `IC_AA_MOMENTS`: adaptive
+        /// anti-aliasing).
+        ACCUM_SQ: StorageBuffer,
     }
 }
 

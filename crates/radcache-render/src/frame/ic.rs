@@ -137,7 +137,15 @@ impl IcRenderer {
                 radiance,
                 settings.glossy_spacing,
             )?,
-            composite: CompositePass::with_radiance(ctx, shaders, gpu, w, h, radiance)?,
+            composite: CompositePass::with_options(
+                ctx,
+                shaders,
+                gpu,
+                w,
+                h,
+                radiance,
+                settings.anti_aliasing.is_some(),
+            )?,
             emission: EmissionPass::new(ctx, shaders, gpu)?,
             state: IcState::with_radiance(ctx, shaders, capacity, w * h, radiance)?,
             temporal: if temporal {
@@ -198,6 +206,9 @@ impl IcRenderer {
         self.has_records = true;
         for k in 0..run.sub_frames {
             self.shade_sub_frame(ctx, gpu, settings, k, &mut run)?;
+        }
+        if let Some(aa) = settings.anti_aliasing {
+            self.anti_alias(ctx, gpu, settings, aa, &mut run)?;
         }
         self.finish(ctx, gpu, settings, run)
     }

@@ -40,6 +40,7 @@
 //! cleared), then samples in submissions sized to take about `chunk_target_ms` each until the
 //! budget (samples or seconds) is spent, then the read-back of the mean (and the AOVs).
 
+pub mod aa;
 pub mod clock;
 pub mod ic;
 pub mod path;

@@ -62,6 +62,26 @@ pub struct IcSettings {
     /// How records for glossy lobes from the cache are spaced. Must be set when the renderer is
     /// created.
     pub glossy_spacing: GlossySpacing,
+    /// Adaptive anti-aliasing ([`AntiAliasing`]): more sub-frames after the first `sub_frames`
+    /// until the image's sampling error is estimated small enough. `None` (the default) shades
+    /// exactly `sub_frames`. Must be set when the renderer is created.
+    pub anti_aliasing: Option<AntiAliasing>,
+}
+
+/// Adaptive anti-aliasing of a frame rendered with the cache (docs/cache-frame.md §7.1): after
+/// the `sub_frames` of the cache phase, the frame goes on shading jittered sub-frames (reusing
+/// the records: no new record, no hole filling) while the relMSE that the sub-frame sampling
+/// leaves in the mean image, estimated from each pixel's second moment
+/// ([`crate::frame::aa::sampling_relmse`]), is above `target`, up to `max_sub_frames`. The
+/// estimate sees what the sub-frames average (edges, textures, direct-light noise), not the
+/// records' own error, which stays the same in every sub-frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AntiAliasing {
+    /// The estimated sampling relMSE the frame stops at (`(c−r)²/(r²+0.01)` as
+    /// `radcache compare`'s relMSE).
+    pub target: f64,
+    /// The most sub-frames a frame shades.
+    pub max_sub_frames: u32,
 }
 
 /// How the records made for glossy lobes from the cache are spaced (docs/radiance-caching.md
@@ -167,6 +187,7 @@ impl Default for IcSettings {
             emitters: EmitterLight::Analytic,
             glossy: GlossyLight::Records,
             glossy_spacing: GlossySpacing::Lobe,
+            anti_aliasing: None,
         }
     }
 }
@@ -208,6 +229,10 @@ pub struct IcStats {
     /// (G-buffer, direct, splat, composite), `emission`, `readback` (summed over sub-frames).
     /// Host-measured, so it holds on drivers whose timestamps miss asynchronous compute work.
     pub phases_s: BTreeMap<String, f64>,
+    /// Sub-frames shaded (`sub_frames`, or more with adaptive anti-aliasing).
+    pub sub_frames_shaded: u32,
+    /// With adaptive anti-aliasing: the sampling relMSE estimated after the last sub-frame.
+    pub aa_relmse_estimate: Option<f64>,
     /// The debug AOVs, when asked for.
     pub debug: Option<IcDebug>,
 }

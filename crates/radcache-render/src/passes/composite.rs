@@ -7,7 +7,9 @@
 //! Bindings: the scene (0–15), the G-buffer (16–21), then from 22: the splat sum (Σw·Ẽ, Σw), the
 //! frame accumulator, the non-finite counter, the emission accumulator (read by
 //! [`crate::EmissionPass`], which adds the box-filtered emission), the debug accumulator and the
-//! splat record count. A non-finite value is replaced by 0 and counted.
+//! splat record count, and with adaptive anti-aliasing the accumulator of squares
+//! (`IC_AA_MOMENTS`, [`CompositePass::read_sampling_relmse`]). A non-finite value is replaced
+//! by 0 and counted.
 
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, ImageUse, MemoryLocation, Pipeline, Recorder,
@@ -40,6 +42,9 @@ pub struct CompositePass {
     pub(crate) accum: Buffer,
     pub(crate) emission_accum: Buffer,
     debug_accum: Buffer,
+    /// Σ radiance² per pixel (16 bytes a pixel with moments, one vec4 otherwise).
+    accum_sq: Buffer,
+    moments: bool,
     nonfinite: Buffer,
     width: u32,
     height: u32,
@@ -63,22 +68,27 @@ impl CompositePass {
         width: u32,
         height: u32,
     ) -> Result<CompositePass> {
-        Self::with_radiance(ctx, shaders, scene, width, height, false)
+        Self::with_options(ctx, shaders, scene, width, height, false, false)
     }
 
     /// As [`CompositePass::new`]; with `radiance` the pass can add the glossy splat's target
-    /// (`HAS_RADIANCE_CACHE`, [`CompositePass::record_glossy`]).
-    pub fn with_radiance(
+    /// (`HAS_RADIANCE_CACHE`, [`CompositePass::record_glossy`]); with `moments` it also sums
+    /// the squares of the radiance (`IC_AA_MOMENTS`, [`CompositePass::read_sampling_relmse`]).
+    pub fn with_options(
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
         width: u32,
         height: u32,
         radiance: bool,
+        moments: bool,
     ) -> Result<CompositePass> {
         let mut defines = scene.defines();
         if radiance {
             defines.push(("HAS_RADIANCE_CACHE", "1"));
+        }
+        if moments {
+            defines.push(("IC_AA_MOMENTS", "1"));
         }
         let spirv = shaders.compile("passes/composite.comp", &defines)?;
         let pipeline = Pipeline::compute(
@@ -106,6 +116,12 @@ impl CompositePass {
             accum: buffer("composite.accum", pixels * 16, MemoryLocation::GpuOnly)?,
             emission_accum: buffer("composite.emission", pixels * 16, MemoryLocation::GpuOnly)?,
             debug_accum: buffer("composite.debug", pixels * 32, MemoryLocation::GpuOnly)?,
+            accum_sq: buffer(
+                "composite.accum_sq",
+                if moments { pixels * 16 } else { 16 },
+                MemoryLocation::GpuOnly,
+            )?,
+            moments,
             nonfinite: buffer("composite.nonfinite", 16, MemoryLocation::GpuToCpu)?,
             width,
             height,
@@ -117,6 +133,7 @@ impl CompositePass {
         rec.fill_buffer(&self.accum, 0, vk::WHOLE_SIZE, 0);
         rec.fill_buffer(&self.emission_accum, 0, vk::WHOLE_SIZE, 0);
         rec.fill_buffer(&self.debug_accum, 0, vk::WHOLE_SIZE, 0);
+        rec.fill_buffer(&self.accum_sq, 0, vk::WHOLE_SIZE, 0);
         rec.fill_buffer(&self.nonfinite, 0, vk::WHOLE_SIZE, 0);
         rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
     }
@@ -165,6 +182,7 @@ impl CompositePass {
             (b::DEBUG_ACCUM, Resource::Buffer(&self.debug_accum)),
             (b::SPLAT_COUNT, Resource::StorageImage(&splat.count)),
             (b::GLOSSY_SUM, Resource::StorageImage(glossy_sum)),
+            (b::ACCUM_SQ, Resource::Buffer(&self.accum_sq)),
         ]);
         let push = CompositePush {
             jitter,
@@ -211,6 +229,18 @@ impl CompositePass {
     /// Width and height of the accumulator.
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)
+    }
+
+    /// The sampling relMSE of the mean over the sub-frames accumulated so far
+    /// ([`crate::frame::aa::sampling_relmse`]); `None` for a pass made without moments.
+    pub fn read_sampling_relmse(&self, ctx: &Context) -> Result<Option<f64>> {
+        if !self.moments {
+            return Ok(None);
+        }
+        let n = (self.width * self.height) as usize;
+        let sums: Vec<[f32; 4]> = ctx.read_buffer(&self.accum, n)?;
+        let squares: Vec<[f32; 4]> = ctx.read_buffer(&self.accum_sq, n)?;
+        Ok(Some(crate::frame::aa::sampling_relmse(&sums, &squares)))
     }
 
     /// The mean over the accumulated sub-frames, and the number of non-finite values dropped.

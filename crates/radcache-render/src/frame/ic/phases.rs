@@ -11,9 +11,10 @@ use radcache_vk::Context;
 
 use super::IcRenderer;
 use crate::error::Result;
+use crate::frame::aa::next_sub_frames;
 use crate::frame::clock::FrameClock;
 use crate::frame::path::{FrameOutput, Progress};
-use crate::frame::settings::{sub_frame_jitter, IcSettings, IcStats};
+use crate::frame::settings::{sub_frame_jitter, AntiAliasing, IcSettings, IcStats};
 use crate::passes::holes::HoleSelection;
 use crate::passes::record::creation_seed;
 use crate::passes::splat::{SplatScope, SplatWeights};
@@ -28,8 +29,12 @@ pub(super) struct FrameRun<'p> {
     pub stats: IcStats,
     /// Ray queries per kind of work (`records`, `direct`, `emission`).
     pub rays: BTreeMap<String, u64>,
-    /// Jittered sub-frames of the frame (at least 1).
+    /// Jittered sub-frames of the cache phase (at least 1).
     pub sub_frames: u32,
+    /// Sub-frames to shade: `sub_frames`, more with adaptive anti-aliasing.
+    pub shade_total: u32,
+    /// Sub-frames shaded so far.
+    pub shaded: u32,
     /// Records kept from the previous frame, before the setup's temporal advance.
     pub kept: u32,
     /// Records the temporal advance listed as expired (evaluated again by the look-ahead).
@@ -48,6 +53,8 @@ impl<'p> FrameRun<'p> {
             },
             rays: BTreeMap::new(),
             sub_frames: sub_frames.max(1),
+            shade_total: sub_frames.max(1),
+            shaded: 0,
             kept: 0,
             expired: 0,
             start: Instant::now(),
@@ -55,11 +62,11 @@ impl<'p> FrameRun<'p> {
         }
     }
 
-    /// Reports `done` of the frame's `2 × sub_frames` steps (cache, then shade).
+    /// Reports `done` of the frame's `sub_frames + shade_total` steps (cache, then shade).
     fn report(&mut self, done: u32) {
         (self.progress)(Progress {
             done,
-            total: 2 * self.sub_frames,
+            total: self.sub_frames + self.shade_total,
             elapsed_s: self.start.elapsed().as_secs_f64(),
         });
     }
@@ -319,8 +326,38 @@ impl IcRenderer {
         run.stats.dropped_requests = u64::from(c.dropped_requests);
         run.stats.rejected_records = u64::from(c.rejected_records);
         run.clock.lap("shade");
+        run.shaded = k + 1;
         run.report(run.sub_frames + k + 1);
         Ok(())
+    }
+
+    /// **Adaptive anti-aliasing** (docs/cache-frame.md §7.1): while the sampling relMSE estimated
+    /// from the accumulated moments is above `aa.target`, shades the sub-frames that `1/n`
+    /// predicts (at least one more, at most `aa.max_sub_frames`) with the records as they are.
+    pub(super) fn anti_alias(
+        &self,
+        ctx: &Context,
+        gpu: &GpuScene,
+        settings: &IcSettings,
+        aa: AntiAliasing,
+        run: &mut FrameRun<'_>,
+    ) -> Result<()> {
+        loop {
+            let Some(estimate) = self.composite.read_sampling_relmse(ctx)? else {
+                return Ok(());
+            };
+            run.stats.aa_relmse_estimate = Some(estimate);
+            run.clock.lap("anti_aliasing");
+            let done = run.shaded;
+            if estimate <= aa.target || done >= aa.max_sub_frames {
+                return Ok(());
+            }
+            let next = next_sub_frames(done, estimate, aa.target, aa.max_sub_frames);
+            run.shade_total = next;
+            for k in done..next {
+                self.shade_sub_frame(ctx, gpu, settings, k, run)?;
+            }
+        }
     }
 
     /// **Finish**: the box-filtered emission, the instances kept for the next frame's motion,
@@ -347,17 +384,18 @@ impl IcRenderer {
         run.clock.lap("emission");
         let (pixels, nonfinite_pixels) = self.composite.read_mean(ctx)?;
         if settings.debug_aovs {
-            let debug = self.read_debug(ctx, run.sub_frames, run.stats.records)?;
+            let debug = self.read_debug(ctx, run.shaded, run.stats.records)?;
             run.stats.debug = Some(debug);
         }
         run.clock.lap("readback");
+        run.stats.sub_frames_shaded = run.shaded;
         let mut clock = run.clock;
         run.stats.phases_s = std::mem::take(&mut clock.phases_s);
         let output = FrameOutput {
             width: self.width,
             height: self.height,
             pixels,
-            spp: run.sub_frames,
+            spp: run.shaded,
             time_s: clock.elapsed_s(),
             rays: run.rays,
             passes_ms: std::mem::take(&mut clock.passes_ms),
