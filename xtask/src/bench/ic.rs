@@ -15,8 +15,10 @@
 //! share is a lower bound), set against the raw incoherent ray-query rate in the same scene (the
 //! scene's triangles, rays from random surface points, measured in the same run). Beside the
 //! defaults, the frame at 256² with the direct light of before the closed-form emitters and the
-//! sky through the records (`--emitters sampled --sky direct`; case suffix `_sampled_light`),
-//! with its direct rays and shade-phase time, so one run shows what they changed.
+//! sky through the records (`--emitters sampled --sky direct`; case suffix `_sampled_light`), and
+//! with adaptive anti-aliasing (suffix `_aa`; `_aa_12x36` with 12×36 strata on the courtyard),
+//! each with its direct rays, sub-frames and shade-phase time, so one run shows what they
+//! changed.
 
 /// A scene of the benchmark: name, glTF, reference, the presets timed at 256² and whether the
 /// default is also timed at 512².
@@ -49,11 +51,35 @@ use anyhow::Result;
 use radcache_cache::{IcParams, Preset};
 use radcache_image::{compare, read_exr, Image};
 use radcache_render::{
-    render_ic, render_path, Budget, EmitterLight, GpuScene, IcSettings, PathSettings, SkyLight,
+    render_ic, render_path, AntiAliasing, Budget, EmitterLight, GpuScene, IcSettings, PathSettings,
+    SkyLight,
 };
 use radcache_scene::{LoadOptions, Scene};
 
 use super::harness::{Bench, Figure};
+
+/// How a case differs from the preset with 8 sub-frames.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Variant {
+    Plain,
+    /// `--emitters sampled --sky direct`.
+    SampledLight,
+    /// Adaptive anti-aliasing with the preset's target.
+    Aa,
+    /// Adaptive anti-aliasing and 12×36 strata.
+    AaStrata12x36,
+}
+
+impl Variant {
+    fn suffix(self) -> &'static str {
+        match self {
+            Variant::Plain => "",
+            Variant::SampledLight => "_sampled_light",
+            Variant::Aa => "_aa",
+            Variant::AaStrata12x36 => "_aa_12x36",
+        }
+    }
+}
 
 pub fn run(args: &[&str]) -> Result<()> {
     let usage = "usage: cargo xtask bench ic [--scene cornell|courtyard]";
@@ -101,24 +127,41 @@ pub fn run(args: &[&str]) -> Result<()> {
     bench.warm_up_ic(&scene, &mut gpu, sampled_light)?;
     bench.warm_up_path(&scene, &mut gpu)?;
 
-    // (size, preset, sampled light): every preset at the reference's size, the default at 512²,
-    // and the default at 256² with the direct light sampled as before.
-    let mut cases: Vec<(u32, Preset, bool)> = bs.presets.iter().map(|&p| (256, p, false)).collect();
+    // (size, preset, variant): every preset at the reference's size with 8 sub-frames, the
+    // default at 512², the default at 256² with the direct light sampled as before, and with
+    // the CLI's adaptive anti-aliasing (AntiAliasing::preset; on the courtyard also with 12×36
+    // strata).
+    use Variant::*;
+    let mut cases: Vec<(u32, Preset, Variant)> =
+        bs.presets.iter().map(|&p| (256, p, Plain)).collect();
     if bs.at_512 {
-        cases.push((512, Preset::Default, false));
+        cases.push((512, Preset::Default, Plain));
     }
-    cases.push((256, Preset::Default, true));
+    cases.push((256, Preset::Default, SampledLight));
+    cases.push((256, Preset::Default, Aa));
+    if bs.name == "courtyard" {
+        cases.push((256, Preset::Default, AaStrata12x36));
+    }
     let mut matched = Vec::new(); // (case, relMSE, time) of the frames with a reference
-    for (size, preset, sampled) in cases {
+    for (size, preset, variant) in cases {
         let mut settings = IcSettings {
             width: size,
             height: size,
             params: IcParams::preset(preset),
             ..IcSettings::default()
         };
-        if sampled {
-            settings.emitters = EmitterLight::Sampled;
-            settings.sky = SkyLight::Direct;
+        match variant {
+            Plain => {}
+            SampledLight => {
+                settings.emitters = EmitterLight::Sampled;
+                settings.sky = SkyLight::Direct;
+            }
+            Aa => settings.anti_aliasing = Some(AntiAliasing::preset(preset)),
+            AaStrata12x36 => {
+                settings.anti_aliasing = Some(AntiAliasing::preset(preset));
+                settings.params.strata_m = 12;
+                settings.params.strata_n = 36;
+            }
         }
         let (out, stats) = render_ic(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
         let record_rays = stats.record_rays as f64;
@@ -130,9 +173,7 @@ pub fn run(args: &[&str]) -> Result<()> {
         } else {
             format!("{}_{size}_{name}", bs.name)
         };
-        if sampled {
-            case.push_str("_sampled_light");
-        }
+        case.push_str(variant.suffix());
         let direct_rays = out.rays.get("direct").copied().unwrap_or(0) as f64;
         let shade_s = stats.phases_s.get("shade").copied().unwrap_or(0.0);
         println!(
@@ -150,6 +191,13 @@ pub fn run(args: &[&str]) -> Result<()> {
             .collect();
         println!("  phases (wall s): {}", phases.join(", "));
         figures.push(Figure::new(&case, "ic_time_s", out.time_s, "s"));
+        let sub_frames = f64::from(stats.sub_frames_shaded);
+        figures.push(Figure::new(
+            &case,
+            "ic_sub_frames",
+            sub_frames,
+            "sub-frames",
+        ));
         figures.push(Figure::new(
             &case,
             "ic_records",

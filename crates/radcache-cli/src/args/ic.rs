@@ -144,22 +144,21 @@ fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T
 }
 
 impl IcArgs {
-    /// Adaptive anti-aliasing (docs/cache-frame.md §7.1), `None` with `--aa-target 0`. The
-    /// default targets are about each preset's own error on the Cornell box at 256² (relMSE
-    /// 3.4e-4 draft, 2.3e-4 default), so a scene whose error the cache dominates keeps its 8
-    /// sub-frames and one whose edges dominate (the courtyard) gets more.
+    /// Adaptive anti-aliasing (docs/cache-frame.md §7.1; defaults `AntiAliasing::preset`),
+    /// `None` with `--aa-target 0`.
     pub fn anti_aliasing(&self) -> Result<Option<AntiAliasing>> {
-        let target = self.aa_target.unwrap_or(match self.quality {
-            Quality::Draft => 2e-3,
-            Quality::Default => 5e-4,
-            Quality::High => 2e-4,
+        let preset = AntiAliasing::preset(match self.quality {
+            Quality::Draft => Preset::Draft,
+            Quality::Default => Preset::Default,
+            Quality::High => Preset::High,
         });
+        let target = self.aa_target.unwrap_or(preset.target);
         if !(target.is_finite() && target >= 0.0) {
             bail!(
                 "--aa-target {target}: expected a relMSE ≥ 0 (0 turns adaptive anti-aliasing off)"
             );
         }
-        let max_sub_frames = self.max_sub_frames.unwrap_or(64);
+        let max_sub_frames = self.max_sub_frames.unwrap_or(preset.max_sub_frames);
         if max_sub_frames == 0 {
             bail!("--max-sub-frames 0: expected at least 1");
         }
