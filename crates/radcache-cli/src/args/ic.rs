@@ -144,14 +144,19 @@ fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T
 }
 
 impl IcArgs {
-    /// Adaptive anti-aliasing (docs/cache-frame.md §7.1; defaults `AntiAliasing::preset`),
-    /// `None` with `--aa-target 0`.
-    pub fn anti_aliasing(&self) -> Result<Option<AntiAliasing>> {
-        let preset = AntiAliasing::preset(match self.quality {
+    /// The quality preset.
+    pub fn preset(&self) -> Preset {
+        match self.quality {
             Quality::Draft => Preset::Draft,
             Quality::Default => Preset::Default,
             Quality::High => Preset::High,
-        });
+        }
+    }
+
+    /// Adaptive anti-aliasing (docs/cache-frame.md §7.1; defaults `AntiAliasing::preset`),
+    /// `None` with `--aa-target 0`.
+    pub fn anti_aliasing(&self) -> Result<Option<AntiAliasing>> {
+        let preset = AntiAliasing::preset(self.preset());
         let target = self.aa_target.unwrap_or(preset.target);
         if !(target.is_finite() && target >= 0.0) {
             bail!(
@@ -203,11 +208,7 @@ impl IcArgs {
 
     /// The cache parameters: the preset with the overrides applied, checked.
     pub fn params(&self) -> Result<IcParams> {
-        let mut params = IcParams::preset(match self.quality {
-            Quality::Draft => Preset::Draft,
-            Quality::Default => Preset::Default,
-            Quality::High => Preset::High,
-        });
+        let mut params = IcParams::preset(self.preset());
         if let Some(w) = self.weight {
             params.weight_kind = match w {
                 Weight::Tl => WeightKind::TabellionLamorlette,
