@@ -67,6 +67,10 @@ pub struct FarmArgs {
     /// At most N tasks of the array at once (`--array=…%N`).
     #[arg(long, value_name = "N")]
     max_running: Option<u32>,
+    /// Runs again of a chunk's render that a signal killed (an abort, a segmentation fault, the
+    /// out-of-memory killer); the frames it wrote are kept. Errors are not retried.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    retries: u32,
     /// CPUs per task (`--cpus-per-task`).
     #[arg(long, value_name = "N")]
     cpus_per_task: Option<u32>,
@@ -309,6 +313,7 @@ pub fn run(args: &FarmArgs) -> Result<ExitCode> {
         cpus_per_task: args.cpus_per_task,
         prepass_every: prepass.filter(|_| !layout.cache_file().exists()),
         cache_in: prepass.is_some(),
+        retries: args.retries,
     };
     let total = layout.last - layout.first + 1;
     println!(

@@ -8,6 +8,17 @@
 //! radcache-farm: chunk 3 frames 49..72 started on node7 at 2026-12-01T21:00:00Z
 //! radcache-farm: chunk 3 frames 49..72 exit 0 seconds 61.4
 //! ```
+//!
+//! A render killed by a signal (exit status 128 + n: an abort, a segmentation fault, the
+//! kernel's out-of-memory killer) is run again, at most [`Jobs::retries`] times; each such
+//! attempt leaves a line before the end line, and the run again keeps the frames the killed one
+//! wrote (it renders the others, with their warm-up frames):
+//!
+//! ```text
+//! radcache-farm: chunk 3 frames 49..72 attempt 1 exit 134 (signal 6); running it again
+//! ```
+//!
+//! Other failures (exit 1: an error the render named) are not retried: they would fail again.
 
 use std::path::Path;
 
@@ -28,6 +39,8 @@ pub struct Jobs<'a> {
     pub prepass_every: Option<u32>,
     /// The chunks read the prepass's cache file.
     pub cache_in: bool,
+    /// Runs again of a chunk's render that a signal killed.
+    pub retries: u32,
 }
 
 /// `text` as one single-quoted shell word.
@@ -108,15 +121,22 @@ impl Jobs<'_> {
         text.push_str(&format!(
             "# Task i renders chunk i: frames FIRST + (i-1)*CHUNK .. (the chunk's last), after\n\
              # WARM_UP frames it does not write; frames already on disk are kept.\n\
-             FIRST={first} LAST={last} CHUNK={chunk} WARM_UP={warm}\n\
+             FIRST={first} LAST={last} CHUNK={chunk} WARM_UP={warm} RETRIES={retries}\n\
              task=${{SLURM_ARRAY_TASK_ID:?run this script as a Slurm array task}}\n\
              a=$((FIRST + (task - 1) * CHUNK))\n\
              b=$((a + CHUNK - 1))\n\
              if ((b > LAST)); then b=$LAST; fi\n\
              echo \"radcache-farm: chunk $task frames $a..$b started on $(hostname) at $(date -u +%FT%TZ)\"\n\
              start=$(date +%s.%N)\n\
-             {bin} render {scene} -o {pattern} --frames \"$a..$b\" --start-frame $FIRST --warm-up $WARM_UP{cache}{opts}\n\
-             rc=$?\n\
+             # A render killed by a signal runs again (frames it wrote are kept); errors do not.\n\
+             attempt=1\n\
+             while :; do\n\
+             \x20   {bin} render {scene} -o {pattern} --frames \"$a..$b\" --start-frame $FIRST --warm-up $WARM_UP{cache}{opts}\n\
+             \x20   rc=$?\n\
+             \x20   if ((rc < 128 || attempt > RETRIES)); then break; fi\n\
+             \x20   echo \"radcache-farm: chunk $task frames $a..$b attempt $attempt exit $rc (signal $((rc - 128))); running it again\"\n\
+             \x20   attempt=$((attempt + 1))\n\
+             done\n\
              seconds=$(awk -v s=\"$start\" -v e=\"$(date +%s.%N)\" 'BEGIN {{ printf \"%.1f\", e - s }}')\n\
              echo \"radcache-farm: chunk $task frames $a..$b exit $rc seconds $seconds\"\n\
              exit $rc\n",
@@ -124,6 +144,7 @@ impl Jobs<'_> {
             last = l.last,
             chunk = l.chunk,
             warm = self.warm_up,
+            retries = self.retries,
             bin = quote_path(self.binary),
             scene = quote_path(&l.scene),
             pattern = quote_path(&l.pattern),
@@ -172,5 +193,94 @@ mod tests {
         assert_eq!(quote("it's"), r"'it'\''s'");
         assert_eq!(quote(""), "''");
         assert_eq!(quote("a b"), "'a b'");
+    }
+
+    /// Runs chunk 1 of `chunks.sh` (without Slurm) with a fake `radcache` that runs `body`
+    /// (bash; `$count` is how many times it ran before) and `retries`; returns the exit status,
+    /// the task's output and how often the fake ran.
+    fn run_chunk(name: &str, body: &str, retries: u32) -> (i32, String, u32) {
+        let dir =
+            std::env::temp_dir().join(format!("radcache-script-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let fake = dir.join("radcache");
+        let counter = dir.join("count");
+        std::fs::write(
+            &fake,
+            format!(
+                "#!/bin/bash\nulimit -c 0\ncount=$(cat {c} 2>/dev/null || echo 0)\n\
+                 echo $((count + 1)) > {c}\n{body}\n",
+                c = quote_path(&counter)
+            ),
+        )
+        .unwrap();
+        std::process::Command::new("chmod")
+            .arg("+x")
+            .arg(&fake)
+            .status()
+            .unwrap();
+        let layout = Layout {
+            scene: dir.join("s.gltf"),
+            pattern: dir.join("f_####.exr"),
+            first: 1,
+            last: 4,
+            chunk: 2,
+            dir: dir.join(".farm"),
+        };
+        let jobs = Jobs {
+            layout: &layout,
+            binary: &fake,
+            render: &[],
+            warm_up: 0,
+            partition: None,
+            cpus_per_task: None,
+            prepass_every: None,
+            cache_in: false,
+            retries,
+        };
+        let script = dir.join("chunks.sh");
+        std::fs::write(&script, jobs.chunks()).unwrap();
+        // One stream, as Slurm's log file gets it.
+        let out = std::process::Command::new("bash")
+            .arg("-c")
+            .arg(format!("exec bash {} 2>&1", quote_path(&script)))
+            .env("SLURM_ARRAY_TASK_ID", "1")
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        let runs = std::fs::read_to_string(&counter)
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        (out.status.code().unwrap(), text, runs)
+    }
+
+    #[test]
+    fn a_render_killed_by_a_signal_runs_again_and_an_error_does_not() {
+        let abort_once = "echo 'frame 1: 0.5 s [1/2 done, 0 skipped] ETA 1 s'\n\
+                          if ((count == 0)); then echo 'heap corrupted' >&2; kill -ABRT $$; fi\n\
+                          echo 'frame 2: 0.5 s [1/2 done, 1 skipped] ETA 0 s'";
+        let (rc, text, runs) = run_chunk("once", abort_once, 1);
+        assert_eq!((rc, runs), (0, 2), "{text}");
+        assert!(
+            text.contains("radcache-farm: chunk 1 frames 1..2 attempt 1 exit 134 (signal 6); running it again"),
+            "{text}"
+        );
+        // The summary reads the attempt from the log (stderr lands there too under Slurm).
+        let run = super::super::summary::parse_log(&text, 1);
+        assert_eq!(run.end.map(|e| e.0), Some(0));
+        assert_eq!(run.killed.len(), 1, "{text}");
+        assert_eq!(run.killed[0].exit, 134);
+        assert_eq!(run.killed[0].after_frame, Some(1));
+        assert_eq!(run.killed[0].last_words.as_deref(), Some("heap corrupted"));
+
+        let (rc, text, runs) = run_chunk("always", "kill -SEGV $$", 2);
+        assert_eq!((rc, runs), (139, 3), "retries are bounded:\n{text}");
+        let (rc, text, runs) = run_chunk("error", "echo 'error: bad scene' >&2; exit 1", 3);
+        assert_eq!((rc, runs), (1, 1), "an error is not retried:\n{text}");
+        let (rc, _, runs) = run_chunk("none", "kill -ABRT $$", 0);
+        assert_eq!((rc, runs), (134, 1), "--retries 0 runs once");
     }
 }

@@ -24,6 +24,21 @@ pub struct ChunkRun {
     pub warm_up_s: f64,
     /// The last `error: …` line.
     pub error: Option<String>,
+    /// Attempts a signal killed before the last one (the script ran the render again): exit
+    /// status and what the render printed after its last progress line (its dying words).
+    pub killed: Vec<Killed>,
+    /// The dying words of the last attempt, where a signal killed it too.
+    pub crash: Option<String>,
+}
+
+/// An attempt of a chunk's render that a signal killed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Killed {
+    pub exit: i32,
+    /// The frame of the last progress line before it died.
+    pub after_frame: Option<u32>,
+    /// The first line the render printed after that (e.g. the C library's heap check).
+    pub last_words: Option<String>,
 }
 
 /// The last run of chunk `chunk` in its log's text (logs are appended across runs).
@@ -40,13 +55,32 @@ pub fn parse_log(text: &str, chunk: u32) -> ChunkRun {
         started: true,
         ..ChunkRun::default()
     };
+    // What the running attempt printed after its last progress line (its last words when a
+    // signal kills it).
+    let mut after_frame: Option<u32> = None;
+    let mut last_words: Option<String> = None;
+    let mut listening = true;
     for line in &lines[from + 1..] {
         if let Some(rest) = line.strip_prefix(&start) {
             let words: Vec<&str> = rest.split_whitespace().collect();
-            if let ["exit", rc, "seconds", s, ..] = words[1..] {
-                if let (Ok(rc), Ok(s)) = (rc.parse(), s.parse()) {
-                    run.end = Some((rc, s));
+            match words[1..] {
+                ["exit", rc, "seconds", s, ..] => {
+                    if let (Ok(rc), Ok(s)) = (rc.parse::<i32>(), s.parse()) {
+                        run.end = Some((rc, s));
+                        if rc >= 128 {
+                            run.crash = last_words.take();
+                        }
+                    }
                 }
+                ["attempt", _, "exit", rc, ..] => {
+                    run.killed.push(Killed {
+                        exit: rc.parse().unwrap_or(-1),
+                        after_frame: after_frame.take(),
+                        last_words: last_words.take(),
+                    });
+                    listening = true;
+                }
+                _ => {}
             }
         } else if let Some(rest) = line.trim_start().strip_prefix("warm-up: frames ") {
             let seconds = rest
@@ -55,11 +89,25 @@ pub fn parse_log(text: &str, chunk: u32) -> ChunkRun {
                 .and_then(|t| t.split_whitespace().next())
                 .and_then(|t| t.parse::<f64>().ok());
             run.warm_up_s += seconds.unwrap_or(0.0);
+        } else if let Some(n) = progress_frame(line) {
+            after_frame = Some(n);
+            last_words = None;
+            listening = true;
         } else if line.starts_with("error: ") {
             run.error = Some(line.to_string());
+        } else if listening && !line.trim().is_empty() {
+            last_words = Some(line.chars().take(160).collect());
+            listening = false;
         }
     }
     run
+}
+
+/// The frame of a render's progress line (`frame 17: 0.77 s [5/12 done, …`).
+fn progress_frame(line: &str) -> Option<u32> {
+    let rest = line.strip_prefix("frame ")?;
+    let (n, _) = rest.split_once(": ")?;
+    n.parse().ok()
 }
 
 /// Mean flicker of the pairs across chunk boundaries and of those inside chunks, with their
@@ -114,14 +162,43 @@ pub fn run(layout: &Layout) -> Result<ExitCode> {
         let (status, seconds) = match (run.started, run.end) {
             (false, _) => ("no log".to_string(), "-".to_string()),
             (true, None) => ("did not finish".to_string(), "-".to_string()),
-            (true, Some((0, s))) => ("ok".to_string(), format!("{s:.1}")),
-            (true, Some((rc, s))) => (format!("exit {rc}"), format!("{s:.1}")),
+            (true, Some((rc, s))) => {
+                let mut status = if rc == 0 {
+                    "ok".to_string()
+                } else {
+                    format!("exit {rc}")
+                };
+                if !run.killed.is_empty() {
+                    let exits: Vec<String> = run
+                        .killed
+                        .iter()
+                        .map(|k| format!("exit {}", k.exit))
+                        .collect();
+                    let _ = write!(status, " after {}", exits.join(", "));
+                }
+                (status, format!("{s:.1}"))
+            }
         };
         let _ = writeln!(
             text,
             "| {i} | {a}..{b} | {status} | {seconds} | {:.1} |",
             run.warm_up_s
         );
+        for (n, k) in run.killed.iter().enumerate() {
+            let after = k
+                .after_frame
+                .map_or(String::new(), |f| format!(" after frame {f}"));
+            let words = k.last_words.as_deref().unwrap_or("(nothing printed)");
+            errors.push(format!(
+                "chunk {i} ({}): attempt {} killed (exit {}){after}, run again: {words}",
+                log.display(),
+                n + 1,
+                k.exit
+            ));
+        }
+        if let Some(words) = &run.crash {
+            errors.push(format!("chunk {i} ({}): killed: {words}", log.display()));
+        }
         if let Some(e) = run.error {
             errors.push(format!("chunk {i} ({}): {e}", log.display()));
         }
@@ -193,6 +270,40 @@ mod tests {
         let killed = parse_log(&log[..log.find("error").unwrap() + 30], 2);
         assert!(killed.started && killed.end.is_none());
         assert_eq!(parse_log(log, 3), ChunkRun::default());
+    }
+
+    #[test]
+    fn killed_attempts_keep_their_last_words() {
+        let log = "radcache-farm: chunk 2 frames 13..24 started on a at t\n\
+                   warm-up: frames 1..12 (12) in 6.31 s, not written\n\
+                   frame 13: 0.60 s [1/12 done, 0 skipped] ETA 7 s\n\
+                   frame 17: 0.77 s [5/12 done, 0 skipped] ETA 5 s\n\
+                   malloc_consolidate(): unaligned fastbin chunk detected\n\
+                   /spool/slurm_script: line 16: 25738 Aborted /bin/radcache render\n\
+                   radcache-farm: chunk 2 frames 13..24 attempt 1 exit 134 (signal 6); running it again\n\
+                   warm-up: frames 6..17 (12) in 6.00 s, not written\n\
+                   frame 18: 0.60 s [1/12 done, 5 skipped] ETA 4 s\n\
+                   frame 24: 0.60 s [7/12 done, 5 skipped] ETA 0 s\n\
+                   7 frames rendered (0.60 s each), 5 skipped, 0 not rendered, 11.0 s in all\n\
+                   radcache-farm: chunk 2 frames 13..24 exit 0 seconds 30.0\n";
+        let run = parse_log(log, 2);
+        assert_eq!(run.end, Some((0, 30.0)));
+        assert!((run.warm_up_s - 12.31).abs() < 1e-9);
+        assert_eq!(
+            run.killed,
+            vec![Killed {
+                exit: 134,
+                after_frame: Some(17),
+                last_words: Some("malloc_consolidate(): unaligned fastbin chunk detected".into()),
+            }]
+        );
+        assert_eq!(run.crash, None);
+        let dead = "radcache-farm: chunk 1 frames 1..12 started on a at t\n\
+                    Segmentation fault\n\
+                    radcache-farm: chunk 1 frames 1..12 exit 139 seconds 1.0\n";
+        let run = parse_log(dead, 1);
+        assert_eq!(run.crash.as_deref(), Some("Segmentation fault"));
+        assert!(run.killed.is_empty());
     }
 
     #[test]
