@@ -16,7 +16,7 @@
 //! scene's triangles, rays from random surface points, measured in the same run). Beside the
 //! defaults, the frame at 256² with the direct light of before the closed-form emitters and the
 //! sky through the records (`--emitters sampled --sky direct`; case suffix `_sampled_light`), and
-//! with adaptive anti-aliasing (suffix `_aa`; `_aa_12x36` with 12×36 strata on the courtyard),
+//! with adaptive anti-aliasing (suffix `_aa`; `_aa_12x36` with 12×36 strata),
 //! each with its direct rays, sub-frames and shade-phase time, so one run shows what they
 //! changed.
 
@@ -129,8 +129,7 @@ pub fn run(args: &[&str]) -> Result<()> {
 
     // (size, preset, variant): every preset at the reference's size with 8 sub-frames, the
     // default at 512², the default at 256² with the direct light sampled as before, and with
-    // the CLI's adaptive anti-aliasing (AntiAliasing::preset; on the courtyard also with 12×36
-    // strata).
+    // the CLI's adaptive anti-aliasing (AntiAliasing::preset; also with 12×36 strata).
     use Variant::*;
     let mut cases: Vec<(u32, Preset, Variant)> =
         bs.presets.iter().map(|&p| (256, p, Plain)).collect();
@@ -139,9 +138,7 @@ pub fn run(args: &[&str]) -> Result<()> {
     }
     cases.push((256, Preset::Default, SampledLight));
     cases.push((256, Preset::Default, Aa));
-    if bs.name == "courtyard" {
-        cases.push((256, Preset::Default, AaStrata12x36));
-    }
+    cases.push((256, Preset::Default, AaStrata12x36));
     let mut matched = Vec::new(); // (case, relMSE, time) of the frames with a reference
     for (size, preset, variant) in cases {
         let mut settings = IcSettings {
