@@ -26,7 +26,7 @@ pub fn run(args: &[&str]) -> Result<()> {
         ["peer", rest @ ..] => peer::run(rest),
         _ => bail!(
             "usage: cargo xtask bench rays [--rays N] | pt [--spp N] | ic [--scene cornell|courtyard] \
-             | scaling [--preset draft|default|high] [--max-size N] \
+             | scaling [--scene cornell|courtyard] [--preset draft|default|high] [--max-size N] \
              | temporal [--frames N] [--size S] [--preset P] [--reference-frames K] \
              [--reference-spp SPP] \
              | peer [--scenes a,b,..] [--reference-spp N] [--height H] [--radcache-ref SCENE=FILE.exr]"

@@ -1,11 +1,14 @@
-//! `cargo xtask bench scaling [--preset draft|default|high] [--max-size N]`: how the cache's
-//! frame scales with resolution and with triangle count, on the Cornell box.
+//! `cargo xtask bench scaling [--scene cornell|courtyard] [--preset draft|default|high]
+//! [--max-size N]`: how the cache's frame scales with resolution and with triangle count, on the
+//! Cornell box; with `--scene courtyard`, how it scales from 256² to 1920×1080 on the
+//! Sponza-class courtyard (the default preset there, no triangle sweep), with the frame time per
+//! megapixel of each size and the ratio of the 1080p one to the 256² one.
 //!
 //! Both sweeps use the **draft** preset unless `--preset` says otherwise, so that the 1024² frame
 //! stays within a few minutes on lavapipe; the printed header names the preset in use.
 //!
-//! - Resolution: the cache at 128², 256², 512² and 1024² (sizes above `--max-size`, default
-//!   1024, are skipped): the frame's wall time (`FrameOutput::time_s`, pipeline creation
+//! - Resolution: the cache at 128², 256², 512² and 1024² (sizes whose larger side is above
+//!   `--max-size`, default 1920, are skipped): the frame's wall time (`FrameOutput::time_s`, pipeline creation
 //!   included), records, ray queries (all passes, and the record pass alone) and the wall time of
 //!   the frame's main phases (`IcStats::phases_s`).
 //! - Triangles: at 256² (or `--max-size` when smaller), the same scene with every triangle split
@@ -17,7 +20,8 @@
 //!   noise level is given by the untessellated scene rendered with another seed.
 //!
 //! Every figure goes to `bench/results.csv` (bench `scaling`): cases `cornell_res_<size>` and
-//! `cornell_tess_<k>x`, suffixed `_default` or `_high` when that preset was asked for.
+//! `cornell_tess_<k>x`, suffixed `_default` or `_high` when that preset was asked for (`_draft`
+//! or `_high` on the courtyard, whose cases are `courtyard_res_256` and `courtyard_res_1920x1080`).
 
 use std::time::Instant;
 
@@ -31,10 +35,13 @@ use radcache_vk::Context;
 use super::harness::{Bench, Figure};
 use super::tessellate::subdivide_scene;
 
-const USAGE: &str = "usage: cargo xtask bench scaling [--preset draft|default|high] [--max-size N]";
+const USAGE: &str = "usage: cargo xtask bench scaling [--scene cornell|courtyard] \
+                     [--preset draft|default|high] [--max-size N]";
 
-/// The resolutions of the first sweep.
-const SIZES: [u32; 4] = [128, 256, 512, 1024];
+/// The resolutions of the first sweep on the Cornell box.
+const SIZES: [(u32, u32); 4] = [(128, 128), (256, 256), (512, 512), (1024, 1024)];
+/// The resolutions of the sweep on the courtyard: the benchmarks' 256² and full HD.
+const COURTYARD_SIZES: [(u32, u32); 2] = [(256, 256), (1920, 1080)];
 /// The subdivision levels of the second sweep (n² triangles per triangle).
 const LEVELS: [u32; 5] = [1, 2, 4, 8, 10];
 /// The size of the second sweep (smaller when `--max-size` is).
@@ -54,14 +61,16 @@ const PHASES: [(&str, &str, &str); 8] = [
 ];
 
 struct Options {
-    preset: Preset,
+    courtyard: bool,
+    preset: Option<Preset>,
     max_size: u32,
 }
 
 fn parse(args: &[&str]) -> Result<Options> {
     let mut o = Options {
-        preset: Preset::Draft,
-        max_size: 1024,
+        courtyard: false,
+        preset: None,
+        max_size: 1920,
     };
     let mut it = args.iter();
     while let Some(&arg) = it.next() {
@@ -71,13 +80,20 @@ fn parse(args: &[&str]) -> Result<Options> {
                 .with_context(|| format!("{arg}: no value\n{USAGE}"))
         };
         match arg {
+            "--scene" => {
+                o.courtyard = match value()? {
+                    "cornell" => false,
+                    "courtyard" => true,
+                    other => bail!("unknown scene {other:?}\n{USAGE}"),
+                }
+            }
             "--preset" => {
-                o.preset = match value()? {
+                o.preset = Some(match value()? {
                     "draft" => Preset::Draft,
                     "default" => Preset::Default,
                     "high" => Preset::High,
                     other => bail!("unknown preset {other:?}\n{USAGE}"),
-                }
+                })
             }
             "--max-size" => {
                 let v = value()?;
@@ -100,10 +116,10 @@ fn preset_name(p: Preset) -> &'static str {
     }
 }
 
-fn settings(size: u32, preset: Preset, seed: u32) -> IcSettings {
+fn settings((width, height): (u32, u32), preset: Preset, seed: u32) -> IcSettings {
     IcSettings {
-        width: size,
-        height: size,
+        width,
+        height,
         params: IcParams::preset(preset),
         seed,
         ..IcSettings::default()
@@ -139,80 +155,81 @@ fn upload(ctx: &Context, scene: &Scene) -> Result<(GpuScene, f64, f64)> {
     ))
 }
 
-pub fn run(args: &[&str]) -> Result<()> {
-    let opts = parse(args)?;
-    let (preset, pname) = (opts.preset, preset_name(opts.preset));
-    let suffix = match preset {
-        Preset::Draft => String::new(),
-        _ => format!("_{pname}"),
-    };
-    let root = crate::root();
-    let (scene, _) = Scene::load(
-        &root.join("assets/cornell/cornell.gltf"),
-        &LoadOptions::default(),
-    )?;
-    let bench = Bench::new("scaling")?;
+/// The name of a size in case names and tables: `256` for 256², else `1920x1080`.
+fn size_name((w, h): (u32, u32)) -> String {
+    if w == h {
+        w.to_string()
+    } else {
+        format!("{w}x{h}")
+    }
+}
+
+/// The resolution sweep: one frame per size on `gpu`, a table row and its figures (the case of
+/// each size named by `case`), with the frame time per megapixel; returns those times.
+fn resolution_sweep(
+    bench: &Bench,
+    scene: &Scene,
+    gpu: &mut GpuScene,
+    sizes: &[(u32, u32)],
+    preset: Preset,
+    case: &dyn Fn((u32, u32)) -> String,
+    figures: &mut Vec<Figure>,
+) -> Result<Vec<f64>> {
     let (ctx, shaders) = (bench.ctx(), bench.shaders());
-    let mut figures = Vec::new();
-
-    // Warm-up (shader compilation is not part of the figures), on an upload of its own.
-    bench.warm_up_ic(
-        &scene,
-        &mut upload(ctx, &scene)?.0,
-        settings(16, Preset::Draft, 0),
-    )?;
-
-    // 1. Resolution.
-    println!(
-        "device: {}; Cornell box, {} triangles; preset `{pname}`{}",
-        bench.device(),
-        scene.instanced_triangle_count(),
-        if preset == Preset::Draft {
-            " (the default here, so that 1024² stays within minutes on lavapipe)"
-        } else {
-            ""
-        }
-    );
     println!("\nresolution sweep (frame and phases: wall time, s)");
     let head: Vec<String> = PHASES[..5].iter().map(|p| format!("{:>9}", p.2)).collect();
     println!(
-        "{:>9} {:>8} {:>8} {:>9} {:>9} {} {:>9}",
+        "{:>9} {:>8} {:>8} {:>8} {:>9} {:>9} {} {:>9}",
         "size",
         "frame",
+        "s/MP",
         "records",
         "Mrays",
         "rec Mrays",
         head.join(" "),
         "other"
     );
-    let mut gpu = upload(ctx, &scene)?.0;
-    for size in SIZES.into_iter().filter(|&s| s <= opts.max_size) {
+    let mut per_mp = Vec::new();
+    for &size in sizes {
         let (out, stats) = render_ic(
             ctx,
             shaders,
-            &scene,
-            &mut gpu,
+            scene,
+            gpu,
             &settings(size, preset, 0),
             &mut |_| {},
         )?;
         let rays = total_rays(&out);
+        let s_per_mp = out.time_s / (f64::from(size.0) * f64::from(size.1) / 1e6);
+        per_mp.push(s_per_mp);
         let shown: Vec<String> = PHASES[..5]
             .iter()
             .map(|p| format!("{:>9.3}", phase(&stats, p.0)))
             .collect();
         let other: f64 = PHASES[5..].iter().map(|p| phase(&stats, p.0)).sum();
         println!(
-            "{:>9} {:>8.2} {:>8} {:>9.2} {:>9.2} {} {:>9.3}",
-            format!("{size}²"),
+            "{:>9} {:>8.2} {:>8.1} {:>8} {:>9.2} {:>9.2} {} {:>9.3}",
+            if size.0 == size.1 {
+                format!("{}²", size.0)
+            } else {
+                size_name(size)
+            },
             out.time_s,
+            s_per_mp,
             stats.records,
             rays as f64 / 1e6,
             stats.record_rays as f64 / 1e6,
             shown.join(" "),
             other
         );
-        let case = format!("cornell_res_{size}{suffix}");
+        let case = case(size);
         figures.push(Figure::new(&case, "frame_s", out.time_s, "s"));
+        figures.push(Figure::new(
+            &case,
+            "frame_s_per_megapixel",
+            s_per_mp,
+            "s/MP",
+        ));
         figures.push(Figure::new(
             &case,
             "records",
@@ -230,7 +247,90 @@ pub fn run(args: &[&str]) -> Result<()> {
             figures.push(Figure::new(&case, metric, phase(&stats, key), "s"));
         }
     }
+    Ok(per_mp)
+}
+
+pub fn run(args: &[&str]) -> Result<()> {
+    let opts = parse(args)?;
+    let (name, gltf, default_preset) = if opts.courtyard {
+        (
+            "courtyard",
+            "assets/courtyard/courtyard.gltf",
+            Preset::Default,
+        )
+    } else {
+        ("cornell", "assets/cornell/cornell.gltf", Preset::Draft)
+    };
+    let preset = opts.preset.unwrap_or(default_preset);
+    let pname = preset_name(preset);
+    let suffix = if preset == default_preset {
+        String::new()
+    } else {
+        format!("_{pname}")
+    };
+    let root = crate::root();
+    let (scene, _) = Scene::load(&root.join(gltf), &LoadOptions::default())?;
+    let bench = Bench::new("scaling")?;
+    let (ctx, shaders) = (bench.ctx(), bench.shaders());
+    let mut figures = Vec::new();
+
+    // Warm-up (shader compilation is not part of the figures), on an upload of its own.
+    bench.warm_up_ic(
+        &scene,
+        &mut upload(ctx, &scene)?.0,
+        settings((16, 16), preset, 0),
+    )?;
+
+    // 1. Resolution.
+    println!(
+        "device: {}; {name}, {} triangles; preset `{pname}`{}",
+        bench.device(),
+        scene.instanced_triangle_count(),
+        if preset == Preset::Draft && !opts.courtyard {
+            " (the default here, so that 1024² stays within minutes on lavapipe)"
+        } else {
+            ""
+        }
+    );
+    let max = opts.max_size;
+    let sizes: Vec<(u32, u32)> = if opts.courtyard {
+        &COURTYARD_SIZES[..]
+    } else {
+        &SIZES[..]
+    }
+    .iter()
+    .copied()
+    .filter(|&(w, h)| w.max(h) <= max)
+    .collect();
+    let case = |size| format!("{name}_res_{}{suffix}", size_name(size));
+    let mut gpu = upload(ctx, &scene)?.0;
+    let per_mp = resolution_sweep(
+        &bench,
+        &scene,
+        &mut gpu,
+        &sizes,
+        preset,
+        &case,
+        &mut figures,
+    )?;
     drop(gpu);
+    if opts.courtyard {
+        if let [(first, a), .., (last, b)] = sizes.iter().zip(&per_mp).collect::<Vec<_>>()[..] {
+            let ratio = b / a;
+            println!(
+                "frame time per megapixel at {} ÷ at {}: {ratio:.2}",
+                size_name(*last),
+                size_name(*first)
+            );
+            figures.push(Figure::new(
+                case(*last),
+                "per_megapixel_vs_256",
+                ratio,
+                "ratio",
+            ));
+        }
+        return bench.finish(&figures);
+    }
 
     // 2. Triangles.
     let size = TESS_SIZE.min(opts.max_size);
@@ -256,7 +356,7 @@ pub fn run(args: &[&str]) -> Result<()> {
             shaders,
             &tess,
             &mut gpu,
-            &settings(size, preset, 0),
+            &settings((size, size), preset, 0),
             &mut |_| {},
         )?;
         let (time_s, rays) = (out.time_s, total_rays(&out));
@@ -271,7 +371,7 @@ pub fn run(args: &[&str]) -> Result<()> {
                     shaders,
                     &tess,
                     &mut gpu,
-                    &settings(size, preset, 1),
+                    &settings((size, size), preset, 1),
                     &mut |_| {},
                 )?;
                 let noise = compare(&img, &image(other)?)?.relmse;
