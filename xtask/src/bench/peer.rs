@@ -9,8 +9,9 @@
 //! 2. the reference: Mitsuba at `--reference-spp` (default 8192) samples per pixel, cached as an
 //!    EXR beside the export (keyed by the export's hash, which covers resolution and camera, and
 //!    the spp), so a second run reuses it (or any cached one with more samples);
-//! 3. radcache renders the frame with `--method ic` at the default preset in-process after a
-//!    warm-up frame, as `bench ic` does: its wall time is T;
+//! 3. radcache renders the frame with `--method ic` at the default preset, with the CLI's
+//!    default adaptive anti-aliasing (`AntiAliasing::preset`), in-process after a warm-up frame,
+//!    as `bench ic` does: its wall time is T;
 //! 4. Mitsuba renders for the same T: a discarded warm-up pass compiles its kernels (not in the
 //!    figure), the first timed pass gives the time per pass and the number of passes that fits T;
 //!    both achieved times are recorded;
@@ -30,7 +31,7 @@ mod mitsuba;
 use anyhow::{Context as _, Result};
 use radcache_cache::{IcParams, Preset};
 use radcache_image::{compare, read_exr, write_exr, ExrOptions, Image, Metadata, Metrics};
-use radcache_render::{render_ic, GpuScene, IcSettings};
+use radcache_render::{render_ic, AntiAliasing, GpuScene, IcSettings};
 use radcache_scene::{LoadOptions, Scene};
 
 use super::harness::{Bench, Figure};
@@ -174,19 +175,30 @@ fn one_scene(
         figures.push(Figure::new(&case, "validation_relmse", m.relmse, "relMSE"));
     }
 
-    // radcache: default preset, in-process, warm.
+    // radcache: default preset with the CLI's adaptive anti-aliasing, in-process, warm.
     let (ctx, shaders) = (bench.ctx(), bench.shaders());
     let mut gpu = GpuScene::new(ctx, &scene, None)?;
     let settings = IcSettings {
         width,
         height,
         params: IcParams::preset(Preset::Default),
+        anti_aliasing: Some(AntiAliasing::preset(Preset::Default)),
         time: t,
         ..IcSettings::default()
     };
     bench.warm_up_ic(&scene, &mut gpu, settings.clone())?;
-    let (out, _) = render_ic(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
+    let (out, stats) = render_ic(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
     drop(gpu);
+    println!(
+        "  radcache: {} sub-frames shaded (adaptive anti-aliasing)",
+        stats.sub_frames_shaded
+    );
+    figures.push(Figure::new(
+        &case,
+        "radcache_sub_frames",
+        f64::from(stats.sub_frames_shaded),
+        "sub-frames",
+    ));
     let rc_image = Image::from_pixels(out.width, out.height, out.pixels)?;
     let big_t = out.time_s;
 
