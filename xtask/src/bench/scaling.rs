@@ -4,12 +4,13 @@
 //! Sponza-class courtyard (the default preset there, no triangle sweep), with the frame time per
 //! megapixel of each size and the ratio of the 1080p one to the 256² one.
 //!
-//! Both sweeps use the **draft** preset unless `--preset` says otherwise, so that the 1024² frame
-//! stays within a few minutes on lavapipe; the printed header names the preset in use.
+//! On the Cornell box both sweeps use the **draft** preset unless `--preset` says otherwise, so
+//! that the 1024² frame stays within a few minutes on lavapipe; the printed header names the
+//! preset in use.
 //!
 //! - Resolution: the cache at 128², 256², 512² and 1024² (sizes whose larger side is above
-//!   `--max-size`, default 1920, are skipped): the frame's wall time (`FrameOutput::time_s`, pipeline creation
-//!   included), records, ray queries (all passes, and the record pass alone) and the wall time of
+//!   `--max-size`, default 1920, are skipped): the frame's wall time (`FrameOutput::time_s`,
+//!   pipeline creation included), records, ray queries (all passes, and the record pass alone) and the wall time of
 //!   the frame's main phases (`IcStats::phases_s`).
 //! - Triangles: at 256² (or `--max-size` when smaller), the same scene with every triangle split
 //!   into n² congruent sub-triangles (`tessellate.rs`), n = 1, 2, 4, 8, 10: 1× to 100× the
@@ -315,7 +316,8 @@ pub fn run(args: &[&str]) -> Result<()> {
     )?;
     drop(gpu);
     if opts.courtyard {
-        if let [(first, a), .., (last, b)] = sizes.iter().zip(&per_mp).collect::<Vec<_>>()[..] {
+        // The last size (full HD) against the first (256²), when both were rendered.
+        if let ([first, .., last], [a, .., b]) = (&sizes[..], &per_mp[..]) {
             let ratio = b / a;
             println!(
                 "frame time per megapixel at {} ÷ at {}: {ratio:.2}",
