@@ -8,6 +8,10 @@
 // A non-finite value is dropped and counted. With IC_AA_MOMENTS (adaptive anti-aliasing,
 // docs/cache-frame.md §7.1) the squares of the sub-frame's radiance go to a second accumulator, from
 // which the host estimates the sampling error of the mean (radcache_render::frame::aa).
+// Splatting once per frame (pc.centre, docs/cache-frame.md §6.5): the sub-frame at the pixel
+// centres stores each pixel's centre point and normal (pc.centre = 1); every later sub-frame
+// (pc.centre = 2) interpolates its sample's cached light between the centres around it that
+// match it (`cached_light_from_centres`), and counts the samples no centre matches.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -19,11 +23,15 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = B_COMPOSITE_SPLAT_SUM, rgba32f) readonly uniform image2D splat_sum;
 layout(binding = B_COMPOSITE_ACCUM, std430) buffer Accum { vec4 accum[]; };
-layout(binding = B_COMPOSITE_NONFINITE, std430) buffer Bad { uint nonfinite; };
+layout(binding = B_COMPOSITE_NONFINITE, std430) buffer Bad { uint nonfinite; uint unmatched; };
 layout(binding = B_COMPOSITE_EMISSION_ACCUM, std430) buffer EmissionAccum { vec4 emission_accum[]; };
 // Debug AOVs, two vec4 per pixel: indirect radiance (rgb) and Σw (a); records per pixel (x).
 layout(binding = B_COMPOSITE_DEBUG_ACCUM, std430) buffer DebugAccum { vec4 debug_accum[]; };
 layout(binding = B_COMPOSITE_SPLAT_COUNT, r32f) readonly uniform image2D splat_count;
+
+// Per pixel: the centre sample's position (xyz; w = 1 on a surface) and normal (xyz; w = its
+// footprint), written with pc.centre = 1 and read with pc.centre = 2.
+layout(binding = B_COMPOSITE_CENTRE, std430) buffer Centre { vec4 centre[]; };
 
 #ifdef IC_AA_MOMENTS
 layout(binding = B_COMPOSITE_ACCUM_SQ, std430) buffer AccumSq { vec4 accum_sq[]; };
@@ -36,6 +44,116 @@ layout(push_constant) uniform Push { CompositePush pc; };
 layout(binding = B_COMPOSITE_GLOSSY_SUM, rgba32f) readonly uniform image2D glossy_sum;
 #endif
 
+// How far a pixel centre (position c, normal n) is from the sample g as a stand-in for its
+// cached light, in footprints: the distance off the centre's tangent plane, the normals'
+// disagreement (4 per unit of 1 − cos) and a quarter of the distance along the plane. A centre
+// matches when it is within CENTRE_MATCH_PLANE footprints of the plane and its normal within
+// acos(CENTRE_MATCH_COS) of the sample's (docs/cache-frame.md §6.5).
+const float CENTRE_MATCH_PLANE = 1.0;
+const float CENTRE_MATCH_COS = 0.9;
+
+float centre_cost(GSample g, vec3 c, vec3 n, out bool matches) {
+    vec3 d = g.position - c;
+    float f = max(g.footprint, 1.0e-30);
+    float plane = abs(dot(n, d));
+    float along = length(d - n * dot(n, d));
+    float cosine = dot(n, g.normal);
+    matches = plane <= CENTRE_MATCH_PLANE * f && cosine >= CENTRE_MATCH_COS;
+    return plane / f + 4.0 * (1.0 - cosine) + 0.25 * along / f;
+}
+
+// The cached light of one pixel's splat targets.
+struct CachedLight {
+    vec3 irradiance;  // Σw·Ẽ / Σw (0 where Σw = 0)
+    vec3 glossy;      // the glossy splat's rgb / a, at least 0 (0 where it did not reach)
+    float weight;     // Σw
+    float count;      // records reaching the pixel (read for the debug AOVs only)
+};
+
+CachedLight cached_light_at(ivec2 q) {
+    CachedLight c;
+    vec4 s = imageLoad(splat_sum, q);
+    c.irradiance = s.a > 0.0 ? s.rgb / s.a : vec3(0.0);
+    c.weight = s.a;
+    c.count = pc.debug != 0u ? imageLoad(splat_count, q).r : 0.0;
+    c.glossy = vec3(0.0);
+#ifdef HAS_RADIANCE_CACHE
+    if (pc.glossy != 0u) {
+        vec4 gs = imageLoad(glossy_sum, q);
+        if (gs.a > 0.0) {
+            // Clamped at 0 as a truncated SH product can dip below it.
+            c.glossy = max(gs.rgb / gs.a, vec3(0.0));
+        }
+    }
+#endif
+    return c;
+}
+
+// Does the centre of pixel q match the sample g (and how far is it, `cost`)? False off the
+// image and where the centre is not a surface.
+bool centre_of(GSample g, ivec2 q, out float cost) {
+    cost = 1.0e30;
+    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(frame.resolution.xy)))) {
+        return false;
+    }
+    uint i = uint(q.y) * frame.resolution.x + uint(q.x);
+    vec4 c = centre[2u * i];
+    if (c.w < 0.5) {
+        return false;
+    }
+    bool ok;
+    cost = centre_cost(g, c.xyz, centre[2u * i + 1u].xyz, ok);
+    return ok;
+}
+
+// The cached light of the sample g of `pixel` at `jitter` (pixels from its centre) from the
+// splat made at the centres: interpolated bilinearly at the sample's position between the four
+// nearest centres that match it and hold light (joint bilateral upsampling); where none does,
+// that of the closest centre of the 3×3 neighbourhood (`matched` false), or none where no
+// centre there is a surface.
+CachedLight cached_light_from_centres(GSample g, ivec2 pixel, vec2 jitter, out bool matched) {
+    vec2 pos = vec2(pixel) + jitter;
+    ivec2 base = ivec2(floor(pos));
+    vec2 f = pos - vec2(base);
+    CachedLight sum = CachedLight(vec3(0.0), vec3(0.0), 0.0, 0.0);
+    float total = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        ivec2 o = ivec2(k & 1, k >> 1);
+        float b = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
+        float cost;
+        if (b <= 0.0 || !centre_of(g, base + o, cost)) {
+            continue;
+        }
+        CachedLight c = cached_light_at(base + o);
+        if (!(c.weight > 0.0)) {
+            continue;
+        }
+        sum.irradiance += b * c.irradiance;
+        sum.glossy += b * c.glossy;
+        sum.weight += b * c.weight;
+        sum.count += b * c.count;
+        total += b;
+    }
+    matched = total > 0.0;
+    if (matched) {
+        float inv = 1.0 / total;
+        return CachedLight(sum.irradiance * inv, sum.glossy * inv, sum.weight * inv,
+                           sum.count * inv);
+    }
+    ivec2 best = ivec2(-1);
+    float best_cost = 1.0e30;
+    for (int k = 0; k < 9; ++k) {
+        ivec2 q = pixel + ivec2(k % 3 - 1, k / 3 - 1);
+        float cost;
+        centre_of(g, q, cost);
+        if (cost < best_cost) {
+            best_cost = cost;
+            best = q;
+        }
+    }
+    return best.x >= 0 ? cached_light_at(best) : sum;
+}
+
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(pixel, ivec2(frame.resolution.xy)))) {
@@ -45,9 +163,24 @@ void main() {
     GSample g = gbuffer_load(pixel);
     vec3 l;
     vec3 emitted = vec3(0.0);
+    if (pc.centre == 1u) {
+        centre[2u * index] = vec4(g.position, g.surface ? 1.0 : 0.0);
+        centre[2u * index + 1u] = vec4(g.normal, g.footprint);
+    }
     if (g.surface) {
-        vec4 s = imageLoad(splat_sum, pixel);
-        vec3 e = s.a > 0.0 ? s.rgb / s.a : vec3(0.0);
+        // The cached light of this sample: its pixel's splat, or with pc.centre = 2 that made
+        // at the centres around it (none matching: counted).
+        CachedLight c;
+        if (pc.centre == 2u) {
+            bool matched;
+            c = cached_light_from_centres(g, pixel, pc.jitter, matched);
+            if (!matched) {
+                atomicAdd(unmatched, 1u);
+            }
+        } else {
+            c = cached_light_at(pixel);
+        }
+        vec3 e = c.irradiance;
 #ifdef HAS_SPECULAR
         // The cached irradiance lights the diffuse lobe alone, weighted by its share for this
         // view direction (docs/materials.md §6); the direct pass adds the specular lobe's light.
@@ -57,22 +190,14 @@ void main() {
 #else
         vec3 indirect = g.albedo * INV_PI * e;
 #endif
-#ifdef HAS_RADIANCE_CACHE
         // The specular lobe's indirect light from the radiance records, where the glossy splat
-        // reached the pixel (its lobe rough enough: docs/radiance-caching.md §6.2); clamped at 0
-        // as a truncated SH product can dip below it.
-        if (pc.glossy != 0u) {
-            vec4 gs = imageLoad(glossy_sum, pixel);
-            if (gs.a > 0.0) {
-                indirect += max(gs.rgb / gs.a, vec3(0.0));
-            }
-        }
-#endif
+        // reached (its lobe rough enough: docs/radiance-caching.md §6.2; 0 without pc.glossy).
+        indirect += c.glossy;
         l = imageLoad(g_direct, pixel).rgb + indirect;
         emitted = g.emission;
         if (pc.debug != 0u && !any(isnan(indirect)) && !any(isinf(indirect))) {
-            debug_accum[2u * index] += vec4(indirect, s.a);
-            debug_accum[2u * index + 1u].x += imageLoad(splat_count, pixel).r;
+            debug_accum[2u * index] += vec4(indirect, c.weight);
+            debug_accum[2u * index + 1u].x += c.count;
         }
     } else {
         Ray r = camera_ray(uvec2(pixel), vec2(0.5) + pc.jitter);

@@ -6,7 +6,9 @@ struct CompositePush {
     vec2 jitter;
     uint debug;
     uint glossy;
-};  // 16 bytes
+    uint centre;
+    uint pad0;
+};  // 24 bytes
 
 struct DirectPush {
     uint samples;

@@ -4,7 +4,7 @@
 //! another frame seed it draws other samples (the comparison can fail) and stays within noise.
 
 use radcache_cache::IcParams;
-use radcache_render::{GBuffer, GpuScene, IcRenderer, IcSettings, RecordPass};
+use radcache_render::{GBuffer, GpuScene, IcRenderer, IcSettings, RecordPass, SplatMode};
 use radcache_shared::gpu::{DispatchArgs, GpuRecord, IcCounters};
 use radcache_tests::scenes::load;
 use radcache_tests::{context, finish, shaders};
@@ -73,6 +73,8 @@ fn a_refreshed_record_reproduces_its_value() {
         sub_frames: 2,
         direct_samples: 2,
         seed: SEED,
+        // Holes filled at both sub-frames' jitters, so that records carry either seed.
+        splat: SplatMode::PerSubFrame,
         ..IcSettings::default()
     };
     let mut r = IcRenderer::new(&ctx, &shaders, &gpu, &settings).unwrap();

@@ -180,6 +180,7 @@ pub fn ic_settings(ic: &IcArgs, size: (u32, u32), seed: u32) -> Result<IcSetting
         glossy_spacing: ic.glossy_spacing(),
         emitters: ic.emitter_light(),
         anti_aliasing: ic.anti_aliasing()?,
+        splat: ic.splat_mode(),
         seed,
         ..defaults
     })
@@ -297,6 +298,8 @@ pub fn stats_entry(r: &Rendered, frame: u32, time: f32) -> Value {
         entry["records_created"] = json!(ic.records_per_level.iter().sum::<u64>());
         entry["records_per_level"] = json!(ic.records_per_level);
         entry["holes_left"] = json!(ic.holes_left);
+        entry["unmatched_samples"] = json!(ic.unmatched_samples);
+        entry["sub_frames_shaded"] = json!(ic.sub_frames_shaded);
         entry["dropped_requests"] = json!(ic.dropped_requests);
         entry["rejected_records"] = json!(ic.rejected_records);
         entry["phases_wall_s"] = json!(ic.phases_s);

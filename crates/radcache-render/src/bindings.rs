@@ -207,6 +207,9 @@ pass_bindings! {
         /// Σ radiance² (rgb) per pixel (`vec4[]`, written with `IC_AA_MOMENTS`: adaptive
         /// anti-aliasing).
         ACCUM_SQ: StorageBuffer,
+        /// Each pixel's centre sample (`vec4[2 per pixel]`: position, normal and footprint),
+        /// for splatting once per frame (docs/cache-frame.md §6.5).
+        CENTRE: StorageBuffer,
     }
 }
 

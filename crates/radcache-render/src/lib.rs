@@ -26,10 +26,10 @@ pub use frame::ic::{render_ic, IcRenderer};
 pub use frame::path::{render_path, Budget, FrameOutput, PathSettings, Progress};
 pub use frame::settings::{
     sub_frame_jitter, AntiAliasing, EmitterLight, GlossyLight, GlossySpacing, IcDebug, IcSettings,
-    IcStats, SkyLight,
+    IcStats, SkyLight, SplatMode,
 };
 pub use passes::aov::{render_aovs, AovPass, Aovs};
-pub use passes::composite::CompositePass;
+pub use passes::composite::{CentreSamples, CompositePass};
 pub use passes::direct::DirectPass;
 pub use passes::emission::EmissionPass;
 pub use passes::gbuffer::{GBuffer, GBufferPass, DEPTH_FORMAT, GBUFFER_BINDINGS, GBUFFER_FORMAT};

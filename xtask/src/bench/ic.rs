@@ -16,9 +16,10 @@
 //! scene's triangles, rays from random surface points, measured in the same run). Beside the
 //! defaults, the frame at 256² with the direct light of before the closed-form emitters and the
 //! sky through the records (`--emitters sampled --sky direct`; case suffix `_sampled_light`), and
-//! with adaptive anti-aliasing (suffix `_aa`; `_aa_12x36` with 12×36 strata),
-//! each with its direct rays, sub-frames and shade-phase time, so one run shows what they
-//! changed.
+//! with adaptive anti-aliasing (suffix `_aa`; `_aa_12x36` with 12×36 strata), and splatting at
+//! every sub-frame instead of once per frame (suffixes `_splat_per_sub_frame` and
+//! `_aa_splat_per_sub_frame`), each with its direct rays, sub-frames and shade-phase time, so
+//! one run shows what they changed.
 
 /// A scene of the benchmark: name, glTF, reference, the presets timed at 256² and whether the
 /// default is also timed at 512².
@@ -52,7 +53,7 @@ use radcache_cache::{IcParams, Preset};
 use radcache_image::{compare, read_exr, Image};
 use radcache_render::{
     render_ic, render_path, AntiAliasing, Budget, EmitterLight, GpuScene, IcSettings, PathSettings,
-    SkyLight,
+    SkyLight, SplatMode,
 };
 use radcache_scene::{LoadOptions, Scene};
 
@@ -68,6 +69,10 @@ enum Variant {
     Aa,
     /// Adaptive anti-aliasing and 12×36 strata.
     AaStrata12x36,
+    /// A splat at every sub-frame (`--splat per-sub-frame`).
+    SplatPerSubFrame,
+    /// Adaptive anti-aliasing and a splat at every sub-frame.
+    AaSplatPerSubFrame,
 }
 
 impl Variant {
@@ -77,6 +82,8 @@ impl Variant {
             Variant::SampledLight => "_sampled_light",
             Variant::Aa => "_aa",
             Variant::AaStrata12x36 => "_aa_12x36",
+            Variant::SplatPerSubFrame => "_splat_per_sub_frame",
+            Variant::AaSplatPerSubFrame => "_aa_splat_per_sub_frame",
         }
     }
 }
@@ -139,6 +146,8 @@ pub fn run(args: &[&str]) -> Result<()> {
     cases.push((256, Preset::Default, SampledLight));
     cases.push((256, Preset::Default, Aa));
     cases.push((256, Preset::Default, AaStrata12x36));
+    cases.push((256, Preset::Default, SplatPerSubFrame));
+    cases.push((256, Preset::Default, AaSplatPerSubFrame));
     let mut matched = Vec::new(); // (case, relMSE, time) of the frames with a reference
     for (size, preset, variant) in cases {
         let mut settings = IcSettings {
@@ -158,6 +167,11 @@ pub fn run(args: &[&str]) -> Result<()> {
                 settings.anti_aliasing = Some(AntiAliasing::preset(preset));
                 settings.params.strata_m = 12;
                 settings.params.strata_n = 36;
+            }
+            SplatPerSubFrame => settings.splat = SplatMode::PerSubFrame,
+            AaSplatPerSubFrame => {
+                settings.anti_aliasing = Some(AntiAliasing::preset(preset));
+                settings.splat = SplatMode::PerSubFrame;
             }
         }
         let (out, stats) = render_ic(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
@@ -194,6 +208,12 @@ pub fn run(args: &[&str]) -> Result<()> {
             "ic_sub_frames",
             sub_frames,
             "sub-frames",
+        ));
+        figures.push(Figure::new(
+            &case,
+            "ic_unmatched_samples",
+            stats.unmatched_samples as f64,
+            "samples",
         ));
         figures.push(Figure::new(
             &case,

@@ -4,7 +4,9 @@
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 use radcache_cache::{ErrorControl, IcParams, Preset, WeightKind};
-use radcache_render::{AntiAliasing, EmitterLight, GlossyLight, GlossySpacing, SkyLight};
+use radcache_render::{
+    AntiAliasing, EmitterLight, GlossyLight, GlossySpacing, SkyLight, SplatMode,
+};
 
 /// Cache quality preset.
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -69,6 +71,16 @@ pub enum GlossySpacingArg {
     Irradiance,
 }
 
+/// How often a cache frame splats its records (docs/cache-frame.md §6.5).
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Splat {
+    /// Once per frame at the pixel centres; the other sub-frames interpolate each sample's
+    /// cached light between the nearest centres that match it (default).
+    Once,
+    /// At every sub-frame's own samples (one splat and one hole-filling pass per sub-frame).
+    PerSubFrame,
+}
+
 /// The rule that sets a record's radius.
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ErrorControlArg {
@@ -128,6 +140,9 @@ pub struct IcArgs {
     /// How records for glossy lobes from the cache are spaced (`--method ic`).
     #[arg(long, value_enum, default_value_t = GlossySpacingArg::Lobe)]
     pub glossy_spacing: GlossySpacingArg,
+    /// How often the records are splatted (`--method ic`).
+    #[arg(long, value_enum, default_value_t = Splat::Once)]
+    pub splat: Splat,
 }
 
 fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T)> {
@@ -187,6 +202,14 @@ impl IcArgs {
             Glossy::Records => GlossyLight::Records,
             Glossy::RecordsNoGradients => GlossyLight::RecordsWithoutGradients,
             Glossy::Paths => GlossyLight::Paths,
+        }
+    }
+
+    /// How often the records are splatted.
+    pub fn splat_mode(&self) -> SplatMode {
+        match self.splat {
+            Splat::Once => SplatMode::Once,
+            Splat::PerSubFrame => SplatMode::PerSubFrame,
         }
     }
 

@@ -13,7 +13,7 @@ use radcache_vk::{Context, ShaderCompiler};
 
 use crate::error::{Error, Result};
 use crate::frame::path::{FrameOutput, Progress};
-use crate::frame::settings::{GlossyLight, IcDebug, IcSettings, IcStats};
+use crate::frame::settings::{GlossyLight, IcDebug, IcSettings, IcStats, SplatMode};
 use crate::passes::composite::CompositePass;
 use crate::passes::direct::DirectPass;
 use crate::passes::emission::EmissionPass;
@@ -69,6 +69,8 @@ pub struct IcRenderer {
     /// The records hold a constant environment's light ([`crate::SkyLight::Records`] in a scene
     /// with one).
     sky_in_records: bool,
+    /// How often the records are splatted (set at creation: the composite's centre samples).
+    splat_mode: SplatMode,
 }
 
 impl std::fmt::Debug for IcRenderer {
@@ -145,6 +147,7 @@ impl IcRenderer {
                 h,
                 radiance,
                 settings.anti_aliasing.is_some(),
+                settings.splat == SplatMode::Once,
             )?,
             emission: EmissionPass::new(ctx, shaders, gpu)?,
             state: IcState::with_radiance(ctx, shaders, capacity, w * h, radiance)?,
@@ -164,6 +167,7 @@ impl IcRenderer {
                 .sky
                 .define(gpu.has_constant_environment())
                 .is_some(),
+            splat_mode: settings.splat,
         })
     }
 
@@ -196,7 +200,17 @@ impl IcRenderer {
         progress: &mut dyn FnMut(Progress),
     ) -> Result<(FrameOutput, IcStats)> {
         self.check(settings)?;
-        let mut run = FrameRun::new(self.params.levels, settings.sub_frames, progress);
+        // Splatting once, only the centres' holes matter: the cache phase fills those alone.
+        let cache_sub_frames = match self.splat_mode {
+            SplatMode::Once => 1,
+            SplatMode::PerSubFrame => settings.sub_frames,
+        };
+        let mut run = FrameRun::new(
+            self.params.levels,
+            cache_sub_frames,
+            settings.sub_frames,
+            progress,
+        );
         let view = self.setup(ctx, scene, gpu, settings, &mut run)?;
         self.cache_phase(ctx, gpu, settings, &mut run)?;
         if settings.time_step_s > 0.0 {
@@ -204,7 +218,7 @@ impl IcRenderer {
         }
         run.add_rays("records", run.stats.record_rays);
         self.has_records = true;
-        for k in 0..run.sub_frames {
+        for k in 0..run.shade_total {
             self.shade_sub_frame(ctx, gpu, settings, k, &mut run)?;
         }
         if let Some(aa) = settings.anti_aliasing {
@@ -215,17 +229,22 @@ impl IcRenderer {
 
     /// Refuses settings the renderer was not made for.
     fn check(&self, settings: &IcSettings) -> Result<()> {
-        let same = (settings.width, settings.height, settings.params)
-            == (self.width, self.height, self.params);
+        let same = (
+            settings.width,
+            settings.height,
+            settings.params,
+            settings.splat,
+        ) == (self.width, self.height, self.params, self.splat_mode);
         let lifespans = self.temporal.as_ref().is_some_and(|t| t.lifespans());
         if same && (settings.time_step_s <= 0.0 || lifespans) {
             return Ok(());
         }
         Err(Error::Invalid(format!(
-            "the renderer was made for {}x{} and {:?}{}, not {}x{} and {:?} with a time step of {} s",
+            "the renderer was made for {}x{}, {:?} and {:?}{}, not {}x{}, {:?} and {:?} with a time step of {} s",
             self.width,
             self.height,
             self.params,
+            self.splat_mode,
             if self.temporal.is_some() {
                 " with temporal caching"
             } else {
@@ -234,6 +253,7 @@ impl IcRenderer {
             settings.width,
             settings.height,
             settings.params,
+            settings.splat,
             settings.time_step_s
         )))
     }

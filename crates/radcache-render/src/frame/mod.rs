@@ -21,6 +21,8 @@
 //!    their radii against the records nearby (`passes/neighbours.rs`, a hash grid). The host
 //!    only loops over levels and reads the counters for the figures; a level that finds no hole
 //!    ends the sub-frame. With `settle_records` the phase repeats until a pass creates nothing.
+//!    Splatting once per frame ([`settings::SplatMode::Once`], the default) the phase covers
+//!    sub-frame 0 (the pixel centres) alone, and always repeats until a pass creates nothing.
 //! 3. **Look-ahead** (temporal caching, only with a time step): the frame's new records and the
 //!    expired ones are evaluated again, at their own points, in the scene of the next frame
 //!    (`passes/temporal.rs`, the record pass's refresh), which gives their rates and lifespans.
@@ -28,6 +30,9 @@
 //!    one-sample MIS), the splat of every record with the final weights (marking the records
 //!    used), the count of the holes left, and the **composite**
 //!    `L = direct + albedo/π · Σw·Ẽ / Σw` into the frame accumulator (`passes/composite.rs`).
+//!    Splatting once per frame only sub-frame 0 splats and counts holes; its composite stores
+//!    the centres' points, and every later sub-frame's composite interpolates the centres' splat
+//!    at its samples (docs/cache-frame.md §6.5).
 //!    Every sub-frame is shaded with the same, final set of records, so a frame whose holes are
 //!    all covered by kept records creates none and shades exactly as the frame before it.
 //! 5. **Finish**: the **emission** pass adds the box-filtered emission (`passes/emission.rs`),

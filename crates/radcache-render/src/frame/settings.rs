@@ -66,6 +66,24 @@ pub struct IcSettings {
     /// until the image's sampling error is estimated small enough. `None` (the default) shades
     /// exactly `sub_frames`. Must be set when the renderer is created.
     pub anti_aliasing: Option<AntiAliasing>,
+    /// How often the records are splatted: once per frame (the default) or at every
+    /// sub-frame. Must be set when the renderer is created.
+    pub splat: SplatMode,
+}
+
+/// How often a frame rendered with the cache splats its records (docs/cache-frame.md §6.5).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum SplatMode {
+    /// Once per frame, at the pixel centres (sub-frame 0, whose jitter is 0): every other
+    /// sub-frame interpolates each sample's cached light between the four nearest centres
+    /// that match it (the closest centre of its 3×3 neighbourhood where none does), and the
+    /// cache phase fills the holes of the centres alone. The splat's cost no longer grows with
+    /// the sub-frames.
+    #[default]
+    Once,
+    /// At every sub-frame's own samples, and the cache phase fills the holes of every
+    /// sub-frame: the exact per-sample interpolation, one splat per sub-frame.
+    PerSubFrame,
 }
 
 /// Adaptive anti-aliasing of a frame rendered with the cache (docs/cache-frame.md §7.1): after
@@ -206,6 +224,7 @@ impl Default for IcSettings {
             glossy: GlossyLight::Records,
             glossy_spacing: GlossySpacing::Lobe,
             anti_aliasing: None,
+            splat: SplatMode::Once,
         }
     }
 }
@@ -217,8 +236,13 @@ pub struct IcStats {
     pub records_per_level: Vec<u64>,
     /// Records at the end of the frame.
     pub records: u64,
-    /// Surface pixels left uncovered by the final splat (summed over sub-frames).
+    /// Surface pixels left uncovered by the final splat (summed over the sub-frames that splat:
+    /// the first alone with [`SplatMode::Once`]).
     pub holes_left: u64,
+    /// With [`SplatMode::Once`]: samples of the later sub-frames that none of the four nearest
+    /// centres matched (lit from the closest centre of their 3×3 neighbourhood, or unlit where
+    /// no centre there is a surface), summed over the sub-frames.
+    pub unmatched_samples: u64,
     /// Requests dropped because the record buffer was full.
     pub dropped_requests: u64,
     /// Records whose irradiance was invalid (stored as black).

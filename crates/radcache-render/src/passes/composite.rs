@@ -8,8 +8,9 @@
 //! frame accumulator, the non-finite counter, the emission accumulator (read by
 //! [`crate::EmissionPass`], which adds the box-filtered emission), the debug accumulator and the
 //! splat record count, and with adaptive anti-aliasing the accumulator of squares
-//! (`IC_AA_MOMENTS`, [`CompositePass::read_sampling_relmse`]). A non-finite value is replaced
-//! by 0 and counted.
+//! (`IC_AA_MOMENTS`, [`CompositePass::read_sampling_relmse`]), and the pixels' centre samples
+//! ([`CentreSamples`]: splatting once per frame). A non-finite value is replaced by 0 and
+//! counted.
 
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, ImageUse, MemoryLocation, Pipeline, Recorder,
@@ -33,7 +34,26 @@ radcache_shared::gpu_struct! {
         /// 1: add the glossy splat's target (pass built with radiance; docs/radiance-caching.md
         /// §6.2).
         pub glossy: u32 => "uint",
+        /// [`CentreSamples`] as a number: 0 off, 1 store, 2 match.
+        pub centre: u32 => "uint",
+        /// Padding.
+        pub pad0: u32 => "uint",
     }
+}
+
+/// What a sub-frame's composite does with the pixels' centre samples when the records are
+/// splatted once per frame ([`crate::SplatMode::Once`], docs/cache-frame.md §6.5).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CentreSamples {
+    /// The splat was made at this sub-frame's own samples: each pixel reads its own.
+    Own,
+    /// As `Own`, and the samples are stored as the frame's centre samples (the sub-frame at
+    /// the pixel centres, which the splat used).
+    Store,
+    /// The splat was made at the stored centre samples: each sample interpolates the splat
+    /// bilinearly between the four nearest centres that match it (where none does, that of
+    /// the closest centre of its 3×3 neighbourhood).
+    Match,
 }
 
 /// The composite pipeline and the frame accumulator.
@@ -45,6 +65,10 @@ pub struct CompositePass {
     /// Σ radiance² per pixel (16 bytes a pixel with moments, one vec4 otherwise).
     accum_sq: Buffer,
     moments: bool,
+    /// The centre samples (32 bytes a pixel when the pass was made for them, one vec4
+    /// otherwise).
+    centre: Buffer,
+    /// Non-finite values dropped, then samples no centre matched (two `uint`s).
     nonfinite: Buffer,
     width: u32,
     height: u32,
@@ -68,12 +92,14 @@ impl CompositePass {
         width: u32,
         height: u32,
     ) -> Result<CompositePass> {
-        Self::with_options(ctx, shaders, scene, width, height, false, false)
+        Self::with_options(ctx, shaders, scene, width, height, false, false, false)
     }
 
     /// As [`CompositePass::new`]; with `radiance` the pass can add the glossy splat's target
     /// (`HAS_RADIANCE_CACHE`, [`CompositePass::record_glossy`]); with `moments` it also sums
-    /// the squares of the radiance (`IC_AA_MOMENTS`, [`CompositePass::read_sampling_relmse`]).
+    /// the squares of the radiance (`IC_AA_MOMENTS`, [`CompositePass::read_sampling_relmse`]);
+    /// with `centres` it can store and match centre samples ([`CentreSamples`]).
+    #[allow(clippy::too_many_arguments)]
     pub fn with_options(
         ctx: &Context,
         shaders: &ShaderCompiler,
@@ -82,6 +108,7 @@ impl CompositePass {
         height: u32,
         radiance: bool,
         moments: bool,
+        centres: bool,
     ) -> Result<CompositePass> {
         let mut defines = scene.defines();
         if radiance {
@@ -122,6 +149,11 @@ impl CompositePass {
                 MemoryLocation::GpuOnly,
             )?,
             moments,
+            centre: buffer(
+                "composite.centre",
+                if centres { pixels * 32 } else { 16 },
+                MemoryLocation::GpuOnly,
+            )?,
             nonfinite: buffer("composite.nonfinite", 16, MemoryLocation::GpuToCpu)?,
             width,
             height,
@@ -148,11 +180,13 @@ impl CompositePass {
         jitter: [f32; 2],
         debug: bool,
     ) -> Result<()> {
-        self.record_glossy(rec, scene, gbuffer, splat, None, jitter, debug)
+        let centre = CentreSamples::Own;
+        self.record_glossy(rec, scene, gbuffer, splat, None, jitter, centre, debug)
     }
 
     /// As [`CompositePass::record`]; with `glossy`, the glossy target's `rgb/a` is added where
-    /// its weight is positive.
+    /// its weight is positive; `centre` says whose samples the splat targets hold (anything but
+    /// [`CentreSamples::Own`] needs a pass made with `centres`).
     #[allow(clippy::too_many_arguments)]
     pub fn record_glossy(
         &self,
@@ -162,8 +196,15 @@ impl CompositePass {
         splat: &SplatPass,
         glossy: Option<&GlossySplatPass>,
         jitter: [f32; 2],
+        centre: CentreSamples,
         debug: bool,
     ) -> Result<()> {
+        let pixels = u64::from(self.width) * u64::from(self.height);
+        if centre != CentreSamples::Own && self.centre.size() < pixels * 32 {
+            return Err(crate::error::Error::Invalid(
+                "the composite pass was made without centre samples".into(),
+            ));
+        }
         for image in gbuffer.images() {
             rec.use_image(image, ImageUse::ComputeStorage);
         }
@@ -183,11 +224,18 @@ impl CompositePass {
             (b::SPLAT_COUNT, Resource::StorageImage(&splat.count)),
             (b::GLOSSY_SUM, Resource::StorageImage(glossy_sum)),
             (b::ACCUM_SQ, Resource::Buffer(&self.accum_sq)),
+            (b::CENTRE, Resource::Buffer(&self.centre)),
         ]);
         let push = CompositePush {
             jitter,
             debug: u32::from(debug),
             glossy: u32::from(glossy.is_some()),
+            centre: match centre {
+                CentreSamples::Own => 0,
+                CentreSamples::Store => 1,
+                CentreSamples::Match => 2,
+            },
+            pad0: 0,
         };
         let (w, h) = (self.width, self.height);
         rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
@@ -241,6 +289,12 @@ impl CompositePass {
         let sums: Vec<[f32; 4]> = ctx.read_buffer(&self.accum, n)?;
         let squares: Vec<[f32; 4]> = ctx.read_buffer(&self.accum_sq, n)?;
         Ok(Some(crate::frame::aa::sampling_relmse(&sums, &squares)))
+    }
+
+    /// Samples of the sub-frames composited with [`CentreSamples::Match`] that no centre of
+    /// their neighbourhood matched, since the last clear.
+    pub fn read_unmatched(&self) -> Result<u64> {
+        Ok(u64::from(self.nonfinite.read::<u32>(2)?[1]))
     }
 
     /// The mean over the accumulated sub-frames, and the number of non-finite values dropped.

@@ -14,7 +14,8 @@ use crate::error::Result;
 use crate::frame::aa::next_sub_frames;
 use crate::frame::clock::FrameClock;
 use crate::frame::path::{FrameOutput, Progress};
-use crate::frame::settings::{sub_frame_jitter, AntiAliasing, IcSettings, IcStats};
+use crate::frame::settings::{sub_frame_jitter, AntiAliasing, IcSettings, IcStats, SplatMode};
+use crate::passes::composite::CentreSamples;
 use crate::passes::holes::HoleSelection;
 use crate::passes::record::creation_seed;
 use crate::passes::splat::{SplatScope, SplatWeights};
@@ -29,9 +30,9 @@ pub(super) struct FrameRun<'p> {
     pub stats: IcStats,
     /// Ray queries per kind of work (`records`, `direct`, `emission`).
     pub rays: BTreeMap<String, u64>,
-    /// Jittered sub-frames of the cache phase (at least 1).
+    /// Jittered sub-frames of the cache phase (at least 1; 1 when splatting once per frame).
     pub sub_frames: u32,
-    /// Sub-frames to shade: `sub_frames`, more with adaptive anti-aliasing.
+    /// Sub-frames to shade: the settings' `sub_frames`, more with adaptive anti-aliasing.
     pub shade_total: u32,
     /// Sub-frames shaded so far.
     pub shaded: u32,
@@ -44,7 +45,12 @@ pub(super) struct FrameRun<'p> {
 }
 
 impl<'p> FrameRun<'p> {
-    pub fn new(levels: u32, sub_frames: u32, progress: &'p mut dyn FnMut(Progress)) -> Self {
+    pub fn new(
+        levels: u32,
+        cache_sub_frames: u32,
+        shade_sub_frames: u32,
+        progress: &'p mut dyn FnMut(Progress),
+    ) -> Self {
         FrameRun {
             clock: FrameClock::new(),
             stats: IcStats {
@@ -52,8 +58,8 @@ impl<'p> FrameRun<'p> {
                 ..IcStats::default()
             },
             rays: BTreeMap::new(),
-            sub_frames: sub_frames.max(1),
-            shade_total: sub_frames.max(1),
+            sub_frames: cache_sub_frames.max(1),
+            shade_total: shade_sub_frames.max(1),
             shaded: 0,
             kept: 0,
             expired: 0,
@@ -158,7 +164,10 @@ impl IcRenderer {
         settings: &IcSettings,
         run: &mut FrameRun<'_>,
     ) -> Result<()> {
-        let passes = if settings.settle_records {
+        // Splatting once, the one cache sub-frame is the only chance to cover the centres, so
+        // its passes also repeat: a record created late in a pass can shrink (neighbour
+        // clamping) one that covered a centre the pass had already passed.
+        let passes = if settings.settle_records || self.splat_mode == SplatMode::Once {
             MAX_CACHE_PASSES
         } else {
             1
@@ -268,7 +277,9 @@ impl IcRenderer {
 
     /// **Shade** sub-frame `k`: its G-buffer, direct light, the splat of every record with the
     /// final weights (marking the records used this frame), the count of the holes left, and
-    /// the composite into the frame accumulator.
+    /// the composite into the frame accumulator. Splatting once per frame ([`SplatMode::Once`])
+    /// only sub-frame 0 (the pixel centres) splats, counts holes and stores its samples; every
+    /// later one composites against those centres (docs/cache-frame.md §6.5).
     pub(super) fn shade_sub_frame(
         &self,
         ctx: &Context,
@@ -283,6 +294,12 @@ impl IcRenderer {
         };
         let jitter = sub_frame_jitter(k);
         let (gbuffer, state) = (&self.gbuffer, &self.state);
+        let splats = k == 0 || self.splat_mode == SplatMode::PerSubFrame;
+        let centre = match (self.splat_mode, k) {
+            (SplatMode::PerSubFrame, _) => CentreSamples::Own,
+            (SplatMode::Once, 0) => CentreSamples::Store,
+            (SplatMode::Once, _) => CentreSamples::Match,
+        };
         let mut rec = ctx.begin("ic.shade")?;
         self.gbuffer_pass.record(&mut rec, gpu, gbuffer, jitter)?;
         let glossy = self.glossy();
@@ -295,36 +312,48 @@ impl IcRenderer {
             settings.seed,
             glossy,
         )?;
-        self.splat.record(
+        if splats {
+            self.splat.record(
+                &mut rec,
+                "splat",
+                SplatScope::All,
+                gpu,
+                gbuffer,
+                state,
+                &final_weights,
+            )?;
+            if let Some(g) = glossy {
+                g.record(&mut rec, gpu, gbuffer, state, &final_weights)?;
+            }
+            self.state.record_begin_level(&mut rec)?;
+            self.holes.record(
+                &mut rec,
+                gbuffer,
+                &self.splat,
+                state,
+                HoleSelection::CountOnly,
+            )?;
+        }
+        let debug = settings.debug_aovs;
+        self.composite.record_glossy(
             &mut rec,
-            "splat",
-            SplatScope::All,
             gpu,
             gbuffer,
-            state,
-            &final_weights,
-        )?;
-        if let Some(g) = glossy {
-            g.record(&mut rec, gpu, gbuffer, state, &final_weights)?;
-        }
-        self.state.record_begin_level(&mut rec)?;
-        self.holes.record(
-            &mut rec,
-            gbuffer,
             &self.splat,
-            state,
-            HoleSelection::CountOnly,
+            glossy,
+            jitter,
+            centre,
+            debug,
         )?;
-        let debug = settings.debug_aovs;
-        self.composite
-            .record_glossy(&mut rec, gpu, gbuffer, &self.splat, glossy, jitter, debug)?;
         run.clock.submit(ctx, rec)?;
         run.add_rays("direct", self.direct.rays()?);
-        let c = self.state.read_counters()?;
-        run.stats.holes_left += u64::from(c.holes);
-        run.stats.records = u64::from(c.record_count);
-        run.stats.dropped_requests = u64::from(c.dropped_requests);
-        run.stats.rejected_records = u64::from(c.rejected_records);
+        if splats {
+            let c = self.state.read_counters()?;
+            run.stats.holes_left += u64::from(c.holes);
+            run.stats.records = u64::from(c.record_count);
+            run.stats.dropped_requests = u64::from(c.dropped_requests);
+            run.stats.rejected_records = u64::from(c.rejected_records);
+        }
         run.clock.lap("shade");
         run.shaded = k + 1;
         run.report(run.sub_frames + k + 1);
@@ -389,6 +418,7 @@ impl IcRenderer {
         }
         run.clock.lap("readback");
         run.stats.sub_frames_shaded = run.shaded;
+        run.stats.unmatched_samples = self.composite.read_unmatched()?;
         let mut clock = run.clock;
         run.stats.phases_s = std::mem::take(&mut clock.phases_s);
         let output = FrameOutput {
