@@ -93,6 +93,17 @@ impl std::fmt::Debug for Gpu {
 
 impl Gpu {
     pub fn new(scene: &Scene, env: Option<&EnvMap>, size: (u32, u32)) -> Gpu {
+        Self::with_gbuffer(scene, env, size, None)
+    }
+
+    /// As [`Gpu::new`], the G-buffer traced (`Some(true)`) or rasterized (`Some(false)`)
+    /// whatever the scene's plan says (`None`: as it says).
+    pub fn with_gbuffer(
+        scene: &Scene,
+        env: Option<&EnvMap>,
+        size: (u32, u32),
+        traced: Option<bool>,
+    ) -> Gpu {
         let ctx = context();
         let shaders = shaders();
         let mut gpu = GpuScene::new(&ctx, scene, env).unwrap();
@@ -103,7 +114,8 @@ impl Gpu {
         gpu.record_update(&ctx, &mut rec).unwrap();
         ctx.submit(rec).unwrap().wait().unwrap();
         let gbuffer = GBuffer::new(&ctx, size.0, size.1).unwrap();
-        let pass = GBufferPass::new(&ctx, &shaders, &gpu).unwrap();
+        let traced = traced.unwrap_or(gpu.plan().traced_gbuffer);
+        let pass = GBufferPass::with_method(&ctx, &shaders, &gpu, traced).unwrap();
         Gpu {
             ctx,
             shaders,

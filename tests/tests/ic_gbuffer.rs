@@ -1,5 +1,5 @@
-//! The cache's G-buffer pass on lavapipe against CPU ray casting (Cornell box; a scene of front,
-//! back, double-sided and mirrored emitters).
+//! The cache's G-buffer pass on lavapipe against CPU ray casting, rasterized and ray traced
+//! (Cornell box; a scene of front, back, double-sided and mirrored emitters).
 
 use glam::{DVec3, Vec3};
 use radcache_scene::Scene;
@@ -115,15 +115,19 @@ fn check_gbuffer(scene: &Scene, gpu: &Gpu, g: &GRead, jitter: [f32; 2]) -> Check
     c
 }
 
+/// Both ways of making the G-buffer (rasterized; ray traced, which scenes of many triangles
+/// get) against CPU ray casting.
 #[test]
 fn gbuffer_matches_cpu_ray_casting() {
-    for (scene, size) in [(cornell(), (64, 64)), (faces_scene(), (40, 32))] {
-        let gpu = Gpu::new(&scene, None, size);
+    let cases = [(cornell(), (64, 64)), (faces_scene(), (40, 32))];
+    for ((scene, size), traced) in cases.iter().flat_map(|c| [(c, false), (c, true)]) {
+        let (scene, size) = (scene, *size);
+        let gpu = Gpu::with_gbuffer(scene, None, size, Some(traced));
         for jitter in [[0.0, 0.0], [0.3, -0.4]] {
             let scopes = gpu.render(jitter, None);
             assert!(scopes.iter().any(|s| s == "gbuffer"), "{scopes:?}");
-            let c = check_gbuffer(&scene, &gpu, &gpu.read_gbuffer(), jitter);
-            eprintln!("{size:?} jitter {jitter:?}: {c:?}");
+            let c = check_gbuffer(scene, &gpu, &gpu.read_gbuffer(), jitter);
+            eprintln!("{size:?} traced {traced} jitter {jitter:?}: {c:?}");
             let n = (size.0 * size.1) as usize;
             assert!(
                 c.surface + c.background > n / 2,

@@ -76,6 +76,12 @@ pub struct AnimationPlan {
 /// integral per sub-frame, a few dozen flops beside a shadow ray's traversal.
 pub const ANALYTIC_EMITTERS_MAX: usize = 16;
 
+/// Fewest instanced triangles for which the cache's G-buffer is ray traced
+/// ([`ScenePlan::traced_gbuffer`]). Measured on lavapipe (docs/cache-frame.md §2): at 32
+/// triangles (the Cornell box) rasterization is level at 256² and 25 % faster at 1024²; from
+/// 7,958 (metal_spheres) tracing is faster, 3.5× at 113,394 (the courtyard, 256²).
+pub const TRACED_GBUFFER_MIN_TRIANGLES: usize = 1_000;
+
 /// Rendering plan of a scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScenePlan {
@@ -116,6 +122,11 @@ pub struct ScenePlan {
     /// `Mesh::texcoords1`): the passes compile the second set in (`HAS_TEXCOORD1`) and upload it
     /// per vertex. False: no second set in memory or in the shaders.
     pub texcoord1: bool,
+    /// The cache's G-buffer is ray traced, one camera ray per pixel (`passes/gbuffer.comp`):
+    /// the scene has at least [`TRACED_GBUFFER_MIN_TRIANGLES`] instanced triangles, where
+    /// rasterizing them all at every sub-frame costs more than a ray per pixel. False: they are
+    /// rasterized (`passes/gbuffer.vert` and `.frag`).
+    pub traced_gbuffer: bool,
     /// Punctual light instances by kind.
     pub lights: LightCounts,
     /// Environment kind.
@@ -175,6 +186,7 @@ impl ScenePlan {
             normal_maps: scene.meshes.iter().any(|m| !m.tangents.is_empty()),
             uv_transform: scene.materials.iter().any(|m| m.has_uv_transform()),
             texcoord1: scene.meshes.iter().any(|m| !m.texcoords1.is_empty()),
+            traced_gbuffer: scene.instanced_triangle_count() >= TRACED_GBUFFER_MIN_TRIANGLES,
             emissive_triangles: count,
             emissive_power: emitters.total_power,
             lights,
@@ -300,6 +312,15 @@ impl fmt::Display for ScenePlan {
                 )?;
             }
         }
+        writeln!(
+            f,
+            "  G-buffer: {}",
+            if self.traced_gbuffer {
+                "ray traced (a camera ray per pixel)"
+            } else {
+                "rasterized (few triangles)"
+            }
+        )?;
         writeln!(
             f,
             "  normal maps: {}",

@@ -1,21 +1,25 @@
-//! G-buffer rasterization (`shaders/passes/gbuffer.vert` + `gbuffer.frag`): one draw per instance
-//! with vertex pulling, reversed-Z depth (cleared to 0, GREATER), no culling (both sides are drawn;
-//! the emission rule decides what a back face emits), and a sub-pixel jitter per sub-frame.
+//! The cache's G-buffer, ray traced or rasterized as the scene's plan says
+//! ([`radcache_scene::ScenePlan::traced_gbuffer`]: many triangles; docs/cache-frame.md §2).
 //!
-//! Writes the five attachments of `shaders/common/gbuffer.glsl` (position, shading normal +
+//! Traced (`shaders/passes/gbuffer.comp`): one camera ray per pixel through its jittered sample,
+//! its first hit written with the rules below. Rasterized (`shaders/passes/gbuffer.vert` +
+//! `gbuffer.frag`): one draw per instance with vertex pulling, reversed-Z depth (cleared to 0,
+//! GREATER), no culling (both sides are drawn; the emission rule decides what a back face
+//! emits), and a sub-pixel jitter per sub-frame; each fragment traces one ray query from the
+//! camera to itself: a surface hit before it (rasterization snapped a zero-thickness wall's edge
+//! away from the sample, so the sample sees the floor behind the wall) replaces it, so the
+//! G-buffer never holds a point the camera cannot see (the stiff suite's `two_rooms`).
+//!
+//! Either writes the five images of `shaders/common/gbuffer.glsl` (position, shading normal +
 //! footprint, geometric normal + material, albedo, emission), zero on the background, and clears
-//! the direct-light image. Reads the scene bindings 0–15 (vertex and fragment stages; nothing is
-//! written from the vertex stage). Each fragment traces one ray query from the camera to itself:
-//! a surface hit before it (rasterization snapped a zero-thickness wall's edge away from the
-//! sample, so the sample sees the floor behind the wall) replaces it, so the G-buffer never holds
-//! a point the camera cannot see (the stiff suite's `two_rooms`).
+//! the direct-light image. Both read the scene bindings 0–15.
 
 use radcache_vk::{
-    vk, ColorTarget, Context, DepthState, DepthTarget, GraphicsDesc, ImageUse, Pipeline, Recorder,
-    ShaderCompiler,
+    vk, Access, ColorTarget, Context, DepthState, DepthTarget, GraphicsDesc, ImageUse, Pipeline,
+    Recorder, ShaderCompiler,
 };
 
-use crate::bindings::SCENE;
+use crate::bindings::{GBUFFER, SCENE};
 use crate::error::Result;
 use crate::scene::GpuScene;
 
@@ -35,24 +39,54 @@ radcache_shared::gpu_struct! {
     }
 }
 
-/// The G-buffer pipeline.
+/// The G-buffer pipeline: rasterization, or the ray-traced one (`gbuffer.comp`) where the plan
+/// says so.
 pub struct GBufferPass {
     pipeline: Pipeline,
+    traced: bool,
 }
 
 impl std::fmt::Debug for GBufferPass {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("GBufferPass").finish_non_exhaustive()
+        f.debug_struct("GBufferPass")
+            .field("traced", &self.traced)
+            .finish_non_exhaustive()
     }
 }
 
 impl GBufferPass {
-    /// Compiles the pass for `scene`'s materials (the fragment stage stores metallic and
-    /// roughness only where some material is not Lambertian; both stages carry tangents only
-    /// where some primitive has a normal map).
+    /// Compiles the pass for `scene`'s plan (traced or rasterized) and materials (metallic and
+    /// roughness are stored only where some material is not Lambertian; the rasterization
+    /// carries tangents only where some primitive has a normal map).
     pub fn new(ctx: &Context, shaders: &ShaderCompiler, scene: &GpuScene) -> Result<GBufferPass> {
-        let vertex = shaders.compile("passes/gbuffer.vert", &scene.material_defines())?;
-        let fragment = shaders.compile("passes/gbuffer.frag", &scene.material_defines())?;
+        Self::with_method(ctx, shaders, scene, scene.plan().traced_gbuffer)
+    }
+
+    /// As [`GBufferPass::new`], traced or rasterized as `traced` says whatever the plan.
+    pub fn with_method(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        scene: &GpuScene,
+        traced: bool,
+    ) -> Result<GBufferPass> {
+        let defines = scene.material_defines();
+        if traced {
+            let spirv = shaders.compile("passes/gbuffer.comp", &defines)?;
+            let layout: Vec<_> = SCENE.iter().chain(GBUFFER.iter()).copied().collect();
+            let pipeline = Pipeline::compute(
+                ctx,
+                "gbuffer",
+                &spirv,
+                &layout,
+                std::mem::size_of::<GBufferPush>() as u32,
+            )?;
+            return Ok(GBufferPass {
+                pipeline,
+                traced: true,
+            });
+        }
+        let vertex = shaders.compile("passes/gbuffer.vert", &defines)?;
+        let fragment = shaders.compile("passes/gbuffer.frag", &defines)?;
         let pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc {
@@ -72,7 +106,15 @@ impl GBufferPass {
                 topology: vk::PrimitiveTopology::TRIANGLE_LIST,
             },
         )?;
-        Ok(GBufferPass { pipeline })
+        Ok(GBufferPass {
+            pipeline,
+            traced: false,
+        })
+    }
+
+    /// The pass traces its G-buffer (the plan's `traced_gbuffer`).
+    pub fn traced(&self) -> bool {
+        self.traced
     }
 
     /// Records the G-buffer of `scene`'s current view, clearing everything first, in the profiler
@@ -88,6 +130,27 @@ impl GBufferPass {
         gbuffer: &GBuffer,
         jitter: [f32; 2],
     ) -> Result<()> {
+        if self.traced {
+            for image in gbuffer.images() {
+                rec.use_image(image, ImageUse::ComputeStorage);
+            }
+            let mut bindings = scene.bindings();
+            bindings.extend(gbuffer.bindings());
+            let (w, h) = (gbuffer.width, gbuffer.height);
+            rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
+            rec.pass("gbuffer", |rec| {
+                rec.bind_pipeline(&self.pipeline);
+                rec.push_bindings(&bindings);
+                rec.push_constants(&GBufferPush {
+                    instance: 0,
+                    pad: 0,
+                    jitter,
+                });
+                rec.dispatch(w.div_ceil(8), h.div_ceil(8), 1)
+            })?;
+            rec.barrier(Access::COMPUTE_WRITE, Access::ALL);
+            return Ok(());
+        }
         for image in gbuffer.attachments() {
             rec.use_image(image, ImageUse::ColorAttachment);
         }

@@ -1,0 +1,92 @@
+// passes/gbuffer.comp — Rust: crates/radcache-render/src/passes/gbuffer.rs
+// The G-buffer by ray tracing (docs/cache-frame.md §2): one camera ray per pixel through
+// p + 0.5 + jitter, its first hit (alpha-tested as every ray is) written to the images of
+// shaders/common/gbuffer.glsl with the rules of the rasterized G-buffer (gbuffer.frag): normals
+// toward the camera, the pinhole footprint from the view depth (clip w), the stored point moved
+// a hair toward the camera, zero on the background and in the direct-light image. The hit is the
+// surface the camera sees, so rasterization's edge snapping (gbuffer.frag's occluder ray) cannot
+// arise.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+
+#include "../common/path.glsl"
+#include "../common/ircache_math.glsl"
+#include "../common/gbuffer_pack.glsl"
+#include "gbuffer_push.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = B_GBUFFER_POSITION, rgba32f) writeonly uniform image2D o_position;
+layout(binding = B_GBUFFER_NORMAL, rgba32f) writeonly uniform image2D o_normal;
+layout(binding = B_GBUFFER_GEOMETRIC, rgba32f) writeonly uniform image2D o_geometric;
+layout(binding = B_GBUFFER_ALBEDO, rgba32f) writeonly uniform image2D o_albedo;
+layout(binding = B_GBUFFER_EMISSION, rgba32f) writeonly uniform image2D o_emission;
+layout(binding = B_GBUFFER_DIRECT, rgba32f) writeonly uniform image2D o_direct;
+
+#ifdef HAS_ALPHA
+// The seed of this pixel's BLEND tests in this sub-frame, as gbuffer.frag draws it.
+uint gbuffer_alpha_seed(uvec2 p) {
+    uint h = pcg_hash(frame.resolution.w ^ pcg_hash(frame.resolution.z));
+    h = pcg_hash(h ^ floatBitsToUint(pc.jitter.x));
+    h = pcg_hash(h ^ floatBitsToUint(pc.jitter.y));
+    h = pcg_hash(h ^ p.x);
+    return pcg_hash(h ^ p.y);
+}
+#endif
+
+void main() {
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(pixel, frame.resolution.xy))) {
+        return;
+    }
+    ivec2 at = ivec2(pixel);
+    imageStore(o_direct, at, vec4(0.0));
+#ifdef HAS_ALPHA
+    uint alpha_seed = gbuffer_alpha_seed(pixel);
+#else
+    uint alpha_seed = 0u;
+#endif
+    Ray r = camera_ray(pixel, vec2(0.5) + pc.jitter);
+    rayQueryEXT q;
+    scene_trace_seeded(q, 0u, r.origin, r.dir, IC_FAR, alpha_seed);
+    if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
+        imageStore(o_position, at, vec4(0.0));
+        imageStore(o_normal, at, vec4(0.0));
+        imageStore(o_geometric, at, vec4(0.0));
+        imageStore(o_albedo, at, vec4(0.0));
+        imageStore(o_emission, at, vec4(0.0));
+        return;
+    }
+    uint instance = uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true));
+    Surface s = surface_at(instance, uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
+                           rayQueryGetIntersectionBarycentricsEXT(q, true), r.dir);
+    vec3 position = s.position;
+    vec3 to_camera = frame.camera_position.xyz - position;
+    vec3 ng = s.geometric_normal;
+    // View depth = clip w. The y row of clip_from_world is the projection's ±1/tan(fov_y/2)
+    // times a row of the view rotation (a unit vector).
+    float view_depth = (frame.clip_from_world * vec4(position, 1.0)).w;
+    vec3 row_y = vec3(frame.clip_from_world[0][1], frame.clip_from_world[1][1],
+                      frame.clip_from_world[2][1]);
+    float dist = length(to_camera);
+    float cos_view = dist > 0.0 ? dot(ng, to_camera) / dist : 1.0;
+    float footprint = pixel_footprint(view_depth, 1.0 / length(row_y),
+                                      float(frame.resolution.y), cos_view);
+    // A hair toward the camera, as gbuffer.frag explains (the stiff suite's `inside_object`).
+    float step_len = min(max(1e-5 * dist, 1e-6 * max(abs(position.x), max(abs(position.y),
+                                                                        abs(position.z)))),
+                         0.5 * dist);
+    position += dist > 0.0 ? to_camera * (step_len / dist) : vec3(0.0);
+    imageStore(o_position, at, vec4(position, 1.0));
+    imageStore(o_normal, at, vec4(s.shading_normal, footprint));
+    imageStore(o_geometric, at, vec4(ng, float(s.material)));
+#ifdef HAS_SPECULAR
+    Material m = material_at(s.material, s.uv);
+    imageStore(o_albedo, at, vec4(m.base_colour, float(instance)));
+    imageStore(o_emission, at, vec4(material_emission(s.material, s.uv, s.front_face),
+                                    gbuffer_pack_metallic_roughness(m.metallic, m.roughness)));
+#else
+    imageStore(o_albedo, at, vec4(material_albedo(s.material, s.uv), float(instance)));
+    imageStore(o_emission, at, vec4(material_emission(s.material, s.uv, s.front_face), 0.0));
+#endif
+}
