@@ -28,6 +28,16 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = B_DIRECT_RAY_COUNT, std430) buffer RayCount { uint ray_count; };
+#ifdef HAS_ANALYTIC_EMITTERS
+// With pc.adaptive_shadows: what each pixel's neighbourhood saw of the emitters in this frame's
+// sub-frames so far, written at sub-frame 0 and raised to a penumbra by later ones
+// (docs/cache-frame.md §8.2).
+layout(binding = B_DIRECT_PENUMBRA, std430) buffer Penumbra { uint penumbra[]; };
+// What a pixel's neighbourhood saw of the emitters (the values of `penumbra`).
+const uint SHADOW_HIDDEN = 0u;
+const uint SHADOW_LIT = 1u;
+const uint SHADOW_PENUMBRA = 2u;
+#endif
 
 layout(push_constant) uniform Push { DirectPush pc; };
 
@@ -427,9 +437,16 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
 #ifdef HAS_SAMPLED_SOURCES
     n = max(1u, samples - n_emitters);
 #endif
+    // After sub-frame 0, where no penumbra was seen one ray tells lit from hidden: the ratio is
+    // exact there whatever the count (docs/cache-frame.md §8.2). Sub-frame k's samples start
+    // at k × n_emitters of the sequence either way.
+    uint n_shadow = n_emitters;
+    if (pc.adaptive_shadows != 0u && pc.sub_frame > 0u && penumbra[index] != SHADOW_PENUMBRA) {
+        n_shadow = 1u;
+    }
     light.unshadowed = analytic_emitter_irradiance(origin, s.shading_normal);
     if (any(greaterThan(light.unshadowed, vec3(0.0)))) {
-        emitter_ratio_sums(s, origin, pc.sub_frame * n_emitters, n_emitters, shift_light,
+        emitter_ratio_sums(s, origin, pc.sub_frame * n_emitters, n_shadow, shift_light,
                            light.sum_all, light.sum_visible);
     }
 #endif
@@ -483,35 +500,42 @@ shared vec3 s_sum_all[64];
 shared vec3 s_sum_visible[64];
 shared vec4 s_position[64];  // w: 1 for a surface pixel
 shared vec3 s_normal[64];
+shared uint s_partial[64];  // 1 where the pixel's neighbourhood saw a penumbra
 
-// The visible fraction of the emitters' light at this pixel: Σ sum_visible / Σ sum_all over the
-// pixel and the neighbours of its 3×3 block (within its 8×8 workgroup) that lie on the same
-// surface: normals within 25°, within one pixel footprint of its tangent plane and three of its
-// position (docs/cache-frame.md §8.2). Per channel; a channel no sample reached counts as hidden.
-vec3 neighbourhood_ratio(GSample g, PixelLight light) {
-    ivec2 l = ivec2(gl_LocalInvocationID.xy);
-    vec3 all_sum = light.sum_all;
-    vec3 visible = light.sum_visible;
+// Whether workgroup pixel `j` lies on the same surface as `g`: normals within 25°, within one
+// pixel footprint of its tangent plane and three of its position.
+bool same_surface(GSample g, uint j) {
+    vec3 d = s_position[j].xyz - g.position;
     float reach = 3.0 * g.footprint;
+    return s_position[j].w != 0.0 && dot(s_normal[j], g.normal) >= 0.9 &&
+           abs(dot(d, g.normal)) <= g.footprint && dot(d, d) <= reach * reach;
+}
+
+// The workgroup index of the neighbour at `offset` from this invocation, or 64 outside it.
+uint neighbour_index(ivec2 offset) {
+    ivec2 q = ivec2(gl_LocalInvocationID.xy) + offset;
+    if (any(lessThan(q, ivec2(0))) || any(greaterThan(q, ivec2(7)))) {
+        return 64u;
+    }
+    return uint(q.y * 8 + q.x);
+}
+
+// The pixel's and its same-surface 3×3 neighbours' sample sums (within its 8×8 workgroup): the
+// visible fraction of the emitters' light at the pixel is Σ sum_visible / Σ sum_all over them
+// (docs/cache-frame.md §8.2).
+void neighbourhood_sums(GSample g, PixelLight light, out vec3 all_sum, out vec3 visible) {
+    all_sum = light.sum_all;
+    visible = light.sum_visible;
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
-            ivec2 q = l + ivec2(dx, dy);
-            if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThan(q, ivec2(7)))) {
-                continue;
-            }
-            uint j = uint(q.y * 8 + q.x);
-            vec3 d = s_position[j].xyz - g.position;
-            if (s_position[j].w == 0.0 || dot(s_normal[j], g.normal) < 0.9 ||
-                abs(dot(d, g.normal)) > g.footprint || dot(d, d) > reach * reach) {
+            uint j = neighbour_index(ivec2(dx, dy));
+            if ((dx == 0 && dy == 0) || j == 64u || !same_surface(g, j)) {
                 continue;
             }
             all_sum += s_sum_all[j];
             visible += s_sum_visible[j];
         }
     }
-    return vec3(all_sum.r > 0.0 ? visible.r / all_sum.r : 0.0,
-                all_sum.g > 0.0 ? visible.g / all_sum.g : 0.0,
-                all_sum.b > 0.0 ? visible.b / all_sum.b : 0.0);
 }
 #endif
 
@@ -540,8 +564,69 @@ void main() {
     s_position[lid] = vec4(g.position, g.surface ? 1.0 : 0.0);
     s_normal[lid] = g.normal;
     barrier();
+    // With adaptive shadows, what sub-frame 0 saw here (written below): lit, hidden, or a
+    // penumbra (also where no sample reached the emitters).
+    uint seen = SHADOW_PENUMBRA;
+    if (pc.adaptive_shadows != 0u && pc.sub_frame > 0u && g.surface) {
+        seen = penumbra[uint(pixel.y) * frame.resolution.x + uint(pixel.x)];
+    }
+    bool partly_hidden = false;
+    uint own = SHADOW_HIDDEN;
     if (g.surface) {
-        e += light.unshadowed * neighbourhood_ratio(g, light);
+        vec3 all_sum, visible_sum;
+        neighbourhood_sums(g, light, all_sum, visible_sum);
+        // Per channel; a channel no sample reached takes what sub-frame 0 saw when that was
+        // light or shadow (one ray may miss an emitter that four reach), else counts as hidden.
+        float fallback = seen == SHADOW_LIT ? 1.0 : 0.0;
+        vec3 visible = vec3(all_sum.r > 0.0 ? visible_sum.r / all_sum.r : fallback,
+                            all_sum.g > 0.0 ? visible_sum.g / all_sum.g : fallback,
+                            all_sum.b > 0.0 ? visible_sum.b / all_sum.b : fallback);
+        e += light.unshadowed * visible;
+        bool reached = false, any_lit = false, any_dark = false;
+        for (int c = 0; c < 3; ++c) {
+            if (all_sum[c] > 0.0) {
+                bool lit = visible[c] >= 1.0 - 1e-4, dark = visible[c] <= 1e-4;
+                reached = true;
+                any_lit = any_lit || lit;
+                any_dark = any_dark || dark;
+                partly_hidden = partly_hidden || (!lit && !dark);
+            }
+        }
+        if (!reached) {
+            // Unknown where some light arrives unshadowed: every sample is kept.
+            own = any(greaterThan(light.unshadowed, vec3(0.0))) ? SHADOW_PENUMBRA : SHADOW_HIDDEN;
+        } else if (partly_hidden || (any_lit && any_dark)) {
+            own = SHADOW_PENUMBRA;
+        } else {
+            own = any_lit ? SHADOW_LIT : SHADOW_HIDDEN;
+        }
+    }
+    if (pc.adaptive_shadows != 0u) {
+        // A pixel whose own neighbourhood saw only light or only shadow still lends its samples
+        // to a neighbour's penumbra: it is marked too, so that the penumbra keeps all of its
+        // samples (dilation by the same 3×3 neighbourhood). Uniform control flow: the
+        // condition is a push constant.
+        // A later sub-frame that sees other than sub-frame 0 saw (light where there was
+        // shadow, or the reverse) has found a shadow boundary too.
+        bool mark = own == SHADOW_PENUMBRA || (pc.sub_frame > 0u && g.surface && own != seen);
+        s_partial[lid] = mark ? 1u : 0u;
+        barrier();
+        for (int dy = -1; dy <= 1 && g.surface && !mark; ++dy) {
+            for (int dx = -1; dx <= 1; ++dx) {
+                uint j = neighbour_index(ivec2(dx, dy));
+                if (j != 64u && s_partial[j] != 0u && same_surface(g, j)) {
+                    mark = true;
+                }
+            }
+        }
+        if (inside) {
+            uint index = uint(pixel.y) * frame.resolution.x + uint(pixel.x);
+            if (pc.sub_frame == 0u) {
+                penumbra[index] = mark ? SHADOW_PENUMBRA : own;
+            } else if (mark) {
+                penumbra[index] = SHADOW_PENUMBRA;
+            }
+        }
     }
 #endif
     if (!inside) {

@@ -16,7 +16,7 @@ struct DirectPush {
     uint sub_frame;
     uint specular_paths;
     uint radiance_cache;
-    uint pad0;
+    uint adaptive_shadows;
     uint pad1;
     uint pad2;
 };  // 32 bytes

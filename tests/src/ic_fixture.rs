@@ -139,6 +139,34 @@ impl Gpu {
         names(&self.ctx.submit(rec).unwrap().wait().unwrap())
     }
 
+    /// Runs `direct` alone on the G-buffer as it is, for sub-frame `sub_frame` of `seed`, and
+    /// returns its direct image and its ray count.
+    pub fn direct(
+        &self,
+        direct: &DirectPass,
+        samples: u32,
+        sub_frame: u32,
+        seed: u32,
+    ) -> (Vec<Px>, u64) {
+        let mut rec = self.ctx.begin("test.direct").unwrap();
+        // A read-back leaves the images in transfer layouts.
+        for image in self.gbuffer.images() {
+            rec.use_image(image, radcache_vk::ImageUse::ComputeStorage);
+        }
+        direct
+            .record(
+                &mut rec,
+                &self.scene,
+                &self.gbuffer,
+                samples,
+                sub_frame,
+                seed,
+            )
+            .unwrap();
+        self.ctx.submit(rec).unwrap().wait().unwrap();
+        (self.read(&self.gbuffer.direct), direct.rays().unwrap())
+    }
+
     pub fn read(&self, image: &radcache_vk::Image) -> Vec<Px> {
         self.ctx.read_image(image).unwrap()
     }

@@ -179,6 +179,7 @@ pub fn ic_settings(ic: &IcArgs, size: (u32, u32), seed: u32) -> Result<IcSetting
         glossy: ic.glossy_light(),
         glossy_spacing: ic.glossy_spacing(),
         emitters: ic.emitter_light(),
+        emitter_shadows: ic.emitter_shadows(),
         anti_aliasing: ic.anti_aliasing()?,
         splat: ic.splat_mode(),
         seed,

@@ -223,6 +223,10 @@ pass_bindings! {
         GLOSSY_WEIGHTS: StorageBuffer,
         /// The glossy lobe's SH table (`float[]`, read with `HAS_RADIANCE_CACHE`).
         GLOSSY_TABLE: StorageBuffer,
+        /// What each pixel's neighbourhood saw of the emitters: hidden, lit or a penumbra
+        /// (`uint[]`, with `HAS_ANALYTIC_EMITTERS` and adaptive emitter shadows;
+        /// docs/cache-frame.md §8.2).
+        PENUMBRA: StorageBuffer,
     }
 }
 

@@ -18,7 +18,9 @@
 //! sky through the records (`--emitters sampled --sky direct`; case suffix `_sampled_light`), and
 //! with adaptive anti-aliasing (suffix `_aa`; `_aa_12x36` with 12×36 strata), and splatting at
 //! every sub-frame instead of once per frame (suffixes `_splat_per_sub_frame` and
-//! `_aa_splat_per_sub_frame`), each with its direct rays, sub-frames and shade-phase time, so
+//! `_aa_splat_per_sub_frame`), and, where the emitters are taken in closed form, with a quarter
+//! of the direct samples as shadow rays at every pixel instead of adaptive emitter shadows
+//! (suffix `_fixed_shadows`), each with its direct rays, sub-frames and shade-phase time, so
 //! one run shows what they changed.
 
 /// A scene of the benchmark: name, glTF, reference, the presets timed at 256² and whether the
@@ -52,8 +54,8 @@ use anyhow::Result;
 use radcache_cache::{IcParams, Preset};
 use radcache_image::{compare, read_exr, Image};
 use radcache_render::{
-    render_ic, render_path, AntiAliasing, Budget, EmitterLight, GpuScene, IcSettings, PathSettings,
-    SkyLight, SplatMode,
+    render_ic, render_path, AntiAliasing, Budget, EmitterLight, EmitterShadows, GpuScene,
+    IcSettings, PathSettings, SkyLight, SplatMode,
 };
 use radcache_scene::{LoadOptions, Scene};
 
@@ -73,6 +75,9 @@ enum Variant {
     SplatPerSubFrame,
     /// Adaptive anti-aliasing and a splat at every sub-frame.
     AaSplatPerSubFrame,
+    /// A quarter of the direct samples as emitter shadow rays at every pixel and sub-frame
+    /// (`--emitter-shadows fixed`; scenes whose emitters are taken in closed form).
+    FixedShadows,
 }
 
 impl Variant {
@@ -84,6 +89,7 @@ impl Variant {
             Variant::AaStrata12x36 => "_aa_12x36",
             Variant::SplatPerSubFrame => "_splat_per_sub_frame",
             Variant::AaSplatPerSubFrame => "_aa_splat_per_sub_frame",
+            Variant::FixedShadows => "_fixed_shadows",
         }
     }
 }
@@ -148,6 +154,9 @@ pub fn run(args: &[&str]) -> Result<()> {
     cases.push((256, Preset::Default, AaStrata12x36));
     cases.push((256, Preset::Default, SplatPerSubFrame));
     cases.push((256, Preset::Default, AaSplatPerSubFrame));
+    if scene.plan().analytic_emitters {
+        cases.push((256, Preset::Default, FixedShadows));
+    }
     let mut matched = Vec::new(); // (case, relMSE, time) of the frames with a reference
     for (size, preset, variant) in cases {
         let mut settings = IcSettings {
@@ -173,6 +182,7 @@ pub fn run(args: &[&str]) -> Result<()> {
                 settings.anti_aliasing = Some(AntiAliasing::preset(preset));
                 settings.splat = SplatMode::PerSubFrame;
             }
+            FixedShadows => settings.emitter_shadows = EmitterShadows::Fixed,
         }
         let (out, stats) = render_ic(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
         let record_rays = stats.record_rays as f64;

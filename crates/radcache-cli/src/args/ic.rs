@@ -5,7 +5,7 @@ use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 use radcache_cache::{ErrorControl, IcParams, Preset, WeightKind};
 use radcache_render::{
-    AntiAliasing, EmitterLight, GlossyLight, GlossySpacing, SkyLight, SplatMode,
+    AntiAliasing, EmitterLight, EmitterShadows, GlossyLight, GlossySpacing, SkyLight, SplatMode,
 };
 
 /// Cache quality preset.
@@ -46,6 +46,17 @@ pub enum Emitters {
     Analytic,
     /// Light and BSDF sampling with MIS.
     Sampled,
+}
+
+/// How many shadow rays the closed-form emitters' light casts after the first sub-frame.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EmitterShadowsArg {
+    /// After the first sub-frame, a quarter of the direct samples in penumbrae (as the
+    /// sub-frames so far saw them), one ray where the emitters were wholly visible or wholly
+    /// hidden (default; docs/cache-frame.md §8.2).
+    Adaptive,
+    /// A quarter of the direct samples at every pixel.
+    Fixed,
 }
 
 /// Where glossy lobes take their indirect light from in a cache frame.
@@ -134,6 +145,10 @@ pub struct IcArgs {
     /// How the direct pass estimates the light of emissive triangles (`--method ic`).
     #[arg(long, value_enum, default_value_t = Emitters::Analytic)]
     pub emitters: Emitters,
+    /// How many shadow rays the closed-form emitters cast after the first sub-frame
+    /// (`--method ic`, `--emitters analytic`).
+    #[arg(long, value_enum, default_value_t = EmitterShadowsArg::Adaptive)]
+    pub emitter_shadows: EmitterShadowsArg,
     /// Where glossy lobes take their indirect light from (`--method ic`).
     #[arg(long, value_enum, default_value_t = Glossy::Records)]
     pub glossy: Glossy,
@@ -193,6 +208,14 @@ impl IcArgs {
         match self.emitters {
             Emitters::Analytic => EmitterLight::Analytic,
             Emitters::Sampled => EmitterLight::Sampled,
+        }
+    }
+
+    /// How many shadow rays the closed-form emitters cast after the first sub-frame.
+    pub fn emitter_shadows(&self) -> EmitterShadows {
+        match self.emitter_shadows {
+            EmitterShadowsArg::Adaptive => EmitterShadows::Adaptive,
+            EmitterShadowsArg::Fixed => EmitterShadows::Fixed,
         }
     }
 

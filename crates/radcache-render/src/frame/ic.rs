@@ -13,7 +13,9 @@ use radcache_vk::{Context, ShaderCompiler};
 
 use crate::error::{Error, Result};
 use crate::frame::path::{FrameOutput, Progress};
-use crate::frame::settings::{GlossyLight, IcDebug, IcSettings, IcStats, SplatMode};
+use crate::frame::settings::{
+    EmitterShadows, GlossyLight, IcDebug, IcSettings, IcStats, SplatMode,
+};
 use crate::passes::composite::CompositePass;
 use crate::passes::direct::DirectPass;
 use crate::passes::emission::EmissionPass;
@@ -124,6 +126,13 @@ impl IcRenderer {
                 settings.sky,
                 settings.emitters,
                 radiance,
+            )?
+            .with_adaptive_shadows(
+                ctx,
+                match settings.emitter_shadows {
+                    EmitterShadows::Adaptive => Some(w * h),
+                    EmitterShadows::Fixed => None,
+                },
             )?,
             splat: SplatPass::new(ctx, shaders, w, h)?,
             glossy,

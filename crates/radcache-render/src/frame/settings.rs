@@ -56,6 +56,9 @@ pub struct IcSettings {
     /// How the direct pass estimates the light of emissive triangles. Must be set when the
     /// renderer is created.
     pub emitters: EmitterLight,
+    /// How many shadow rays the closed-form emitters' light casts after the first sub-frame
+    /// ([`EmitterShadows`]). Must be set when the renderer is created.
+    pub emitter_shadows: EmitterShadows,
     /// Where glossy lobes take their indirect light from. Must be set when the renderer is
     /// created.
     pub glossy: GlossyLight,
@@ -180,6 +183,22 @@ impl EmitterLight {
     }
 }
 
+/// How many shadow rays the direct pass casts toward emitters whose light is in closed form
+/// ([`EmitterLight::Analytic`]; docs/cache-frame.md §8.2) in the sub-frames after the first.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum EmitterShadows {
+    /// Sub-frame 0 casts a quarter of the direct samples at every pixel and classes each pixel
+    /// by what its 3×3 neighbourhood saw: the emitters wholly visible, wholly hidden, or a
+    /// penumbra (dilated by the same neighbourhood). Later sub-frames cast one ray where the
+    /// pixel was lit or hidden, where the ratio estimator is exact whatever the count, and a
+    /// quarter of the samples in penumbrae; a sub-frame that sees a lit or hidden pixel
+    /// otherwise than sub-frame 0 did marks it a penumbra.
+    #[default]
+    Adaptive,
+    /// A quarter of the direct samples at every pixel and sub-frame.
+    Fixed,
+}
+
 /// Where the light of a constant environment (a sky) enters a frame rendered with the cache
 /// (docs/cache-frame.md §8.3).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -221,6 +240,7 @@ impl Default for IcSettings {
             time_step_s: 0.0,
             sky: SkyLight::Records,
             emitters: EmitterLight::Analytic,
+            emitter_shadows: EmitterShadows::Adaptive,
             glossy: GlossyLight::Records,
             glossy_spacing: GlossySpacing::Lobe,
             anti_aliasing: None,

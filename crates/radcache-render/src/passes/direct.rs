@@ -8,7 +8,7 @@ use radcache_vk::{
 };
 
 use crate::bindings::direct as b;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::frame::settings::{EmitterLight, SkyLight};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::splat_glossy::GlossySplatPass;
@@ -29,8 +29,11 @@ radcache_shared::gpu_struct! {
         /// 1: glossy lobes at or above `GLOSSY_ROUGHNESS_MIN` take their indirect light from the
         /// radiance records (pass built with radiance; docs/radiance-caching.md §6.2).
         pub radiance_cache: u32 => "uint",
-        /// Padding.
-        pub pad0: u32 => "uint",
+        /// 1: after sub-frame 0, pixels whose neighbourhood saw the emitters wholly visible or
+        /// wholly hidden (and no neighbour a penumbra) cast one emitter shadow ray instead of a
+        /// quarter of the samples ([`DirectPass::with_adaptive_shadows`]; docs/cache-frame.md
+        /// §8.2).
+        pub adaptive_shadows: u32 => "uint",
         /// Padding.
         pub pad1: u32 => "uint",
         /// Padding.
@@ -51,6 +54,11 @@ pub struct DirectPass {
     rays: Buffer,
     /// Bound for the glossy weights and table when the pass has no glossy splat to write for.
     placeholder: Buffer,
+    /// The emitters' light is taken in closed form (`HAS_ANALYTIC_EMITTERS`).
+    analytic: bool,
+    /// One `uint` a pixel: what its neighbourhood saw of the emitters in this frame's
+    /// sub-frames so far ([`DirectPass::with_adaptive_shadows`]).
+    penumbra: Option<Buffer>,
 }
 
 impl std::fmt::Debug for DirectPass {
@@ -86,7 +94,8 @@ impl DirectPass {
     ) -> Result<DirectPass> {
         let mut defines = scene.defines();
         defines.extend(sky.define(scene.has_constant_environment()));
-        defines.extend(emitters.define(scene.plan().analytic_emitters));
+        let analytic = emitters.define(scene.plan().analytic_emitters);
+        defines.extend(analytic);
         if radiance {
             defines.push(("HAS_RADIANCE_CACHE", "1"));
         }
@@ -122,7 +131,36 @@ impl DirectPass {
             pipeline,
             rays,
             placeholder,
+            analytic: analytic.is_some(),
+            penumbra: None,
         })
+    }
+
+    /// Makes a pass whose emitters' light is in closed form spend its emitter shadow rays
+    /// where they are needed ([`crate::EmitterShadows::Adaptive`]), for images of `pixels`
+    /// pixels (4 bytes each): sub-frame 0 casts every pixel's quarter of the samples and
+    /// stores what its 3×3 neighbourhood saw (lit, hidden, or a penumbra, dilated by the
+    /// neighbourhood); later sub-frames cast one ray at lit and hidden pixels and mark the
+    /// penumbrae their rays find (docs/cache-frame.md §8.2). Other passes are returned as they
+    /// are, and so is every pass for `pixels` `None` (a quarter of the samples always).
+    pub fn with_adaptive_shadows(
+        mut self,
+        ctx: &Context,
+        pixels: Option<u32>,
+    ) -> Result<DirectPass> {
+        if let (true, Some(pixels)) = (self.analytic, pixels) {
+            self.penumbra = Some(Buffer::new(
+                ctx,
+                &BufferDesc {
+                    name: "direct.penumbra",
+                    size: u64::from(pixels.max(1)) * 4,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                    location: MemoryLocation::GpuOnly,
+                    alignment: 0,
+                },
+            )?);
+        }
+        Ok(self)
     }
 
     /// Records `samples` estimates per pixel into the G-buffer's direct image for sub-frame
@@ -164,17 +202,30 @@ impl DirectPass {
         });
         bindings.push((b::GLOSSY_WEIGHTS, Resource::Buffer(weights)));
         bindings.push((b::GLOSSY_TABLE, Resource::Buffer(table)));
+        let (w, h) = (gbuffer.width, gbuffer.height);
+        let penumbra = self.penumbra.as_ref();
+        if let Some(buffer) = penumbra {
+            if buffer.size() < u64::from(w) * u64::from(h) * 4 {
+                return Err(Error::Invalid(format!(
+                    "the direct pass's penumbra marks hold {} pixels, the G-buffer has {w}x{h}",
+                    buffer.size() / 4
+                )));
+            }
+        }
+        bindings.push((
+            b::PENUMBRA,
+            Resource::Buffer(penumbra.unwrap_or(&self.placeholder)),
+        ));
         let push = DirectPush {
             samples: samples.max(1),
             seed,
             sub_frame,
             specular_paths: specular_paths(samples),
             radiance_cache: u32::from(glossy.is_some()),
-            pad0: 0,
+            adaptive_shadows: u32::from(penumbra.is_some()),
             pad1: 0,
             pad2: 0,
         };
-        let (w, h) = (gbuffer.width, gbuffer.height);
         rec.pass("direct", |rec| {
             rec.bind_pipeline(&self.pipeline);
             rec.push_bindings(&bindings);

@@ -40,6 +40,9 @@ pub(super) struct FrameRun<'p> {
     pub kept: u32,
     /// Records the temporal advance listed as expired (evaluated again by the look-ahead).
     pub expired: u32,
+    /// The sub-frame whose jitter the G-buffer holds for this frame's scene and view, if any:
+    /// a pass that needs that same G-buffer does not render it again.
+    pub gbuffer_at: Option<u32>,
     start: Instant,
     progress: &'p mut dyn FnMut(Progress),
 }
@@ -63,6 +66,7 @@ impl<'p> FrameRun<'p> {
             shaded: 0,
             kept: 0,
             expired: 0,
+            gbuffer_at: None,
             start: Instant::now(),
             progress,
         }
@@ -203,11 +207,16 @@ impl IcRenderer {
         let creation = self.params.for_creation();
         let creation_weights = SplatWeights::from_params(&creation);
         let seed = creation_seed(settings.seed, k);
-        let mut rec = ctx.begin("ic.gbuffer")?;
-        self.gbuffer_pass
-            .record(&mut rec, gpu, &self.gbuffer, sub_frame_jitter(k))?;
-        run.clock.submit(ctx, rec)?;
-        run.clock.lap("cache_gbuffer");
+        // A repeated pass over the same sub-frame (splatting once: sub-frame 0 alone) finds the
+        // G-buffer it needs already there.
+        if run.gbuffer_at != Some(k) {
+            let mut rec = ctx.begin("ic.gbuffer")?;
+            self.gbuffer_pass
+                .record(&mut rec, gpu, &self.gbuffer, sub_frame_jitter(k))?;
+            run.clock.submit(ctx, rec)?;
+            run.gbuffer_at = Some(k);
+            run.clock.lap("cache_gbuffer");
+        }
         for level in 0..self.params.levels {
             let selection = Instant::now();
             let mut rec = ctx.begin("ic.select")?;
@@ -301,7 +310,11 @@ impl IcRenderer {
             (SplatMode::Once, _) => CentreSamples::Match,
         };
         let mut rec = ctx.begin("ic.shade")?;
-        self.gbuffer_pass.record(&mut rec, gpu, gbuffer, jitter)?;
+        // Sub-frame 0 after a cache phase that ended on it (splatting once) has its G-buffer.
+        if run.gbuffer_at != Some(k) {
+            self.gbuffer_pass.record(&mut rec, gpu, gbuffer, jitter)?;
+            run.gbuffer_at = Some(k);
+        }
         let glossy = self.glossy();
         self.direct.record_glossy(
             &mut rec,

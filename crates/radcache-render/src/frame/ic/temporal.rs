@@ -34,6 +34,8 @@ impl IcRenderer {
         view: &CameraView,
         run: &mut FrameRun<'_>,
     ) -> Result<()> {
+        // The refresh binds the G-buffer without reading or writing it, and the scene returns
+        // to the frame's time and view below: `run.gbuffer_at` stays true.
         let (expired, stats, clock) = (run.expired, &mut run.stats, &mut run.clock);
         let t = self.temporal.as_mut().ok_or_else(no_time_step)?;
         let count = self.state.read_counters()?.record_count;
