@@ -441,16 +441,27 @@ void main() {
         }
     }
 
-    uint m = clamp(pc.m, 1u, MAX_STRATA / 3u);
-    uint n = clamp(pc.n, 3u, MAX_STRATA / m);
+    // Records requested at a level no wider than R⁻ gather with the fine strata, unless the
+    // records carry radiance blocks, which the glossy splat reads whatever the record's own
+    // pixel was (IcParams::strata_at; docs/irradiance-cache.md §2.8). A refresh takes the
+    // record's own level, hence its own strata.
+#ifdef HAS_RADIANCE_CACHE
+    bool fine = false;
+#else
+    bool fine = (g_level_subframe & 0xffffu) >= pc.fine_level;
+#endif
+    uint m = clamp(fine ? pc.fine_m : pc.m, 1u, MAX_STRATA / 3u);
+    uint n = clamp(fine ? pc.fine_n : pc.n, 3u, MAX_STRATA / m);
     uint count = m * n;
+    // The test hook's stride per request: the larger strata, whichever a record took.
+    uint stride = max(pc.m * pc.n, pc.fine_m * pc.fine_n);
     vec3 nn = normalize_or_z(g.normal);
     vec3 ng = dot(g.geometric, g.geometric) > 0.0 ? normalize(g.geometric) : nn;
     vec3 t, b;
     basis_from_normal(nn, t, b);
     vec3 origin = offset_ray_origin(g.position, ng);
     uint record_seed = ircache_hash(pixel_index ^ ircache_hash(pass_seed));
-    bool dump = uint(samples.length()) >= (request + 1u) * count;
+    bool dump = uint(samples.length()) >= (request + 1u) * stride;
     if (lid == 0u) {
         s_rays = 0u;
         s_folded = 0u;
@@ -488,7 +499,7 @@ void main() {
             s_lb[i] = l.b;
             s_r[i] = r;
             if (dump) {
-                samples[request * count + i] = vec4(l, r);
+                samples[request * stride + i] = vec4(l, r);
             }
             i = atomicAdd(s_next, 1u);
             if (i < count) {

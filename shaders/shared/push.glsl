@@ -63,9 +63,9 @@ struct RecordPush {
     float v_scale;
     float r_eps_rel;
     uint source;
-    uint pad0;
-    uint pad1;
-    uint pad2;
+    uint fine_level;
+    uint fine_m;
+    uint fine_n;
 };  // 48 bytes
 
 struct SplatWeights {

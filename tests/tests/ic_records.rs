@@ -89,7 +89,9 @@ fn check_record(
     level: u32,
     sub_frame: u32,
 ) -> RecordEstimate {
-    let (m, n) = (params.strata_m, params.strata_n);
+    // The strata of the record's level (the fine strata from `fine_level`; no radiance here).
+    let (m, n) = params.strata_at(level, false);
+    let samples = &samples[..(m * n) as usize];
     let (l, r) = split(samples);
     let est = compute_record(&l, &r, m, n, q.n, f.r_eps);
     let e = xyz(rec.irradiance);
@@ -285,7 +287,13 @@ fn cornell_records_agree_with_an_independent_estimate() {
     let a = run(&mut f, &pass_a, &points, &requests, c, 11, 1, 0);
     let again = run(&mut f, &pass_a, &points, &requests, c, 11, 1, 0);
     let b = run(&mut f, &pass_b, &points, &requests, c, 12, 4, 2);
+    // The default's coarse levels gather 16×48 strata, its fine ones (spacing ≤ R⁻) 8×24.
+    let coarse = run(&mut f, &pass_b, &points, &requests, c, 13, 2, 2);
+    assert_eq!(fine.fine_level(), 3);
+    assert_eq!(fine.strata_at(2, false), (16, 48));
+    assert_eq!(fine.strata_at(4, false), (8, 24));
     assert_eq!(a.records, again.records, "not deterministic");
+    // The test hook's stride is the larger strata's count.
     let (ca, cb) = (draft.sample_count() as usize, fine.sample_count() as usize);
     let mut bad = 0;
     for (i, q) in points.iter().enumerate() {
@@ -293,6 +301,11 @@ fn cornell_records_agree_with_an_independent_estimate() {
         let sb = &b.samples[i * cb..(i + 1) * cb];
         let ea = check_record(&f, &draft, q, &a.records[i], sa, 1, 0);
         let eb = check_record(&f, &fine, q, &b.records[i], sb, 4, 2);
+        let sc = &coarse.samples[i * cb..(i + 1) * cb];
+        check_record(&f, &fine, q, &coarse.records[i], sc, 2, 2);
+        // The fine level's strata are the draft's: the same count of samples.
+        assert_eq!(fine.strata_at(4, false), draft.strata_at(1, false));
+        let sb = &sb[..ca];
         let (sea, seb) = (standard_error(&split(sa).0), standard_error(&split(sb).0));
         let r = &a.records[i];
         let dev = (ea.e - eb.e) / (sea * sea + seb * seb).powf(0.5);
@@ -312,7 +325,8 @@ fn cornell_records_agree_with_an_independent_estimate() {
     }
     // A ray through a crack between two triangles may legitimately differ.
     assert!(bad * 200 <= points.len() * ca, "{bad} distances differ");
-    assert!(a.rays > u64::from(k) * ca as u64 && b.rays > u64::from(k) * cb as u64);
+    assert!(a.rays > u64::from(k) * ca as u64 && b.rays > u64::from(k) * ca as u64);
+    assert!(coarse.rays > u64::from(k) * cb as u64);
     assert_eq!(
         (a.counters.dropped_requests, a.counters.rejected_records),
         (0, 0)

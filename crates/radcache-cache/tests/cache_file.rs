@@ -74,6 +74,14 @@ fn reseal_header(b: &mut [u8]) {
     b[HEADER_LEN - 4..HEADER_LEN].copy_from_slice(&crc.to_le_bytes());
 }
 
+/// Clears the high halves of the strata words (bytes 56..64), as versions 1 and 2 wrote them.
+fn clear_fine_strata(b: &mut [u8]) {
+    for at in [56, 60] {
+        let w = u32::from_le_bytes(b[at..at + 4].try_into().unwrap());
+        b[at..at + 4].copy_from_slice(&(w & 0xffff).to_le_bytes());
+    }
+}
+
 fn dir() -> PathBuf {
     let d = std::env::temp_dir().join(format!("radcache-cache-file-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
@@ -149,7 +157,7 @@ fn a_file_that_is_not_a_cache_file_is_refused() {
 
 #[test]
 fn another_format_version_is_refused() {
-    for version in [0u32, 3] {
+    for version in [0u32, 4] {
         let mut b = bytes(3);
         b[8..12].copy_from_slice(&version.to_le_bytes());
         let (r, text) = refusal(&write("version.rcache", &b), &identity());
@@ -159,12 +167,12 @@ fn another_format_version_is_refused() {
                 Refusal::Version {
                     found,
                     oldest: 1,
-                    newest: 2
+                    newest: 3
                 } if found == version
             ),
             "{text}"
         );
-        assert!(text.contains("reads versions 1 to 2"), "{text}");
+        assert!(text.contains("reads versions 1 to 3"), "{text}");
     }
 }
 
@@ -350,11 +358,65 @@ fn radiance_blocks_round_trip_and_are_checked_like_the_records() {
     assert!(text.contains("payload bytes"), "{text}");
 }
 
+/// From version 3 the strata words carry the fine strata in their high halves; a version-2
+/// file's records all had `strata_m × strata_n`, which it reads as its fine strata too.
+#[test]
+fn fine_strata_round_trip_and_older_files_read_as_uniform() {
+    let mut id = identity();
+    id.params = IcParams::default();
+    assert_ne!(
+        (id.params.strata_m, id.params.strata_n),
+        (id.params.fine_strata_m, id.params.fine_strata_n)
+    );
+    let b = CacheFile::new(id, records(2)).encode();
+    let file = CacheFile::load(&write("fine.rcache", &b), &id, 4).unwrap();
+    assert_eq!(file.header.identity.params, id.params);
+    let text = file.header.describe();
+    assert!(
+        text.contains("strata_m: 16") && text.contains("fine_strata_m: 8"),
+        "{text}"
+    );
+    // The same header as version 2 with the high halves cleared, as version 2 wrote it.
+    let mut v2 = b.clone();
+    v2[8..12].copy_from_slice(&2u32.to_le_bytes());
+    clear_fine_strata(&mut v2);
+    reseal_header(&mut v2);
+    let uniform = IcParams {
+        fine_strata_m: 16,
+        fine_strata_n: 48,
+        ..id.params
+    };
+    let (r, text) = refusal(&write("v2-fine.rcache", &v2), &id);
+    assert!(matches!(r, Refusal::OtherParams(_)), "{text}");
+    assert!(
+        text.contains("fine_strata_m 16 (this render: 8)")
+            && text.contains("fine_strata_n 48 (this render: 24)"),
+        "{text}"
+    );
+    let old = CacheIdentity {
+        params: uniform,
+        ..id
+    };
+    let file = CacheFile::load(&write("v2-uniform.rcache", &v2), &old, 4).unwrap();
+    assert_eq!(file.header.identity.params, uniform);
+    // A version-3 header without fine strata is not one this build wrote.
+    let mut zero = b;
+    let w = u32::from_le_bytes(zero[56..60].try_into().unwrap());
+    zero[56..60].copy_from_slice(&(w & 0xffff).to_le_bytes());
+    reseal_header(&mut zero);
+    let (r, text) = refusal(&write("v3-zero.rcache", &zero), &id);
+    assert!(matches!(r, Refusal::Corrupt(_)), "{text}");
+    assert!(text.contains("fine strata"), "{text}");
+}
+
 #[test]
 fn a_version_1_file_is_read_and_cannot_claim_radiance_blocks() {
-    // Version 1 is version 2 without the radiance flag: the same bytes with the old number.
+    // Version 1 is version 2 without the radiance flag, and version 2 is version 3 without
+    // the fine strata: the same bytes with the old number and the strata words' high halves
+    // cleared.
     let mut v1 = bytes(4);
     v1[8..12].copy_from_slice(&1u32.to_le_bytes());
+    clear_fine_strata(&mut v1);
     reseal_header(&mut v1);
     let file = CacheFile::load(&write("v1.rcache", &v1), &identity(), 4).unwrap();
     assert_eq!(file.header.version, 1);
@@ -368,6 +430,7 @@ fn a_version_1_file_is_read_and_cannot_claim_radiance_blocks() {
     // A version-1 header with the radiance flag is not a file version 1 ever wrote.
     let mut claim = CacheFile::new(identity(), records_with_radiance(4)).encode();
     claim[8..12].copy_from_slice(&1u32.to_le_bytes());
+    clear_fine_strata(&mut claim);
     reseal_header(&mut claim);
     let (r, text) = refusal(&write("v1-claim.rcache", &claim), &identity());
     assert!(matches!(r, Refusal::Corrupt(_)), "{text}");

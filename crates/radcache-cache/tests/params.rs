@@ -29,6 +29,15 @@ fn presets_are_valid_and_ordered() {
         "R⁻ measured (params.rs), the rest §8.1"
     );
     assert_eq!((d.strata_m, d.strata_n), (8, 24), "§2.2 interactive");
+    // Fine strata (§2.8): the default's dense levels gather as the draft does; draft and high
+    // keep their own strata everywhere.
+    assert_eq!(
+        (n.fine_strata_m, n.fine_strata_n),
+        (8, 24),
+        "measured (params.rs)"
+    );
+    assert_eq!((d.fine_strata_m, d.fine_strata_n), (d.strata_m, d.strata_n));
+    assert_eq!((h.fine_strata_m, h.fine_strata_n), (h.strata_m, h.strata_n));
     assert!(d.sample_count() < n.sample_count() && n.sample_count() < h.sample_count());
     assert!(d.accuracy > n.accuracy && n.accuracy > h.accuracy);
     assert!(
@@ -36,6 +45,47 @@ fn presets_are_valid_and_ordered() {
         "high has the smallest zones"
     );
     assert!(d.max_spacing_px > n.max_spacing_px && n.max_spacing_px > h.max_spacing_px);
+}
+
+/// The fine strata start at the first level whose spacing is at most R⁻, and never where the
+/// records carry radiance blocks.
+#[test]
+fn fine_strata_follow_the_level_spacing() {
+    let n = IcParams::default();
+    // Spacings 32, 16, 8, 4, 2, 1 px against R⁻ = 4 px.
+    assert_eq!(n.fine_level(), 3);
+    for level in 0..6 {
+        let fine = level >= 3;
+        let expected = if fine { (8, 24) } else { (16, 48) };
+        assert_eq!(n.strata_at(level, false), expected, "level {level}");
+        assert_eq!(
+            n.strata_at(level, true),
+            (16, 48),
+            "radiance, level {level}"
+        );
+    }
+    // R⁻ = 1.5 px: only the 1-px level; R⁻ below every spacing: none.
+    assert_eq!(IcParams::high().fine_level(), 5);
+    let sparse = IcParams {
+        min_spacing_px: 0.5,
+        ..n
+    };
+    assert_eq!(sparse.fine_level(), 6);
+    assert_eq!(sparse.strata_at(5, false), (16, 48));
+    let wide = IcParams {
+        min_spacing_px: 40.0,
+        ..n
+    };
+    assert_eq!(wide.fine_level(), 0);
+    // with_strata: fine strata with fewer rays stay, others follow.
+    assert_eq!(n.with_strata(24, 72).strata_at(4, false), (8, 24));
+    assert_eq!(n.with_strata(24, 72).strata_at(0, false), (24, 72));
+    assert_eq!(n.with_strata(4, 12).strata_at(4, false), (4, 12));
+    let bad = IcParams {
+        fine_strata_n: 2,
+        ..n
+    };
+    assert!(!bad.is_valid());
 }
 
 #[test]

@@ -20,8 +20,10 @@
 //! every sub-frame instead of once per frame (suffixes `_splat_per_sub_frame` and
 //! `_aa_splat_per_sub_frame`), and, where the emitters are taken in closed form, with a quarter
 //! of the direct samples as shadow rays at every pixel instead of adaptive emitter shadows
-//! (suffix `_fixed_shadows`), each with its direct rays, sub-frames and shade-phase time, so
-//! one run shows what they changed.
+//! (suffix `_fixed_shadows`), and with the preset's strata at every creation level instead of the
+//! fine strata where records are as dense as `R⁻` (suffixes `_uniform_strata` and
+//! `_aa_uniform_strata`), each with its direct rays, sub-frames and shade-phase time, so one run
+//! shows what they changed.
 
 /// A scene of the benchmark: name, glTF, reference, the presets timed at 256² and whether the
 /// default is also timed at 512².
@@ -78,6 +80,10 @@ enum Variant {
     /// A quarter of the direct samples as emitter shadow rays at every pixel and sub-frame
     /// (`--emitter-shadows fixed`; scenes whose emitters are taken in closed form).
     FixedShadows,
+    /// The preset's strata at every level (`--fine-strata` = `--strata`).
+    UniformStrata,
+    /// Adaptive anti-aliasing and the preset's strata at every level.
+    AaUniformStrata,
 }
 
 impl Variant {
@@ -90,6 +96,8 @@ impl Variant {
             Variant::SplatPerSubFrame => "_splat_per_sub_frame",
             Variant::AaSplatPerSubFrame => "_aa_splat_per_sub_frame",
             Variant::FixedShadows => "_fixed_shadows",
+            Variant::UniformStrata => "_uniform_strata",
+            Variant::AaUniformStrata => "_aa_uniform_strata",
         }
     }
 }
@@ -157,6 +165,8 @@ pub fn run(args: &[&str]) -> Result<()> {
     if scene.plan().analytic_emitters {
         cases.push((256, Preset::Default, FixedShadows));
     }
+    cases.push((256, Preset::Default, UniformStrata));
+    cases.push((256, Preset::Default, AaUniformStrata));
     let mut matched = Vec::new(); // (case, relMSE, time) of the frames with a reference
     for (size, preset, variant) in cases {
         let mut settings = IcSettings {
@@ -174,8 +184,7 @@ pub fn run(args: &[&str]) -> Result<()> {
             Aa => settings.anti_aliasing = Some(AntiAliasing::preset(preset)),
             AaStrata12x36 => {
                 settings.anti_aliasing = Some(AntiAliasing::preset(preset));
-                settings.params.strata_m = 12;
-                settings.params.strata_n = 36;
+                settings.params = settings.params.with_strata(12, 36);
             }
             SplatPerSubFrame => settings.splat = SplatMode::PerSubFrame,
             AaSplatPerSubFrame => {
@@ -183,6 +192,13 @@ pub fn run(args: &[&str]) -> Result<()> {
                 settings.splat = SplatMode::PerSubFrame;
             }
             FixedShadows => settings.emitter_shadows = EmitterShadows::Fixed,
+            UniformStrata | AaUniformStrata => {
+                let p = &mut settings.params;
+                (p.fine_strata_m, p.fine_strata_n) = (p.strata_m, p.strata_n);
+                if variant == AaUniformStrata {
+                    settings.anti_aliasing = Some(AntiAliasing::preset(preset));
+                }
+            }
         }
         let (out, stats) = render_ic(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
         let record_rays = stats.record_rays as f64;

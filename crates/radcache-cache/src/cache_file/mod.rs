@@ -12,7 +12,7 @@
 //! | 12..20 | scene content hash (`radcache_scene::Scene::content_hash`, FNV-1a 64) |
 //! | 20..32 | settings: width, height (u32), time step in s (f32) |
 //! | 32..36 | CRC-32 of the settings' 12 bytes (the settings hash) |
-//! | 36..88 | [`IcParams`], 13 words in declaration order (`weight_kind` as its GLSL constant) |
+//! | 36..88 | [`IcParams`], 13 words in declaration order (`weight_kind` as its GLSL constant; from version 3 the high 16 bits of `strata_m` and `strata_n` hold `fine_strata_m` and `fine_strata_n`) |
 //! | 88..92 | record count n |
 //! | 92..96 | the renderer's frame count at export (the clock of the last-use marks and of the temporal state's frame numbers) |
 //! | 96..100 | flags (bit 0: the records carry lifespans; bit 1: they hold a constant environment's light, the sky; bit 2: the Hessian error control sized them, `IcParams::error_control`; bit 3, from version 2: the payload holds their radiance blocks) |
@@ -23,7 +23,8 @@
 //! | 124.. | payload: n `GpuRecord`, n `GpuRecordTemporal`, n last-use marks (u32), then with bit 3 n [`RadianceBlock`]s |
 //!
 //! Version 1 had no bit 3 (its records never carry radiance blocks); it is read as it was
-//! written. A file with the flag but a renderer without radiance records, or the reverse, is the
+//! written. Versions 1 and 2 had no fine strata: every record was gathered with `strata_m ×
+//! strata_n`, which a reader takes as their fine strata too. A file with the flag but a renderer without radiance records, or the reverse, is the
 //! renderer's to settle (`radcache_render::IcRenderer::import_cache`).
 //!
 //! [`CacheFile::decode`] refuses, in this order: a file that does not start with the magic, a
@@ -46,12 +47,12 @@ use crate::params::{ErrorControl, IcParams};
 pub use error::{CacheFileError, Refusal};
 pub use params::ParamValue;
 
-use params::{param_words, params_from_words};
+use params::{param_values, param_words, params_from_words};
 
 /// The first eight bytes of a cache file.
 pub const MAGIC: [u8; 8] = *b"RADCACHE";
 /// The format version this build writes.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 /// The oldest format version this build reads (version 1: no radiance blocks).
 pub const OLDEST_VERSION: u32 = 1;
 /// Bytes of the header (the payload starts here).
@@ -248,7 +249,7 @@ impl CacheFile {
         out.extend_from_slice(&h.identity.scene_hash.to_le_bytes());
         out.extend_from_slice(&h.identity.settings.bytes());
         word(&mut out, h.settings_hash);
-        for (_, w, _) in param_words(&h.identity.params) {
+        for w in param_words(&h.identity.params) {
             word(&mut out, w);
         }
         word(&mut out, h.record_count);
@@ -385,7 +386,7 @@ impl CacheHeader {
         let settings_hash = r.u32();
         let mut w = [0u32; 13];
         w.iter_mut().for_each(|w| *w = r.u32());
-        let mut params = params_from_words(&w)?;
+        let mut params = params_from_words(&w, version)?;
         let (record_count, frames, flags) = (r.u32(), r.u32(), r.u32());
         if flags & FLAG_HESSIAN != 0 {
             params.error_control = ErrorControl::Hessian;
@@ -444,11 +445,11 @@ impl CacheHeader {
                 scene: expected.scene_hash,
             });
         }
-        let mut differ: Vec<String> = param_words(&ours.params)
+        let mut differ: Vec<String> = param_values(&ours.params)
             .iter()
-            .zip(param_words(&expected.params))
-            .filter(|(a, b)| a.1 != b.1)
-            .map(|(a, b)| format!("{} {} (this render: {})", a.0, a.2, b.2))
+            .zip(param_values(&expected.params))
+            .filter(|(a, b)| a.1.bits() != b.1.bits())
+            .map(|(a, b)| format!("{} {} (this render: {})", a.0, a.1, b.1))
             .collect();
         let rule = |p: &IcParams| format!("{:?}", p.error_control);
         if ours.params.error_control != expected.params.error_control {
@@ -506,7 +507,7 @@ impl CacheHeader {
             if self.sky { "yes" } else { "no" },
             if self.radiance { "yes" } else { "no" },
         );
-        for (name, _, value) in param_words(&id.params) {
+        for (name, value) in param_values(&id.params) {
             text.push_str(&format!("  {name}: {value}\n"));
         }
         text.push_str(&format!("  error_control: {:?}\n", id.params.error_control));
@@ -515,9 +516,6 @@ impl CacheHeader {
 
     /// The cache parameters by name (for a JSON report).
     pub fn param_values(&self) -> Vec<(&'static str, ParamValue)> {
-        param_words(&self.identity.params)
-            .iter()
-            .map(|(n, _, v)| (*n, *v))
-            .collect()
+        param_values(&self.identity.params)
     }
 }

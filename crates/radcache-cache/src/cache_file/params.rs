@@ -1,5 +1,6 @@
-//! The cache parameters in a cache file's header: 13 words in declaration order, with their
-//! names for messages and reports.
+//! The cache parameters in a cache file's header: 13 words in declaration order (the strata
+//! words also carry the fine strata from format version 3), and the parameters by name for
+//! messages and reports.
 
 use super::Refusal;
 use crate::params::IcParams;
@@ -14,6 +15,16 @@ pub enum ParamValue {
     Real(f32),
 }
 
+impl ParamValue {
+    /// The value's bits: two parameters are the same when these are.
+    pub fn bits(self) -> u32 {
+        match self {
+            ParamValue::Int(v) => v,
+            ParamValue::Real(v) => v.to_bits(),
+        }
+    }
+}
+
 impl std::fmt::Display for ParamValue {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
@@ -23,11 +34,12 @@ impl std::fmt::Display for ParamValue {
     }
 }
 
-/// The cache parameters as 13 words, with their names, in declaration order.
-pub(super) fn param_words(p: &IcParams) -> [(&'static str, u32, ParamValue); 13] {
-    let f = |name, v: f32| (name, v.to_bits(), ParamValue::Real(v));
-    let u = |name, v: u32| (name, v, ParamValue::Int(v));
-    [
+/// The cache parameters by name, as reports and refusals show them: the 13 header words'
+/// fields in declaration order, then the fine strata.
+pub(super) fn param_values(p: &IcParams) -> Vec<(&'static str, ParamValue)> {
+    let f = |name, v: f32| (name, ParamValue::Real(v));
+    let u = |name, v: u32| (name, ParamValue::Int(v));
+    vec![
         u("weight_kind", p.weight_kind as u32),
         f("accuracy", p.accuracy),
         f("kappa", p.kappa),
@@ -41,14 +53,51 @@ pub(super) fn param_words(p: &IcParams) -> [(&'static str, u32, ParamValue); 13]
         f("front_tolerance_px", p.front_tolerance_px),
         f("temporal_accuracy", p.temporal_accuracy),
         f("max_age_frames", p.max_age_frames),
+        u("fine_strata_m", p.fine_strata_m),
+        u("fine_strata_n", p.fine_strata_n),
     ]
 }
 
-pub(super) fn params_from_words(w: &[u32; 13]) -> Result<IcParams, Refusal> {
+/// The cache parameters as the header's 13 words, in declaration order; from version 3 the
+/// strata words carry the fine strata in their high 16 bits.
+pub(super) fn param_words(p: &IcParams) -> [u32; 13] {
+    let packed = |coarse: u32, fine: u32| (coarse & 0xffff) | (fine << 16);
+    [
+        p.weight_kind as u32,
+        p.accuracy.to_bits(),
+        p.kappa.to_bits(),
+        p.min_spacing_px.to_bits(),
+        p.max_spacing_px.to_bits(),
+        packed(p.strata_m, p.fine_strata_m),
+        packed(p.strata_n, p.fine_strata_n),
+        p.hole_threshold.to_bits(),
+        p.levels,
+        p.creation_strictness.to_bits(),
+        p.front_tolerance_px.to_bits(),
+        p.temporal_accuracy.to_bits(),
+        p.max_age_frames.to_bits(),
+    ]
+}
+
+/// The parameters of a file of format `version`: before version 3 every record had the same
+/// strata, which are then also the fine ones.
+pub(super) fn params_from_words(w: &[u32; 13], version: u32) -> Result<IcParams, Refusal> {
     let weight_kind = WeightKind::from_u32(w[0]);
     if weight_kind as u32 != w[0] {
         return Err(Refusal::Corrupt(format!("unknown weight kind {}", w[0])));
     }
+    let (strata_m, strata_n, fine_strata_m, fine_strata_n) = if version >= 3 {
+        let (m, n) = (w[5] & 0xffff, w[6] & 0xffff);
+        let (fine_m, fine_n) = (w[5] >> 16, w[6] >> 16);
+        if fine_m == 0 || fine_n == 0 {
+            return Err(Refusal::Corrupt(format!(
+                "fine strata {fine_m}×{fine_n} in a version-{version} header"
+            )));
+        }
+        (m, n, fine_m, fine_n)
+    } else {
+        (w[5], w[6], w[5], w[6])
+    };
     let f = f32::from_bits;
     Ok(IcParams {
         weight_kind,
@@ -58,8 +107,10 @@ pub(super) fn params_from_words(w: &[u32; 13]) -> Result<IcParams, Refusal> {
         kappa: f(w[2]),
         min_spacing_px: f(w[3]),
         max_spacing_px: f(w[4]),
-        strata_m: w[5],
-        strata_n: w[6],
+        strata_m,
+        strata_n,
+        fine_strata_m,
+        fine_strata_n,
         hole_threshold: f(w[7]),
         levels: w[8],
         creation_strictness: f(w[9]),

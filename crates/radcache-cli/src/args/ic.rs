@@ -13,7 +13,7 @@ use radcache_render::{
 pub enum Quality {
     /// Fast previews (a = 0.3, 8×24 strata).
     Draft,
-    /// The default (a = 0.15, 16×48 strata).
+    /// The default (a = 0.15, 16×48 strata, 8×24 where records are at least as dense as R⁻).
     Default,
     /// Offline quality (a = 0.1, 24×72 strata).
     High,
@@ -116,9 +116,14 @@ pub struct IcArgs {
     /// Cache accuracy: Ward's a, or 1/κ for Tabellion–Lamorlette (smaller is more accurate).
     #[arg(long)]
     pub accuracy: Option<f32>,
-    /// Hemisphere strata of a record, polar × azimuthal (`--strata 16x48`); M·N ≤ 1728.
+    /// Hemisphere strata of a record, polar × azimuthal (`--strata 16x48`); M·N ≤ 1728. The
+    /// fine strata stay the preset's where they have fewer rays, else become these too.
     #[arg(long, value_name = "MxN")]
     pub strata: Option<String>,
+    /// Strata of the records requested at creation levels no wider than R⁻, in scenes without
+    /// radiance records (`--fine-strata 8x24`; docs/irradiance-cache.md §2.8).
+    #[arg(long, value_name = "MxN")]
+    pub fine_strata: Option<String>,
     /// Record validity radius bounds R⁻,R⁺ in pixels (`--spacing 2,20`).
     #[arg(long, value_name = "MIN,MAX")]
     pub spacing: Option<String>,
@@ -274,12 +279,19 @@ impl IcArgs {
             params.accuracy = a;
             params.kappa = 1.0 / a;
         }
-        if let Some(text) = &self.strata {
-            let (m, n) = pair::<u32>(&text.to_lowercase(), 'x', "--strata")?;
-            if m < 1 || n < 3 || m * n > 1728 {
-                bail!("--strata {text}: need M ≥ 1, N ≥ 3 and M·N ≤ 1728");
+        let strata = |text: &String, flag: &str| -> Result<(u32, u32)> {
+            let (m, n) = pair::<u32>(&text.to_lowercase(), 'x', flag)?;
+            if m < 1 || n < 3 || m.saturating_mul(n) > 1728 {
+                bail!("{flag} {text}: need M ≥ 1, N ≥ 3 and M·N ≤ 1728");
             }
-            (params.strata_m, params.strata_n) = (m, n);
+            Ok((m, n))
+        };
+        if let Some(text) = &self.strata {
+            let (m, n) = strata(text, "--strata")?;
+            params = params.with_strata(m, n);
+        }
+        if let Some(text) = &self.fine_strata {
+            (params.fine_strata_m, params.fine_strata_n) = strata(text, "--fine-strata")?;
         }
         if let Some(text) = &self.spacing {
             let (lo, hi) = pair::<f32>(text, ',', "--spacing")?;

@@ -209,8 +209,7 @@ pub fn ic_cases(weight: WeightKind, quick: bool, glossy: bool) -> Vec<IcCase> {
         &[(4, 12), (8, 24), (24, 72)]
     };
     for &(m, n) in strata {
-        let mut params = base;
-        (params.strata_m, params.strata_n) = (m, n);
+        let params = base.with_strata(m, n);
         cases.push(IcCase {
             ladder: Ladder::Strata,
             label: format!("strata {m}x{n}"),

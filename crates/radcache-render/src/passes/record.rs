@@ -72,12 +72,13 @@ radcache_shared::gpu_struct! {
         pub r_eps_rel: f32 => "float",
         /// 0: requests are pixels (new records); 1: requests are record indices (refresh in place).
         pub source: u32 => "uint",
-        /// Padding.
-        pub pad0: u32 => "uint",
-        /// Padding.
-        pub pad1: u32 => "uint",
-        /// Padding.
-        pub pad2: u32 => "uint",
+        /// The first creation level whose records take the fine strata (without radiance
+        /// blocks; `IcParams::fine_level`; docs/irradiance-cache.md §2.8).
+        pub fine_level: u32 => "uint",
+        /// Fine M.
+        pub fine_m: u32 => "uint",
+        /// Fine N.
+        pub fine_n: u32 => "uint",
     }
 }
 
@@ -166,11 +167,16 @@ impl RecordPass {
         radiance: bool,
         spacing: GlossySpacing,
     ) -> Result<RecordPass> {
-        let (m, n) = (params.strata_m, params.strata_n);
-        if m < 1 || n < 3 || m.saturating_mul(n) > MAX_STRATA {
-            return Err(Error::Invalid(format!(
-                "{m}×{n} strata: M ≥ 1, N ≥ 3 and at most {MAX_STRATA} in all"
-            )));
+        let strata = [
+            (params.strata_m, params.strata_n),
+            (params.fine_strata_m, params.fine_strata_n),
+        ];
+        for (m, n) in strata {
+            if m < 1 || n < 3 || m.saturating_mul(n) > MAX_STRATA {
+                return Err(Error::Invalid(format!(
+                    "{m}×{n} strata: M ≥ 1, N ≥ 3 and at most {MAX_STRATA} in all"
+                )));
+            }
         }
         let mut defines = scene.defines();
         defines.extend(sky.define(scene.has_constant_environment()));
@@ -398,9 +404,9 @@ impl RecordPass {
             v_scale: p.validity_scale(),
             r_eps_rel: R_EPS_REL,
             source: source as u32,
-            pad0: 0,
-            pad1: 0,
-            pad2: 0,
+            fine_level: p.fine_level(),
+            fine_m: p.fine_strata_m,
+            fine_n: p.fine_strata_n,
         };
         for image in gbuffer.images() {
             rec.use_image(image, ImageUse::ComputeStorage);
