@@ -301,6 +301,22 @@ fn mean_image(images: &[Vec<Px>]) -> Vec<DVec3> {
         .collect()
 }
 
+/// The emitters' light in closed form, with adaptive shadows for `pixels` pixels (`None`: a
+/// quarter of the samples at every pixel and sub-frame).
+fn analytic_pass(gpu: &Gpu, pixels: Option<u32>) -> DirectPass {
+    let direct = DirectPass::new(
+        &gpu.ctx,
+        &gpu.shaders,
+        &gpu.scene,
+        SkyLight::Direct,
+        EmitterLight::Analytic,
+    );
+    direct
+        .unwrap()
+        .with_adaptive_shadows(&gpu.ctx, pixels)
+        .unwrap()
+}
+
 /// Adaptive emitter shadows (docs/cache-frame.md §8.2) on the Cornell box: sub-frame 0 is the
 /// fixed pass's, bit for bit; later sub-frames cast far fewer shadow rays, and their mean agrees
 /// with the fixed pass's, with the CPU's estimate, and with the first sub-frame's mean.
@@ -312,20 +328,8 @@ fn adaptive_emitter_shadows_spend_rays_in_penumbrae_alone() {
     gpu.render([0.0; 2], None);
     let g = gpu.read_gbuffer();
     let cpu = cpu_direct(&scene, &g, 256);
-    let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
-    let pass = |adaptive: bool| {
-        DirectPass::new(
-            ctx,
-            shaders,
-            &gpu.scene,
-            SkyLight::Direct,
-            EmitterLight::Analytic,
-        )
-        .unwrap()
-        .with_adaptive_shadows(ctx, adaptive.then_some(w * h))
-        .unwrap()
-    };
-    let (fixed, adaptive) = (pass(false), pass(true));
+    let fixed = analytic_pass(&gpu, None);
+    let adaptive = analytic_pass(&gpu, Some(w * h));
     let (samples, seed, sub_frames) = (16, 5, 8);
     let mut runs = Vec::new();
     for direct in [&fixed, &adaptive] {
@@ -379,17 +383,7 @@ fn adaptive_emitter_shadows_are_exact_in_the_furnace() {
     let gpu = Gpu::new(&scene, None, (w, h));
     gpu.render([0.0; 2], None);
     let expected = DVec3::splat(f64::from(albedo * le));
-    let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
-    let adaptive = DirectPass::new(
-        ctx,
-        shaders,
-        &gpu.scene,
-        SkyLight::Direct,
-        EmitterLight::Analytic,
-    )
-    .unwrap()
-    .with_adaptive_shadows(ctx, Some(w * h))
-    .unwrap();
+    let adaptive = analytic_pass(&gpu, Some(w * h));
     let mut rays = Vec::new();
     for k in 0..4 {
         let (out, r) = gpu.direct(&adaptive, 16, k, 3);
