@@ -441,15 +441,11 @@ void main() {
         }
     }
 
-    // Records requested at a level no wider than R⁻ gather with the fine strata, unless the
-    // records carry radiance blocks, which the glossy splat reads whatever the record's own
-    // pixel was (IcParams::strata_at; docs/irradiance-cache.md §2.8). A refresh takes the
-    // record's own level, hence its own strata.
-#ifdef HAS_RADIANCE_CACHE
-    bool fine = false;
-#else
-    bool fine = (g_level_subframe & 0xffffu) >= pc.fine_level;
-#endif
+    // Records requested at a level no wider than R⁻ gather with the fine strata, unless they
+    // were made for a glossy lobe (RECORD_FLAG_GLOSSY), whose radiance coefficients want the
+    // samples (IcParams::strata_at; docs/irradiance-cache.md §2.8). A refresh takes the
+    // record's own level and flag, hence its own strata.
+    bool fine = (g_level_subframe & 0xffffu) >= pc.fine_level && !glossy;
     uint m = clamp(fine ? pc.fine_m : pc.m, 1u, MAX_STRATA / 3u);
     uint n = clamp(fine ? pc.fine_n : pc.n, 3u, MAX_STRATA / m);
     uint count = m * n;

@@ -89,7 +89,7 @@ fn check_record(
     level: u32,
     sub_frame: u32,
 ) -> RecordEstimate {
-    // The strata of the record's level (the fine strata from `fine_level`; no radiance here).
+    // The strata of the record's level (the fine strata from `fine_level`; no glossy lobe here).
     let (m, n) = params.strata_at(level, false);
     let samples = &samples[..(m * n) as usize];
     let (l, r) = split(samples);

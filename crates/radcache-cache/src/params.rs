@@ -100,7 +100,7 @@ pub struct IcParams {
     /// Azimuthal strata `N` (§2.2).
     pub strata_n: u32,
     /// Polar strata of the records requested at a creation level whose spacing is at most
-    /// `R⁻` ([`IcParams::fine_level`]), where records carry no radiance blocks (§2.8).
+    /// `R⁻` ([`IcParams::fine_level`]) but for those made for glossy lobes (§2.8).
     pub fine_strata_m: u32,
     /// Azimuthal strata of those records (§2.8).
     pub fine_strata_n: u32,
@@ -272,11 +272,11 @@ impl IcParams {
             .unwrap_or(self.levels)
     }
 
-    /// The strata `(M, N)` of a record requested at creation level `level`; `radiance`: the
-    /// records carry radiance blocks (which the glossy splat reads wherever the record was
-    /// made), and every one keeps `strata_m × strata_n` (§2.8).
-    pub fn strata_at(&self, level: u32, radiance: bool) -> (u32, u32) {
-        if level >= self.fine_level() && !radiance {
+    /// The strata `(M, N)` of a record requested at creation level `level`; `glossy`: it is
+    /// made for a glossy lobe from the cache (`RECORD_FLAG_GLOSSY`), whose radiance
+    /// coefficients keep `strata_m × strata_n` at every level (§2.8).
+    pub fn strata_at(&self, level: u32, glossy: bool) -> (u32, u32) {
+        if level >= self.fine_level() && !glossy {
             (self.fine_strata_m, self.fine_strata_n)
         } else {
             (self.strata_m, self.strata_n)

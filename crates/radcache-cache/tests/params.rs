@@ -47,8 +47,8 @@ fn presets_are_valid_and_ordered() {
     assert!(d.max_spacing_px > n.max_spacing_px && n.max_spacing_px > h.max_spacing_px);
 }
 
-/// The fine strata start at the first level whose spacing is at most R⁻, and never where the
-/// records carry radiance blocks.
+/// The fine strata start at the first level whose spacing is at most R⁻, and never for records
+/// made for glossy lobes.
 #[test]
 fn fine_strata_follow_the_level_spacing() {
     let n = IcParams::default();

@@ -120,8 +120,8 @@ pub struct IcArgs {
     /// fine strata stay the preset's where they have fewer rays, else become these too.
     #[arg(long, value_name = "MxN")]
     pub strata: Option<String>,
-    /// Strata of the records requested at creation levels no wider than R⁻, in scenes without
-    /// radiance records (`--fine-strata 8x24`; docs/irradiance-cache.md §2.8).
+    /// Strata of the records requested at creation levels no wider than R⁻, but those made for
+    /// glossy lobes (`--fine-strata 8x24`; docs/irradiance-cache.md §2.8).
     #[arg(long, value_name = "MxN")]
     pub fine_strata: Option<String>,
     /// Record validity radius bounds R⁻,R⁺ in pixels (`--spacing 2,20`).

@@ -72,8 +72,8 @@ radcache_shared::gpu_struct! {
         pub r_eps_rel: f32 => "float",
         /// 0: requests are pixels (new records); 1: requests are record indices (refresh in place).
         pub source: u32 => "uint",
-        /// The first creation level whose records take the fine strata (without radiance
-        /// blocks; `IcParams::fine_level`; docs/irradiance-cache.md §2.8).
+        /// The first creation level whose records take the fine strata (but those made for
+        /// glossy lobes; `IcParams::fine_level`; docs/irradiance-cache.md §2.8).
         pub fine_level: u32 => "uint",
         /// Fine M.
         pub fine_m: u32 => "uint",
