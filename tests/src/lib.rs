@@ -4,6 +4,7 @@
 //! Tests run with the Khronos validation layer on (unless `RADCACHE_VALIDATION=0` is set by
 //! hand); a missing layer fails the test instead of silently running unvalidated.
 
+pub mod direct_cpu;
 pub mod geometry;
 pub mod ic_fixture;
 pub mod record_fixture;
