@@ -33,11 +33,11 @@ layout(binding = B_DIRECT_RAY_COUNT, std430) buffer RayCount { uint ray_count; }
 // sub-frames so far, written at sub-frame 0 and raised to a penumbra by later ones
 // (docs/cache-frame.md §8.2).
 layout(binding = B_DIRECT_PENUMBRA, std430) buffer Penumbra { uint penumbra[]; };
+#endif
 // What a pixel's neighbourhood saw of the emitters (the values of `penumbra`).
 const uint SHADOW_HIDDEN = 0u;
 const uint SHADOW_LIT = 1u;
 const uint SHADOW_PENUMBRA = 2u;
-#endif
 
 layout(push_constant) uniform Push { DirectPush pc; };
 
@@ -406,6 +406,7 @@ struct PixelLight {
     vec3 unshadowed;
     vec3 sum_all;
     vec3 sum_visible;
+    uint seen;  // with adaptive shadows after sub-frame 0: what sub-frame 0 saw (SHADOW_*)
 };
 
 PixelLight pixel_light(GSample g, ivec2 pixel) {
@@ -422,6 +423,7 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     light.unshadowed = vec3(0.0);
     light.sum_all = vec3(0.0);
     light.sum_visible = vec3(0.0);
+    light.seen = SHADOW_PENUMBRA;
     uint samples = max(pc.samples, 1u);
     Rng rng = rng_init(index, 0xffffffffu, pc.seed);
     float shift_pick = rng_next(rng);
@@ -440,10 +442,10 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     // After sub-frame 0, where no penumbra was seen one ray tells lit from hidden: the ratio is
     // exact there whatever the count (docs/cache-frame.md §8.2). Sub-frame k's samples start
     // at k × n_emitters of the sequence either way.
-    uint n_shadow = n_emitters;
-    if (pc.adaptive_shadows != 0u && pc.sub_frame > 0u && penumbra[index] != SHADOW_PENUMBRA) {
-        n_shadow = 1u;
+    if (pc.adaptive_shadows != 0u && pc.sub_frame > 0u) {
+        light.seen = penumbra[index];
     }
+    uint n_shadow = light.seen == SHADOW_PENUMBRA ? n_emitters : 1u;
     light.unshadowed = analytic_emitter_irradiance(origin, s.shading_normal);
     if (any(greaterThan(light.unshadowed, vec3(0.0)))) {
         emitter_ratio_sums(s, origin, pc.sub_frame * n_emitters, n_shadow, shift_light,
@@ -500,7 +502,7 @@ shared vec3 s_sum_all[64];
 shared vec3 s_sum_visible[64];
 shared vec4 s_position[64];  // w: 1 for a surface pixel
 shared vec3 s_normal[64];
-shared uint s_partial[64];  // 1 where the pixel's neighbourhood saw a penumbra
+shared uint s_partial[64];  // 1 where the pixel is marked a penumbra (before dilation)
 
 // Whether workgroup pixel `j` lies on the same surface as `g`: normals within 25°, within one
 // pixel footprint of its tangent plane and three of its position.
@@ -552,6 +554,7 @@ void main() {
     light.unshadowed = vec3(0.0);
     light.sum_all = vec3(0.0);
     light.sum_visible = vec3(0.0);
+    light.seen = SHADOW_PENUMBRA;
     if (g.surface) {
         light = pixel_light(g, pixel);
     }
@@ -564,25 +567,20 @@ void main() {
     s_position[lid] = vec4(g.position, g.surface ? 1.0 : 0.0);
     s_normal[lid] = g.normal;
     barrier();
-    // With adaptive shadows, what sub-frame 0 saw here (written below): lit, hidden, or a
-    // penumbra (also where no sample reached the emitters).
-    uint seen = SHADOW_PENUMBRA;
-    if (pc.adaptive_shadows != 0u && pc.sub_frame > 0u && g.surface) {
-        seen = penumbra[uint(pixel.y) * frame.resolution.x + uint(pixel.x)];
-    }
-    bool partly_hidden = false;
+    // What this sub-frame's pooled samples say: lit, hidden, or a penumbra (also where no
+    // sample reached emitters whose unshadowed light is not zero).
     uint own = SHADOW_HIDDEN;
     if (g.surface) {
         vec3 all_sum, visible_sum;
         neighbourhood_sums(g, light, all_sum, visible_sum);
         // Per channel; a channel no sample reached takes what sub-frame 0 saw when that was
         // light or shadow (one ray may miss an emitter that four reach), else counts as hidden.
-        float fallback = seen == SHADOW_LIT ? 1.0 : 0.0;
+        float fallback = light.seen == SHADOW_LIT ? 1.0 : 0.0;
         vec3 visible = vec3(all_sum.r > 0.0 ? visible_sum.r / all_sum.r : fallback,
                             all_sum.g > 0.0 ? visible_sum.g / all_sum.g : fallback,
                             all_sum.b > 0.0 ? visible_sum.b / all_sum.b : fallback);
         e += light.unshadowed * visible;
-        bool reached = false, any_lit = false, any_dark = false;
+        bool reached = false, any_lit = false, any_dark = false, partly_hidden = false;
         for (int c = 0; c < 3; ++c) {
             if (all_sum[c] > 0.0) {
                 bool lit = visible[c] >= 1.0 - 1e-4, dark = visible[c] <= 1e-4;
@@ -602,13 +600,12 @@ void main() {
         }
     }
     if (pc.adaptive_shadows != 0u) {
-        // A pixel whose own neighbourhood saw only light or only shadow still lends its samples
-        // to a neighbour's penumbra: it is marked too, so that the penumbra keeps all of its
-        // samples (dilation by the same 3×3 neighbourhood). Uniform control flow: the
-        // condition is a push constant.
-        // A later sub-frame that sees other than sub-frame 0 saw (light where there was
-        // shadow, or the reverse) has found a shadow boundary too.
-        bool mark = own == SHADOW_PENUMBRA || (pc.sub_frame > 0u && g.surface && own != seen);
+        // Uniform control flow: the condition is a push constant. A later sub-frame that sees
+        // other than sub-frame 0 saw (light where there was shadow, or the reverse) has found a
+        // shadow boundary too. A pixel whose own neighbourhood saw only light or only shadow
+        // still lends its samples to a neighbour's penumbra: it is marked too, so that the
+        // penumbra keeps all of its samples (dilation by the same 3×3 neighbourhood).
+        bool mark = own == SHADOW_PENUMBRA || (pc.sub_frame > 0u && g.surface && own != light.seen);
         s_partial[lid] = mark ? 1u : 0u;
         barrier();
         for (int dy = -1; dy <= 1 && g.surface && !mark; ++dy) {
