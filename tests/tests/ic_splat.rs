@@ -1,6 +1,6 @@
 //! The cache's splat, hole-selection, counter and neighbour-clamping passes on lavapipe, against
 //! the CPU twins of radcache-cache, on a synthetic G-buffer (every pixel the same surface point),
-//! so each expected value is exact.
+//! so each expected value is exact; and the splat quads' bound on the Cornell box's own G-buffer.
 
 use glam::Vec3;
 use radcache_cache::{extrapolate_irradiance, record_weight, IcParams, WeightKind};
@@ -10,7 +10,8 @@ use radcache_render::{
 };
 use radcache_scene::{LoadOptions, Scene};
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
-use radcache_tests::{context, finish, shaders};
+use radcache_tests::ic_fixture::Gpu;
+use radcache_tests::{context, finish, shaders, Rng};
 use radcache_vk::{Context, ImageUse, Recorder};
 
 const W: u32 = 32;
@@ -216,6 +217,113 @@ fn splat_sums_match_the_cpu_weight_and_extrapolation() {
         }
     }
     end(f);
+}
+
+/// The splat quad bounds a record's zone by two square frusta on its tangent plane
+/// (`splat.vert`), tighter than the ball's box on surfaces seen at an angle: on the Cornell box's
+/// G-buffer (floor, ceiling and side walls seen obliquely, corners where zones reach another
+/// surface), Σw of records at random pixels, with random radii and normals tilted up to ~25°,
+/// equals the CPU's sum over every record at every pixel. A quad that missed a pixel of its
+/// zone would lose that record's weight there.
+#[test]
+fn splat_quads_cover_every_pixel_of_each_zone() {
+    let scene = cornell();
+    let (w, h) = (96, 72);
+    let gpu = Gpu::with_gbuffer(&scene, None, (w, h), Some(false));
+    let splat = SplatPass::new(&gpu.ctx, &gpu.shaders, w, h).unwrap();
+    let state = IcState::new(&gpu.ctx, &gpu.shaders, 64, 1024).unwrap();
+    gpu.render([0.0, 0.0], None);
+    let g = gpu.read_gbuffer();
+    let params = IcParams::default();
+    let weights = SplatWeights::from_params(&params);
+    let surface: Vec<usize> = (0..g.position.len())
+        .filter(|&i| g.position[i][3] > 0.0)
+        .collect();
+    let mut rng = Rng::new(17);
+    let at = |v: [f32; 4]| Vec3::from_slice(&v[..3]);
+    let recs: Vec<GpuRecord> = (0..48)
+        .map(|_| {
+            let i = surface[rng.below(surface.len() as u32) as usize];
+            let tilt = Vec3::new(
+                rng.range(-0.2, 0.2),
+                rng.range(-0.2, 0.2),
+                rng.range(-0.2, 0.2),
+            );
+            let n = (at(g.normal[i]) + tilt).normalize();
+            // Zones of about 2 to 30 pixels.
+            let r = g.normal[i][3] * rng.range(2.0, 30.0);
+            record(
+                at(g.position[i]),
+                n,
+                Vec3::new(1.0, 0.5, 0.25),
+                r,
+                [Vec3::ZERO; 3],
+            )
+        })
+        .collect();
+    let mut rec = gpu.ctx.begin("test.splat_bounds").unwrap();
+    set_state(&mut rec, &state, &recs, counters(recs.len() as u32, 0));
+    for image in gpu.gbuffer.images() {
+        rec.use_image(image, ImageUse::ComputeStorage);
+    }
+    splat
+        .record(
+            &mut rec,
+            "splat",
+            SplatScope::All,
+            &gpu.scene,
+            &gpu.gbuffer,
+            &state,
+            &weights,
+        )
+        .unwrap();
+    gpu.ctx.submit(rec).unwrap().wait().unwrap();
+    let sums: Vec<[f32; 4]> = gpu.ctx.read_image(&splat.sum).unwrap();
+    let (mut reached, mut oblique) = (0, 0);
+    for &i in &surface {
+        let (p, n) = (at(g.position[i]), at(g.normal[i]));
+        let tol = params.front_tolerance_px * g.normal[i][3];
+        let expected: f32 = recs
+            .iter()
+            .map(|r| {
+                let (p_i, n_i) = (at(r.position_radius), at(r.normal_rorig));
+                let w = record_weight(
+                    params.weight_kind,
+                    p,
+                    n,
+                    p_i,
+                    n_i,
+                    r.position_radius[3],
+                    params.weight_param(),
+                    tol,
+                );
+                // Where the ball's box is needed: the record's plane at a steep angle to the
+                // view (the camera looks along −z).
+                if w > 0.0 && n_i.z.abs() < 0.5 {
+                    oblique += 1;
+                }
+                w
+            })
+            .sum();
+        reached += usize::from(expected > 0.0);
+        let got = sums[i][3];
+        assert!(
+            (got - expected).abs() <= 1e-4 * expected.max(1.0),
+            "pixel {i}: GPU Σw {got}, CPU {expected}"
+        );
+    }
+    eprintln!(
+        "{reached} of {} pixels reached; {oblique} oblique weights",
+        surface.len()
+    );
+    assert!(
+        reached > surface.len() / 10,
+        "{reached} of {} pixels reached",
+        surface.len()
+    );
+    assert!(oblique > 100, "{oblique} oblique weights");
+    drop((splat, state));
+    gpu.end();
 }
 
 #[test]

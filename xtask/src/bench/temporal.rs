@@ -1,5 +1,5 @@
 //! `cargo xtask bench temporal [--frames N] [--size S] [--preset P] [--reference-frames K]
-//! [--reference-spp SPP]`: temporal radiance caching on the bundled animated scene
+//! [--reference-spp SPP] [--temporal-accuracy A] [--max-age F] [--dump DIR]`: temporal radiance caching on the bundled animated scene
 //! (`assets/animated`: the camera flies in, a box slides and turns, a cube bounces).
 //!
 //! The sequence (frames 1 … N at 24 fps, time (f − 1)/24 s, default 60 frames at 256², draft) is
@@ -13,11 +13,13 @@
 //! does not have, relative to the reference's RMS). The reference's own noise adds to both
 //! figures; a second path-traced sequence with other seeds measures it (its error and squared
 //! flicker against the reference are twice the reference's own), and the runs' own figures are
-//! given net of it.
+//! given net of it. `--temporal-accuracy` and `--max-age` override the preset's `a_t` and `Δt_max`
+//! (docs/temporal.md §3.3); `--dump DIR` writes the frames the reference covers (kept, rebuilt,
+//! reference) as EXR files there, to see where the errors are.
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context as _, Result};
 use radcache_cache::{IcParams, Preset};
-use radcache_image::{compare, flicker, Image};
+use radcache_image::{compare, flicker, write_exr, ExrOptions, Image, Metadata};
 use radcache_render::{
     render_path, Budget, FrameOutput, GpuScene, IcRenderer, IcSettings, PathSettings,
 };
@@ -34,6 +36,22 @@ struct Options {
     preset: Preset,
     reference_frames: u32,
     reference_spp: u32,
+    temporal_accuracy: Option<f32>,
+    max_age: Option<f32>,
+    dump: Option<std::path::PathBuf>,
+}
+
+impl Options {
+    fn params(&self) -> IcParams {
+        let mut p = IcParams::preset(self.preset);
+        if let Some(a) = self.temporal_accuracy {
+            p.temporal_accuracy = a;
+        }
+        if let Some(f) = self.max_age {
+            p.max_age_frames = f;
+        }
+        p
+    }
 }
 
 fn parse(args: &[&str]) -> Result<Options> {
@@ -43,6 +61,9 @@ fn parse(args: &[&str]) -> Result<Options> {
         preset: Preset::Draft,
         reference_frames: 4,
         reference_spp: 512,
+        temporal_accuracy: None,
+        max_age: None,
+        dump: None,
     };
     let mut it = args.iter();
     while let Some(&a) = it.next() {
@@ -54,6 +75,9 @@ fn parse(args: &[&str]) -> Result<Options> {
             "--size" => o.size = v.parse()?,
             "--reference-frames" => o.reference_frames = v.parse()?,
             "--reference-spp" => o.reference_spp = v.parse()?,
+            "--temporal-accuracy" => o.temporal_accuracy = Some(v.parse()?),
+            "--max-age" => o.max_age = Some(v.parse()?),
+            "--dump" => o.dump = Some(v.into()),
             "--preset" => {
                 o.preset = match v {
                     "draft" => Preset::Draft,
@@ -116,7 +140,7 @@ fn run_sequence(
     let settings = |frame: u32| IcSettings {
         width: o.size,
         height: o.size,
-        params: IcParams::preset(o.preset),
+        params: o.params(),
         seed: 1,
         frame,
         time: (frame - 1) as f32 / FPS,
@@ -180,8 +204,12 @@ pub fn run(args: &[&str]) -> Result<()> {
         o.frames,
         o.size
     );
+    anyhow::ensure!(
+        o.params().is_valid(),
+        "invalid temporal accuracy or maximum age"
+    );
     let warm = IcSettings {
-        params: IcParams::preset(o.preset),
+        params: o.params(),
         time_step_s: 1.0 / FPS,
         ..IcSettings::default()
     };
@@ -209,6 +237,24 @@ pub fn run(args: &[&str]) -> Result<()> {
             let out = render_path(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
             into.push(image(&out)?);
         }
+    }
+    if let Some(dir) = &o.dump {
+        std::fs::create_dir_all(dir)?;
+        for (label, images) in [
+            ("kept", &kept.images),
+            ("rebuilt", &rebuilt.images),
+            ("reference", &references),
+        ] {
+            for (frame, img) in range.clone().zip(images) {
+                let path = dir.join(format!("{label}_{frame:04}.exr"));
+                write_exr(&path, img, &Metadata::default(), &ExrOptions::default())
+                    .with_context(|| format!("writing {}", path.display()))?;
+            }
+        }
+        println!(
+            "wrote the kept, rebuilt and reference frames to {}",
+            dir.display()
+        );
     }
     let mut twin_relmse = 0.0;
     for (img, reference) in twins.iter().zip(&references) {

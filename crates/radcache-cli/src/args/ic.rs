@@ -130,6 +130,15 @@ pub struct IcArgs {
     /// Σw (in units of one full record) below which a pixel is a hole that gets a record.
     #[arg(long)]
     pub hole_threshold: Option<f32>,
+    /// Temporal accuracy `a_t` of records kept across frames with moving geometry or lights: a
+    /// record is evaluated again once its light may have changed by this fraction (smaller is
+    /// more accurate); default 0.1 (draft), 0.05 (default), 0.02 (high); docs/temporal.md §3.3.
+    #[arg(long, value_name = "A_T")]
+    pub temporal_accuracy: Option<f32>,
+    /// The longest life of a record kept across frames with moving geometry or lights, in
+    /// frames (`Δt_max`); default 20 (draft), 30 (default), 15 (high); docs/temporal.md §3.3.
+    #[arg(long, value_name = "FRAMES")]
+    pub max_age: Option<f32>,
     /// Jittered sub-frames of the cache (anti-aliasing); default 8.
     #[arg(long)]
     pub sub_frames: Option<u32>,
@@ -306,9 +315,67 @@ impl IcArgs {
             }
             params.hole_threshold = t;
         }
+        if let Some(a) = self.temporal_accuracy {
+            if !(a.is_finite() && a > 0.0) {
+                bail!("--temporal-accuracy must be a positive number, got {a}");
+            }
+            params.temporal_accuracy = a;
+        }
+        if let Some(f) = self.max_age {
+            if !(f.is_finite() && f >= 1.0) {
+                bail!("--max-age must be at least 1 frame, got {f}");
+            }
+            params.max_age_frames = f;
+        }
         if !params.is_valid() {
             bail!("invalid cache parameters: {params:?}");
         }
         Ok(params)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        ic: IcArgs,
+    }
+
+    fn params(args: &[&str]) -> Result<IcParams> {
+        let cli = Cli::try_parse_from(std::iter::once("radcache").chain(args.iter().copied()))?;
+        cli.ic.params()
+    }
+
+    #[test]
+    fn temporal_accuracy_and_max_age_override_the_preset() {
+        let draft = IcParams::preset(Preset::Draft);
+        let p = params(&["--quality", "draft"]).unwrap();
+        assert_eq!(
+            (p.temporal_accuracy, p.max_age_frames),
+            (draft.temporal_accuracy, draft.max_age_frames)
+        );
+        let p = params(&[
+            "--quality",
+            "draft",
+            "--temporal-accuracy",
+            "0.03",
+            "--max-age",
+            "10",
+        ])
+        .unwrap();
+        assert_eq!((p.temporal_accuracy, p.max_age_frames), (0.03, 10.0));
+        for (flag, bad) in [
+            ("--temporal-accuracy", "0"),
+            ("--temporal-accuracy", "NaN"),
+            ("--max-age", "0.5"),
+            ("--max-age", "inf"),
+        ] {
+            let err = params(&[flag, bad]).unwrap_err().to_string();
+            assert!(err.contains(flag), "{flag} {bad}: {err}");
+        }
     }
 }
