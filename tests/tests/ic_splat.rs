@@ -51,6 +51,21 @@ fn record(p: Vec3, n: Vec3, e: Vec3, r: f32, grad_r: [Vec3; 3]) -> GpuRecord {
     }
 }
 
+/// The CPU twin's weight of record `r` at the G-buffer point `(p, n)` of pixel footprint
+/// `footprint`, with the in-front tolerance the splat uses.
+fn cpu_weight(params: &IcParams, r: &GpuRecord, p: Vec3, n: Vec3, footprint: f32) -> f32 {
+    record_weight(
+        params.weight_kind,
+        p,
+        n,
+        Vec3::from_slice(&r.position_radius[..3]),
+        Vec3::from_slice(&r.normal_rorig[..3]),
+        r.position_radius[3],
+        params.weight_param(),
+        params.front_tolerance_px * footprint,
+    )
+}
+
 /// Fills every G-buffer pixel with the surface point (P, N).
 fn fill_gbuffer(rec: &mut Recorder, g: &GBuffer) {
     let values = [
@@ -179,17 +194,7 @@ fn splat_sums_match_the_cpu_weight_and_extrapolation() {
     for r in &recs {
         let p_i = Vec3::from_slice(&r.position_radius[..3]);
         let n_i = Vec3::from_slice(&r.normal_rorig[..3]);
-        let tol = params.front_tolerance_px * FOOTPRINT;
-        let w = record_weight(
-            params.weight_kind,
-            P,
-            N,
-            p_i,
-            n_i,
-            r.position_radius[3],
-            params.weight_param(),
-            tol,
-        );
+        let w = cpu_weight(&params, r, P, N, FOOTPRINT);
         assert!(w > 0.0, "the test records must contribute");
         let g = |v: [f32; 4]| Vec3::from_slice(&v[..3]);
         let e = extrapolate_irradiance(
@@ -282,24 +287,13 @@ fn splat_quads_cover_every_pixel_of_each_zone() {
     let (mut reached, mut oblique) = (0, 0);
     for &i in &surface {
         let (p, n) = (at(g.position[i]), at(g.normal[i]));
-        let tol = params.front_tolerance_px * g.normal[i][3];
         let expected: f32 = recs
             .iter()
             .map(|r| {
-                let (p_i, n_i) = (at(r.position_radius), at(r.normal_rorig));
-                let w = record_weight(
-                    params.weight_kind,
-                    p,
-                    n,
-                    p_i,
-                    n_i,
-                    r.position_radius[3],
-                    params.weight_param(),
-                    tol,
-                );
-                // Where the ball's box is needed: the record's plane at a steep angle to the
-                // view (the camera looks along −z).
-                if w > 0.0 && n_i.z.abs() < 0.5 {
+                let w = cpu_weight(&params, r, p, n, g.normal[i][3]);
+                // Records whose plane the view sees at an angle (the camera looks along the z
+                // axis), where the frusta's rectangle is much smaller than the ball's box.
+                if w > 0.0 && r.normal_rorig[2].abs() < 0.5 {
                     oblique += 1;
                 }
                 w

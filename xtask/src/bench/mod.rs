@@ -28,7 +28,7 @@ pub fn run(args: &[&str]) -> Result<()> {
             "usage: cargo xtask bench rays [--rays N] | pt [--spp N] | ic [--scene cornell|courtyard] \
              | scaling [--scene cornell|courtyard] [--preset draft|default|high] [--max-size N] \
              | temporal [--frames N] [--size S] [--preset P] [--reference-frames K] \
-             [--reference-spp SPP] \
+             [--reference-spp SPP] [--temporal-accuracy A] [--max-age F] [--dump DIR] \
              | peer [--scenes a,b,..] [--reference-spp N] [--height H] [--radcache-ref SCENE=FILE.exr]"
         ),
     }

@@ -1,6 +1,7 @@
 //! `cargo xtask bench temporal [--frames N] [--size S] [--preset P] [--reference-frames K]
-//! [--reference-spp SPP] [--temporal-accuracy A] [--max-age F] [--dump DIR]`: temporal radiance caching on the bundled animated scene
-//! (`assets/animated`: the camera flies in, a box slides and turns, a cube bounces).
+//! [--reference-spp SPP] [--temporal-accuracy A] [--max-age F] [--dump DIR]`: temporal radiance
+//! caching on the bundled animated scene (`assets/animated`: the camera flies in, a box slides
+//! and turns, a cube bounces).
 //!
 //! The sequence (frames 1 … N at 24 fps, time (f − 1)/24 s, default 60 frames at 256², draft) is
 //! rendered twice with the irradiance cache: **kept** records (temporal caching: records follow
@@ -14,7 +15,7 @@
 //! figures; a second path-traced sequence with other seeds measures it (its error and squared
 //! flicker against the reference are twice the reference's own), and the runs' own figures are
 //! given net of it. `--temporal-accuracy` and `--max-age` override the preset's `a_t` and `Δt_max`
-//! (docs/temporal.md §3.3); `--dump DIR` writes the frames the reference covers (kept, rebuilt,
+//! (docs/temporal.md §3.3; the case names gain `_at<A>` and `_age<F>`); `--dump DIR` writes the frames the reference covers (kept, rebuilt,
 //! reference) as EXR files there, to see where the errors are.
 
 use anyhow::{bail, Context as _, Result};
@@ -92,6 +93,11 @@ fn parse(args: &[&str]) -> Result<Options> {
     anyhow::ensure!(
         o.frames >= 2 && o.reference_frames >= 2 && o.reference_frames <= o.frames,
         "need at least 2 frames and 2 ≤ reference frames ≤ frames"
+    );
+    anyhow::ensure!(
+        o.temporal_accuracy.is_none_or(|a| a.is_finite() && a > 0.0)
+            && o.max_age.is_none_or(|f| f.is_finite() && f >= 1.0),
+        "--temporal-accuracy must be positive and --max-age at least 1 frame"
     );
     Ok(o)
 }
@@ -204,10 +210,6 @@ pub fn run(args: &[&str]) -> Result<()> {
         o.frames,
         o.size
     );
-    anyhow::ensure!(
-        o.params().is_valid(),
-        "invalid temporal accuracy or maximum age"
-    );
     let warm = IcSettings {
         params: o.params(),
         time_step_s: 1.0 / FPS,
@@ -270,7 +272,13 @@ pub fn run(args: &[&str]) -> Result<()> {
         ref_flicker2.sqrt()
     );
 
-    let case = format!("animated_{}_{name}_{}f", o.size, o.frames);
+    let mut case = format!("animated_{}_{name}_{}f", o.size, o.frames);
+    if let Some(a) = o.temporal_accuracy {
+        case += &format!("_at{a}");
+    }
+    if let Some(f) = o.max_age {
+        case += &format!("_age{f}");
+    }
     let mut figures = Vec::new();
     println!(
         "| run | s/frame (after 1st) | record rays/frame | all rays/frame | created | refreshed | \
