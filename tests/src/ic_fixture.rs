@@ -289,9 +289,27 @@ pub fn faces_scene() -> Scene {
     write_and_load(&b, &temp_dir("ic-passes-faces"), "faces")
 }
 
+/// The pipeline of `shaders/tests/gbuffer_fill.comp`, for [`fill_gbuffer_points`].
+pub fn gbuffer_fill_pipeline(
+    ctx: &radcache_vk::Context,
+    shaders: &radcache_vk::ShaderCompiler,
+) -> radcache_vk::Pipeline {
+    use radcache_vk::{BindingKind, BindingLayout};
+    let spirv = shaders.compile("tests/gbuffer_fill.comp", &[]).unwrap();
+    let image = |b| BindingLayout::new(b, BindingKind::StorageImage);
+    let layout = [
+        image(0),
+        image(1),
+        image(2),
+        BindingLayout::new(3, BindingKind::StorageBuffer),
+        image(4),
+    ];
+    radcache_vk::Pipeline::compute(ctx, "gbuffer_fill", &spirv, &layout, 4).unwrap()
+}
+
 /// Records clearing `g` and writing `count` surface points from `texels` into its position,
-/// normal and geometric images with the `shaders/tests/gbuffer_fill.comp` pipeline `fill`
-/// (bindings 0–2 the images, 3 the texels; push constant: the count).
+/// normal, geometric and emission images with the pipeline of [`gbuffer_fill_pipeline`]
+/// (push constant: the count).
 pub fn fill_gbuffer_points(
     rec: &mut radcache_vk::Recorder,
     fill: &radcache_vk::Pipeline,
@@ -304,7 +322,7 @@ pub fn fill_gbuffer_points(
         rec.use_image(image, ImageUse::TransferDst);
         rec.clear_color(image, [0.0; 4]);
     }
-    for image in [&g.position, &g.normal, &g.geometric] {
+    for image in [&g.position, &g.normal, &g.geometric, &g.emission] {
         rec.use_image(image, ImageUse::ComputeStorage);
     }
     rec.bind_pipeline(fill);
@@ -313,6 +331,7 @@ pub fn fill_gbuffer_points(
         (1, Resource::StorageImage(&g.normal)),
         (2, Resource::StorageImage(&g.geometric)),
         (3, Resource::Buffer(texels)),
+        (4, Resource::StorageImage(&g.emission)),
     ]);
     rec.push_constants(&count);
     rec.dispatch(1, 1, 1).unwrap();
@@ -343,14 +362,15 @@ pub struct GbufferPoint {
     pub pixel: [u32; 4],
     /// Position.
     pub p: Vec3,
-    /// Padding.
-    pub pad_p: f32,
+    /// Metallic and roughness, packed as `gbuffer_pack_metallic_roughness` does (0: a
+    /// dielectric of roughness 0).
+    pub metallic_roughness: f32,
     /// Shading normal.
     pub n: Vec3,
     /// World size of one pixel at `p`.
     pub footprint: f32,
     /// Geometric normal.
     pub ng: Vec3,
-    /// Padding.
-    pub pad_ng: f32,
+    /// Material index (as a float, as the G-buffer stores it).
+    pub material: f32,
 }

@@ -12,12 +12,10 @@ use radcache_cache::sampling::{
 use radcache_render::{record_seed, GBuffer, GpuScene, IcState, RecordPass, R_EPS_REL};
 use radcache_scene::Scene;
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
-use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, Buffer, Context, Pipeline, ShaderCompiler,
-};
+use radcache_vk::{vk, Access, Buffer, Context, Pipeline, ShaderCompiler};
 
 use crate::geometry::intersect;
-use crate::ic_fixture::{fill_gbuffer_points, GbufferPoint};
+use crate::ic_fixture::{fill_gbuffer_points, gbuffer_fill_pipeline, GbufferPoint};
 use crate::{context, finish, shaders};
 
 pub const W: u32 = 32;
@@ -59,10 +57,6 @@ pub fn fixture(scene: &Scene) -> Fixture {
     let mut gpu = GpuScene::new(&ctx, scene, None).unwrap();
     gpu.set_time(scene, 0.0).unwrap();
     gpu.set_view(&scene.camera_at(0.0), W, H, 0, 0).unwrap();
-    let spirv = shaders.compile("tests/gbuffer_fill.comp", &[]).unwrap();
-    let image = |b| BindingLayout::new(b, BindingKind::StorageImage);
-    let texels = BindingLayout::new(3, BindingKind::StorageBuffer);
-    let layout = [image(0), image(1), image(2), texels];
     let mut tris = Vec::new();
     for (inst, m) in scene.instances.iter().zip(scene.instance_transforms(0.0)) {
         let mesh = &scene.meshes[inst.mesh];
@@ -70,7 +64,7 @@ pub fn fixture(scene: &Scene) -> Fixture {
         tris.extend((0..mesh.triangle_count()).map(world));
     }
     Fixture {
-        fill: Pipeline::compute(&ctx, "gbuffer_fill", &spirv, &layout, 4).unwrap(),
+        fill: gbuffer_fill_pipeline(&ctx, &shaders),
         gbuffer: GBuffer::new(&ctx, W, H).unwrap(),
         state: IcState::new(&ctx, &shaders, 64, 64).unwrap(),
         r_eps: R_EPS_REL * gpu.constants().camera_position[3],

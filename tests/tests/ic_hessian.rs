@@ -15,10 +15,10 @@ use radcache_cache::{luminance_rec709, ErrorControl, IcParams, IC_FAR};
 use radcache_render::{record_seed, GBuffer, GpuScene, IcState, RecordPass, SkyLight, R_EPS_REL};
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::geometry::intersect;
-use radcache_tests::ic_fixture::{fill_gbuffer_points, GbufferPoint};
+use radcache_tests::ic_fixture::{fill_gbuffer_points, gbuffer_fill_pipeline, GbufferPoint};
 use radcache_tests::scenes::load;
 use radcache_tests::{context, finish, shaders};
-use radcache_vk::{vk, Access, BindingKind, BindingLayout, Pipeline};
+use radcache_vk::{vk, Access};
 
 const W: u32 = 32;
 const H: u32 = 32;
@@ -36,15 +36,7 @@ fn hessian_records_match_the_cpu_twin() {
     gpu.set_time(&scene, 0.0).unwrap();
     let view = scene.camera_at(0.0);
     gpu.set_view(&view, W, H, 0, 0).unwrap();
-    let spirv = shaders.compile("tests/gbuffer_fill.comp", &[]).unwrap();
-    let image = |b| BindingLayout::new(b, BindingKind::StorageImage);
-    let layout = [
-        image(0),
-        image(1),
-        image(2),
-        BindingLayout::new(3, BindingKind::StorageBuffer),
-    ];
-    let fill = Pipeline::compute(&ctx, "gbuffer_fill", &spirv, &layout, 4).unwrap();
+    let fill = gbuffer_fill_pipeline(&ctx, &shaders);
     let gbuffer = GBuffer::new(&ctx, W, H).unwrap();
     let state = IcState::new(&ctx, &shaders, 64, 64).unwrap();
     let r_eps = R_EPS_REL * gpu.constants().camera_position[3];

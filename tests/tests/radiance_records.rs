@@ -21,7 +21,9 @@ use radcache_cache::record::wall_term;
 use radcache_cache::sampling::stratum_index;
 use radcache_cache::{IcParams, IC_FAR};
 use radcache_render::{RecordPass, SkyLight};
-use radcache_shared::consts::{RADIANCE_VEC4S, RECORD_RADIANCE_VEC4S, SH_COEFFS};
+use radcache_shared::consts::{
+    RADIANCE_VEC4S, RECORD_FLAG_GLOSSY, RECORD_RADIANCE_VEC4S, SH_COEFFS,
+};
 use radcache_tests::record_fixture::*;
 use radcache_tests::scenes::load;
 use radcache_vk::vk;
@@ -190,6 +192,78 @@ fn radiance_coefficients_and_gradients_match_the_cpu_twin() {
             "slot {slot} was written"
         );
     }
+    drop((pass, radiance));
+    end(f);
+}
+
+/// `gbuffer_pack_metallic_roughness` (shaders/common/gbuffer_pack.glsl): 10 bits each.
+fn pack_metallic_roughness(metallic: f32, roughness: f32) -> f32 {
+    let q = |v: f32| (v.clamp(0.0, 1.0) * 1023.0 + 0.5).floor();
+    q(metallic) * 1024.0 + q(roughness)
+}
+
+/// Records made for glossy lobes keep the preset's full strata at the fine levels, where other
+/// records take the fine strata (`IcParams::strata_at`; docs/irradiance-cache.md §2.8): on
+/// `glossy_room`, one surface point requested at the default preset's first fine level gathers
+/// 16×48 samples and is flagged glossy where its G-buffer says metal of roughness 0.8, and 8×24
+/// unflagged where it says roughness 0.3 (below the records' threshold, so its lobe's light is
+/// path traced per pixel).
+#[test]
+fn records_for_glossy_lobes_keep_the_full_strata_at_fine_levels() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = load(&root.join("../assets/glossy_room/glossy_room.gltf"));
+    let mut f = fixture(&scene);
+    let params = IcParams::default();
+    let level = params.fine_level();
+    assert!(level < params.levels, "the default preset has fine levels");
+    assert_eq!(params.strata_at(level, true), (16, 48));
+    assert_eq!(params.strata_at(level, false), (8, 24));
+    let metal = scene
+        .materials
+        .iter()
+        .position(|m| m.metallic > 0.5)
+        .expect("glossy_room has a metal");
+    let mut rough = surface_at_pixel(&f, &scene, 16, 26);
+    rough.material = metal as f32;
+    rough.metallic_roughness = pack_metallic_roughness(1.0, 0.8);
+    let mut sharp = rough;
+    sharp.pixel = [5, 5, 0, 0];
+    sharp.metallic_roughness = pack_metallic_roughness(1.0, 0.3);
+    let points = [rough, sharp];
+    let requests: Vec<u32> = points.iter().map(point_index).collect();
+    let pass =
+        RecordPass::with_radiance(&f.ctx, &f.shaders, &f.gpu, &params, SkyLight::Records, true)
+            .unwrap();
+    let zeros = vec![[0.0f32; 4]; SLOTS * RECORD_RADIANCE_VEC4S as usize];
+    let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+    let radiance = f
+        .ctx
+        .create_buffer_init("test.radiance", storage, &zeros)
+        .unwrap();
+    let c = counters(0, 2, 2, 64);
+    let out = run_with_radiance(
+        &mut f,
+        &pass,
+        &points,
+        &requests,
+        c,
+        5,
+        level,
+        0,
+        Some(&radiance),
+    );
+    let per = params.sample_count() as usize;
+    // A stratum the pass traced has a positive distance (the room is closed); the others keep
+    // the dump's zeros.
+    let traced = |i: usize| {
+        out.samples[i * per..(i + 1) * per]
+            .iter()
+            .filter(|s| s[3] > 0.0)
+            .count()
+    };
+    let glossy = |i: usize| out.records[i].info[3] & RECORD_FLAG_GLOSSY != 0;
+    assert_eq!((traced(0), glossy(0)), (16 * 48, true), "roughness 0.8");
+    assert_eq!((traced(1), glossy(1)), (8 * 24, false), "roughness 0.3");
     drop((pass, radiance));
     end(f);
 }
