@@ -48,14 +48,14 @@ void main() {
         basis_from_normal(n, tangent, bitangent);
     }
     bitangent = cross(n, tangent);
+    // The frusta's height, also the squares' half-side at h = ±height.
     float height = oriented ? rho / (1.0 + n_len) : rho;
-    float cap = oriented ? height : rho;  // the squares' half-side at h = ±height
     vec2 lo = vec2(1.0);
     vec2 hi = vec2(-1.0);
     bool full = !(rho < 1.0e6 * frame.camera_position.w);
     for (int i = 0; i < 12 && !full; ++i) {
         int level = i >> 2;  // 0: h = 0, 1: h = +height, 2: h = −height
-        float side = level == 0 ? rho : cap;
+        float side = level == 0 ? rho : height;
         float h = level == 0 ? 0.0 : (level == 1 ? height : -height);
         float st = (i & 1) != 0 ? side : -side;
         float sb = (i & 2) != 0 ? side : -side;
