@@ -9,6 +9,7 @@
 #include "../common/scene.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
+#include "../common/dispatch.glsl"
 
 layout(binding = B_AOV_ALBEDO, std430) writeonly buffer Albedo { vec4 albedo_out[]; };
 layout(binding = B_AOV_NORMAL, std430) writeonly buffer Normal { vec4 normal_out[]; };
@@ -17,7 +18,7 @@ layout(binding = B_AOV_DEPTH, std430) writeonly buffer Depth { float depth_out[]
 const uint GRID = 4u;
 
 void main() {
-    uvec2 pixel = gl_GlobalInvocationID.xy;
+    uvec2 pixel = interleaved_pixel();
     if (any(greaterThanEqual(pixel, frame.resolution.xy))) {
         return;
     }

@@ -20,6 +20,7 @@
 #include "../shared/push.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
+#include "../common/dispatch.glsl"
 
 layout(binding = B_COMPOSITE_SPLAT_SUM, rgba32f) readonly uniform image2D splat_sum;
 layout(binding = B_COMPOSITE_ACCUM, std430) buffer Accum { vec4 accum[]; };
@@ -155,7 +156,7 @@ CachedLight cached_light_from_centres(GSample g, ivec2 pixel, vec2 jitter, out b
 }
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 pixel = ivec2(interleaved_pixel());
     if (any(greaterThanEqual(pixel, ivec2(frame.resolution.xy)))) {
         return;
     }

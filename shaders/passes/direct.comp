@@ -26,6 +26,7 @@
 #endif
 
 layout(local_size_x = 8, local_size_y = 8) in;
+#include "../common/dispatch.glsl"
 
 layout(binding = B_DIRECT_RAY_COUNT, std430) buffer RayCount { uint ray_count; };
 #ifdef HAS_ANALYTIC_EMITTERS
@@ -542,7 +543,7 @@ void neighbourhood_sums(GSample g, PixelLight light, out vec3 all_sum, out vec3 
 #endif
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 pixel = ivec2(interleaved_pixel());
     bool inside = all(lessThan(pixel, ivec2(frame.resolution.xy)));
     GSample g;
     g.surface = false;

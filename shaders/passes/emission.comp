@@ -19,6 +19,7 @@
 #include "../common/path.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
+#include "../common/dispatch.glsl"
 
 layout(binding = B_EMISSION_ACCUM, std430) buffer Accum { vec4 accum[]; };
 layout(binding = B_EMISSION_EMISSION_ACCUM, std430) readonly buffer EmissionAccum { vec4 emission_accum[]; };
@@ -28,7 +29,7 @@ const uint BITS = 6u;            // 64 rays per pixel
 const uint COUNT = 1u << BITS;
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 pixel = ivec2(interleaved_pixel());
     ivec2 size = ivec2(frame.resolution.xy);
     if (any(greaterThanEqual(pixel, size))) {
         return;

@@ -5,11 +5,11 @@
 // surface_at does; both normals are turned toward the camera, and the front
 // face (for the emission rule) is the side the camera sees. The pixel footprint is the pinhole
 // `pixel_footprint` of ircache_math.glsl (its cosine clamp keeps grazing surfaces bounded, where
-// screen-space derivatives would grow without limit). Each fragment checks with one ray query
-// that nothing stands between it and the camera (`occluder`): rasterization's edge snapping must
-// not let a sample see through the seam of a zero-thickness wall. With HAS_ALPHA a fragment where
-// its material is missing (alpha_keep: MASK below the cutoff, BLEND by its stochastic coverage) is
-// discarded, and the occluder ray skips such points with the same test.
+// screen-space derivatives would grow without limit). The samples that rasterization's edge
+// snapping may have let through the seam of a zero-thickness wall are traced again by the
+// repair (gbuffer.comp with GBUFFER_REPAIR). With HAS_ALPHA a fragment where its material is
+// missing (alpha_keep: MASK below the cutoff, BLEND by its stochastic coverage) is discarded,
+// and the repair's ray skips such points with the same test.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -33,36 +33,11 @@ layout(location = 2) out vec4 o_geometric;
 layout(location = 3) out vec4 o_albedo;
 layout(location = 4) out vec4 o_emission;
 
-// The first surface along the camera ray to this fragment, when it is not the fragment's own:
-// rasterization snaps edges to the sub-pixel grid (1/256 px on lavapipe), so where a
-// zero-thickness wall stands on a floor that runs on under it, a sample within that snapping
-// distance of the seam misses the wall and lands on the floor behind it, on the wall's other side
-// (measured: the `two_rooms` scene of the stiff suite, 0.8 mm behind the wall at 2.8 m, lit by
-// the other room's lights). The ray stops 1e-5 of the distance short of the fragment (relative,
-// so any scene scale works); a hit there is the surface the camera really sees.
-// `alpha_seed` is the fragment's (gbuffer_alpha_seed).
-bool occluder(vec3 to_fragment, uint alpha_seed, out Surface s, out uint instance) {
-    float dist = length(to_fragment);
-    if (!(dist > 0.0)) {
-        return false;
-    }
-    vec3 dir = to_fragment / dist;
-    rayQueryEXT q;
-    scene_trace_seeded(q, 0u, frame.camera_position.xyz, dir, dist * (1.0 - 1e-5), alpha_seed);
-    if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
-        return false;
-    }
-    instance = uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true));
-    s = surface_at(instance,
-                   uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true)),
-                   rayQueryGetIntersectionBarycentricsEXT(q, true), dir);
-    return true;
-}
-
 #ifdef HAS_ALPHA
 // The seed of this pixel's BLEND tests in this sub-frame: the pixel, the sub-frame's jitter, the
-// frame's seed and number. Every fragment of the pixel and its occluder ray draw the same number
-// for the same triangle, so a blended surface the rasterizer dropped is dropped by the ray too.
+// frame's seed and number. Every fragment of the pixel and the repair's ray (gbuffer.comp) draw
+// the same number for the same triangle, so a blended surface the rasterizer dropped is dropped
+// by the ray too.
 uint gbuffer_alpha_seed() {
     uvec2 p = uvec2(gl_FragCoord.xy);
     uint h = pcg_hash(frame.resolution.w ^ pcg_hash(frame.resolution.z));
@@ -77,12 +52,9 @@ void main() {
     GpuInstance inst = instances[pc.instance];
     uint material = tri_materials[inst.mesh.w + v_triangle];
 #ifdef HAS_ALPHA
-    uint alpha_seed = gbuffer_alpha_seed();
-    if (!alpha_keep(material, v_uv, pc.instance, v_triangle, alpha_seed)) {
+    if (!alpha_keep(material, v_uv, pc.instance, v_triangle, gbuffer_alpha_seed())) {
         discard;
     }
-#else
-    uint alpha_seed = 0u;
 #endif
     uint first = inst.mesh.z + 3u * v_triangle;
     vec3 p0 = vertices[indices[first] + inst.mesh.y].position_u.xyz;
@@ -118,22 +90,8 @@ void main() {
         ns = ng;
     }
     float view_depth = 1.0 / gl_FragCoord.w;
-    Surface hit;
     uint instance = pc.instance;
-    uint hit_instance;
-    if (occluder(-to_camera, alpha_seed, hit, hit_instance)) {
-        instance = hit_instance;
-        // Same ray: the view depth scales with the distance along it.
-        view_depth *= length(frame.camera_position.xyz - hit.position) / max(length(to_camera), 1e-30);
-        position = hit.position;
-        to_camera = frame.camera_position.xyz - position;
-        ng = hit.geometric_normal;
-        ns = hit.shading_normal;
-        front = hit.front_face;
-        material = hit.material;
-        uv = hit.uv;
-    }
-    // View depth = clip w = 1 / gl_FragCoord.w (scaled above for an occluder). The y row of
+    // View depth = clip w = 1 / gl_FragCoord.w. The y row of
     // clip_from_world is the projection's ±1/tan(fov_y/2) times a row of the view rotation (a unit
     // vector).
     vec3 row_y = vec3(frame.clip_from_world[0][1], frame.clip_from_world[1][1],

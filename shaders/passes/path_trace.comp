@@ -13,6 +13,7 @@
 #include "../shared/push.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
+#include "../common/dispatch.glsl"
 
 layout(binding = B_PATH_TRACE_ACCUM, std430) buffer Accum {
     vec4 accum[];  // per pixel: Kahan sum (rgb), sample count (a)
@@ -28,7 +29,7 @@ layout(binding = B_PATH_TRACE_RAY_COUNT, std430) buffer RayCount {
 layout(push_constant) uniform Push { PathTracePush pc; };
 
 void main() {
-    uvec2 pixel = gl_GlobalInvocationID.xy;
+    uvec2 pixel = interleaved_pixel();
     if (any(greaterThanEqual(pixel, frame.resolution.xy))) {
         return;
     }

@@ -23,7 +23,7 @@ struct DirectPush {
 
 struct GBufferPush {
     uint instance;
-    uint pad;
+    uint repair_stage;
     vec2 jitter;
 };  // 16 bytes
 

@@ -116,10 +116,16 @@ fn check_gbuffer(scene: &Scene, gpu: &Gpu, g: &GRead, jitter: [f32; 2]) -> Check
 }
 
 /// Both ways of making the G-buffer (rasterized; ray traced, which scenes of many triangles
-/// get) against CPU ray casting.
+/// get) against CPU ray casting. The tall image is dispatched in 16 classes of rows
+/// (`radcache_shared::dispatch`): every pixel must still be the one its workgroup's row says.
 #[test]
 fn gbuffer_matches_cpu_ray_casting() {
-    let cases = [(cornell(), (64, 64)), (faces_scene(), (40, 32))];
+    assert_eq!(radcache_shared::dispatch::image_dispatch(24, 1024)[2], 16);
+    let cases = [
+        (cornell(), (64, 64)),
+        (faces_scene(), (40, 32)),
+        (cornell(), (24, 1024)),
+    ];
     for ((scene, size), traced) in cases.iter().flat_map(|c| [(c, false), (c, true)]) {
         let (scene, size) = (scene, *size);
         let gpu = Gpu::with_gbuffer(scene, None, size, Some(traced));

@@ -5,6 +5,7 @@
 //! fails when that file is stale).
 
 pub mod consts;
+pub mod dispatch;
 pub mod glsl_twin;
 pub mod gpu;
 pub mod layout;

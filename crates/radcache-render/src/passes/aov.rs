@@ -1,6 +1,7 @@
 //! The AOV pass (`shaders/passes/aov.comp`): first-hit diffuse albedo, world shading normal and
 //! depth per pixel, box-filtered over 4×4 sub-pixel positions.
 
+use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
     vk, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource, ShaderCompiler,
 };
@@ -88,7 +89,8 @@ impl AovPass {
         rec.pass("aov", |rec| {
             rec.bind_pipeline(&self.pipeline);
             rec.push_bindings(&bindings);
-            rec.dispatch(w.div_ceil(8), h.div_ceil(8), 1)
+            let [x, y, z] = image_dispatch(w, h);
+            rec.dispatch(x, y, z)
         })?;
         Ok(())
     }

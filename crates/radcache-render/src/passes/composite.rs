@@ -12,6 +12,7 @@
 //! ([`CentreSamples`]: splatting once per frame). A non-finite value is replaced by 0 and
 //! counted.
 
+use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, ImageUse, MemoryLocation, Pipeline, Recorder,
     Resource, ShaderCompiler,
@@ -243,7 +244,8 @@ impl CompositePass {
             rec.bind_pipeline(&self.pipeline);
             rec.push_bindings(&bindings);
             rec.push_constants(&push);
-            rec.dispatch(w.div_ceil(8), h.div_ceil(8), 1)
+            let [x, y, z] = image_dispatch(w, h);
+            rec.dispatch(x, y, z)
         })?;
         rec.barrier(
             Access::COMPUTE_WRITE,

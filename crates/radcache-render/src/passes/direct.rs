@@ -2,6 +2,7 @@
 //! MIS per surface pixel, compiled with the plan's defines (only the scene's light sources; a
 //! constant environment only where the sky does not go through the records, [`SkyLight`]).
 
+use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
     ShaderCompiler,
@@ -230,7 +231,8 @@ impl DirectPass {
             rec.bind_pipeline(&self.pipeline);
             rec.push_bindings(&bindings);
             rec.push_constants(&push);
-            rec.dispatch(w.div_ceil(8), h.div_ceil(8), 1)
+            let [x, y, z] = image_dispatch(w, h);
+            rec.dispatch(x, y, z)
         })?;
         rec.barrier(Access::COMPUTE_WRITE, Access::ALL);
         Ok(())

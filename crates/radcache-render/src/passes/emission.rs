@@ -4,6 +4,7 @@
 //! so an axis-aligned edge's coverage is exact to 1/64), so emitter edges are filtered like the
 //! reference's instead of being quantised by the few sub-frame jitters.
 
+use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
     ShaderCompiler,
@@ -67,7 +68,8 @@ impl EmissionPass {
         rec.pass("emission", |rec| {
             rec.bind_pipeline(&self.pipeline);
             rec.push_bindings(&bindings);
-            rec.dispatch(w.div_ceil(8), h.div_ceil(8), 1)
+            let [x, y, z] = image_dispatch(w, h);
+            rec.dispatch(x, y, z)
         })?;
         rec.barrier(
             Access::COMPUTE_WRITE,

@@ -5,15 +5,18 @@
 //! its first hit written with the rules below. Rasterized (`shaders/passes/gbuffer.vert` +
 //! `gbuffer.frag`): one draw per instance with vertex pulling, reversed-Z depth (cleared to 0,
 //! GREATER), no culling (both sides are drawn; the emission rule decides what a back face
-//! emits), and a sub-pixel jitter per sub-frame; each fragment traces one ray query from the
-//! camera to itself: a surface hit before it (rasterization snapped a zero-thickness wall's edge
-//! away from the sample, so the sample sees the floor behind the wall) replaces it, so the
-//! G-buffer never holds a point the camera cannot see (the stiff suite's `two_rooms`).
+//! emits), and a sub-pixel jitter per sub-frame; then the repair (`gbuffer.comp` with
+//! `GBUFFER_REPAIR`, two dispatches) traces the camera ray to each sample that lies behind a
+//! surface edge (a neighbour nearer and off its plane) and writes a surface hit before it
+//! instead (rasterization snapped a zero-thickness wall's edge away from the sample, so the
+//! sample sees the floor behind the wall): the G-buffer never holds a point the camera cannot
+//! see (the stiff suite's `two_rooms`).
 //!
 //! Either writes the five images of `shaders/common/gbuffer.glsl` (position, shading normal +
 //! footprint, geometric normal + material, albedo, emission), zero on the background, and clears
 //! the direct-light image. Both read the scene bindings 0–15.
 
+use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
     vk, Access, ColorTarget, Context, DepthState, DepthTarget, GraphicsDesc, ImageUse, Pipeline,
     Recorder, ShaderCompiler,
@@ -32,8 +35,9 @@ radcache_shared::gpu_struct! {
     pub struct GBufferPush {
         /// Instance.
         pub instance: u32 => "uint",
-        /// Padding.
-        pub pad: u32 => "uint",
+        /// The stage of the rasterized G-buffer's repair (`gbuffer.comp` with `GBUFFER_REPAIR`):
+        /// 0 marks the samples behind a surface edge, 1 traces them; 0 elsewhere.
+        pub repair_stage: u32 => "uint",
         /// Jitter.
         pub jitter: [f32; 2] => "vec2",
     }
@@ -43,6 +47,8 @@ radcache_shared::gpu_struct! {
 /// says so.
 pub struct GBufferPass {
     pipeline: Pipeline,
+    /// The rasterized G-buffer's repair (`gbuffer.comp` with `GBUFFER_REPAIR`); `None` traced.
+    repair: Option<Pipeline>,
     traced: bool,
 }
 
@@ -70,21 +76,27 @@ impl GBufferPass {
         traced: bool,
     ) -> Result<GBufferPass> {
         let defines = scene.material_defines();
-        if traced {
-            let spirv = shaders.compile("passes/gbuffer.comp", &defines)?;
+        let compute = |name: &str, defines: &[(&str, &str)]| -> Result<Pipeline> {
+            let spirv = shaders.compile("passes/gbuffer.comp", defines)?;
             let layout: Vec<_> = SCENE.iter().chain(GBUFFER.iter()).copied().collect();
-            let pipeline = Pipeline::compute(
+            Ok(Pipeline::compute(
                 ctx,
-                "gbuffer",
+                name,
                 &spirv,
                 &layout,
                 std::mem::size_of::<GBufferPush>() as u32,
-            )?;
+            )?)
+        };
+        if traced {
             return Ok(GBufferPass {
-                pipeline,
+                pipeline: compute("gbuffer", &defines)?,
+                repair: None,
                 traced: true,
             });
         }
+        let mut repair_defines = defines.clone();
+        repair_defines.push(("GBUFFER_REPAIR", "1"));
+        let repair = compute("gbuffer.repair", &repair_defines)?;
         let vertex = shaders.compile("passes/gbuffer.vert", &defines)?;
         let fragment = shaders.compile("passes/gbuffer.frag", &defines)?;
         let pipeline = Pipeline::graphics(
@@ -108,6 +120,7 @@ impl GBufferPass {
         )?;
         Ok(GBufferPass {
             pipeline,
+            repair: Some(repair),
             traced: false,
         })
     }
@@ -143,10 +156,11 @@ impl GBufferPass {
                 rec.push_bindings(&bindings);
                 rec.push_constants(&GBufferPush {
                     instance: 0,
-                    pad: 0,
+                    repair_stage: 0,
                     jitter,
                 });
-                rec.dispatch(w.div_ceil(8), h.div_ceil(8), 1)
+                let [x, y, z] = image_dispatch(w, h);
+                rec.dispatch(x, y, z)
             })?;
             rec.barrier(Access::COMPUTE_WRITE, Access::ALL);
             return Ok(());
@@ -178,7 +192,7 @@ impl GBufferPass {
             for &(instance, triangles) in &draws {
                 rec.push_constants(&GBufferPush {
                     instance,
-                    pad: 0,
+                    repair_stage: 0,
                     jitter,
                 });
                 rec.draw(3 * triangles, 1);
@@ -189,6 +203,29 @@ impl GBufferPass {
         rec.clear_color(&gbuffer.direct, [0.0; 4]);
         for image in gbuffer.images() {
             rec.use_image(image, ImageUse::ComputeStorage);
+        }
+        if let Some(repair) = &self.repair {
+            let mut bindings = scene.bindings();
+            bindings.extend(gbuffer.bindings());
+            let [x, y, z] = image_dispatch(gbuffer.width, gbuffer.height);
+            rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
+            rec.pass("gbuffer.repair", |rec| {
+                rec.bind_pipeline(repair);
+                rec.push_bindings(&bindings);
+                for repair_stage in [0, 1] {
+                    if repair_stage == 1 {
+                        rec.barrier(Access::COMPUTE_WRITE, Access::COMPUTE_READ_WRITE);
+                    }
+                    rec.push_constants(&GBufferPush {
+                        instance: 0,
+                        repair_stage,
+                        jitter,
+                    });
+                    rec.dispatch(x, y, z)?;
+                }
+                Ok::<(), radcache_vk::Error>(())
+            })?;
+            rec.barrier(Access::COMPUTE_WRITE, Access::ALL);
         }
         Ok(())
     }

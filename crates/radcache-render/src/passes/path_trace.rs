@@ -6,6 +6,7 @@
 //! `sample_count` samples per pixel, and [`PathTracer::chunk_size`] adapts that count so one
 //! submission stays short (drivers, lavapipe included, kill long dispatches).
 
+use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
     ShaderCompiler,
@@ -144,7 +145,8 @@ impl PathTracer {
             rec.bind_pipeline(pipeline);
             rec.push_bindings(&bindings);
             rec.push_constants(&push);
-            rec.dispatch(w.div_ceil(8), h.div_ceil(8), 1)
+            let [x, y, z] = image_dispatch(w, h);
+            rec.dispatch(x, y, z)
         })?;
         rec.barrier(
             Access::COMPUTE_READ_WRITE,
