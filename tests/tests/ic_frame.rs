@@ -191,6 +191,8 @@ fn the_plan_leaves_out_unneeded_passes() {
         "scene.tlas",
         "accel.tlas_build",
         "gbuffer",
+        // The rasterized G-buffer's guard (docs/cache-frame.md §2).
+        "gbuffer.repair",
         "direct",
         "splat.coverage",
         "holes",
