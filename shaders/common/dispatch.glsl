@@ -1,4 +1,5 @@
-// common/dispatch.glsl — the pixel of an invocation of a 2D image pass of 8×8 workgroups
+// common/dispatch.glsl — the order of a dispatch's workgroups on lavapipe. interleaved_pixel: the
+// pixel of an invocation of a 2D image pass of 8×8 workgroups
 // dispatched as radcache_shared::dispatch::image_dispatch says: (columns, ⌈rows/K⌉, K), and
 // workgroup (x, j, c) takes row of tiles j·K + c (docs/cache-frame.md §11). Include after the
 // pass's `layout(local_size_x = …, local_size_y = …) in;` (it reads gl_WorkGroupSize); a pass
@@ -13,6 +14,30 @@
 // nothing. A dispatch with one z-slice is the plain order.
 #ifndef RADCACHE_DISPATCH_GLSL
 #define RADCACHE_DISPATCH_GLSL
+
+// The item that workgroup `i` of a 1D dispatch of `n` works on (the record pass's requests,
+// which hole selection appends roughly in image order): taken in K = clamp(n/8, 1, 16) classes
+// c, K + c, 2K + c, …, the longer classes first, so that each thread's block holds items from
+// the whole list. A bijection of [0, n); radcache_shared::dispatch::interleaved_index.
+uint interleaved_index(uint i, uint n) {
+    uint k = clamp(n / 8u, 1u, 16u);
+    if (k <= 1u || i >= n) {
+        return i;
+    }
+    uint q = n / k;
+    uint rem = n % k;
+    uint long_items = rem * (q + 1u);
+    uint class_index, j;
+    if (i < long_items) {
+        class_index = i / (q + 1u);
+        j = i % (q + 1u);
+    } else {
+        uint s = i - long_items;
+        class_index = rem + s / q;
+        j = s % q;
+    }
+    return j * k + class_index;
+}
 
 uvec2 interleaved_pixel() {
     uint row = gl_WorkGroupID.y * gl_NumWorkGroups.z + gl_WorkGroupID.z;

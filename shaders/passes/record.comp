@@ -3,8 +3,9 @@
 // §N below cite docs/irradiance-cache.md): one workgroup per requested pixel, dispatched indirectly
 // from IcCounters.dispatch (crates/radcache-render/src/passes/record.rs).
 //
-// Request i (gl_WorkGroupID.x) exists when i < min(requested, request_capacity); it creates
-// record batch_first + i, or, past record_capacity, is dropped and counted in dropped_requests.
+// Request i (taken by workgroup x where i = interleaved_index(x, workgroups), common/dispatch.glsl)
+// exists when i < min(requested, request_capacity); it creates record batch_first + i, or, past
+// record_capacity, is dropped and counted in dropped_requests.
 //
 // Gather (§2.1, §2.4): the M×N stratified cosine-weighted directions (stratum_direction_local with
 // the deterministic jitter stratum_jitter(record_seed, j·N + k), record_seed = ircache_hash(pixel ^
@@ -69,6 +70,7 @@
 // RECORD_GROUP (invocations per record) come from constants.glsl too.
 
 layout(local_size_x = RECORD_GROUP) in;
+#include "../common/dispatch.glsl"
 
 layout(binding = B_RECORD_REQUESTS, std430) readonly buffer Requests { uint requests[]; };
 layout(binding = B_RECORD_COUNTERS, std430) buffer Counters { IcCounters counters; };
@@ -373,7 +375,9 @@ PathState begin_stratum(uint i, uint n, uint m, vec3 origin, vec3 t, vec3 b, vec
 
 void main() {
     uint lid = gl_LocalInvocationID.x;
-    uint request = gl_WorkGroupID.x;
+    // Workgroups take the requests in classes spread over the list (common/dispatch.glsl):
+    // lavapipe gives each thread one block of workgroups.
+    uint request = interleaved_index(gl_WorkGroupID.x, gl_NumWorkGroups.x);
     // Everything up to the barrier is uniform over the workgroup.
     if (request >= min(counters.requested, counters.request_capacity)) {
         return;

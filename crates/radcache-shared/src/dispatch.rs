@@ -35,6 +35,27 @@ pub fn tile_row(j: u32, c: u32, classes: u32) -> u32 {
     j * classes + c
 }
 
+/// The item that workgroup `i` of a 1D dispatch of `n` works on (`interleaved_index` in GLSL;
+/// the record pass's requests, which hole selection appends roughly in image order): items in
+/// `K = clamp(n/8, 1, MAX_CLASSES)` classes `c, K + c, 2K + c, …`, class 0 first, the longer
+/// classes (`⌈n/K⌉` items) before the shorter, so that each thread's block of workgroups holds
+/// items from the whole list. A bijection of `[0, n)`; `i ≥ n` is returned as it is.
+pub fn interleaved_index(i: u32, n: u32) -> u32 {
+    let k = (n / 8).clamp(1, MAX_CLASSES);
+    if k <= 1 || i >= n {
+        return i;
+    }
+    let (q, rem) = (n / k, n % k);
+    let long = rem * (q + 1);
+    let (class, j) = if i < long {
+        (i / (q + 1), i % (q + 1))
+    } else {
+        let s = i - long;
+        (rem + s / q, s % q)
+    };
+    j * k + class
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -92,6 +113,30 @@ mod tests {
         }
         let plain: Vec<u32> = (0..128).collect();
         assert_eq!(quarters(&plain, 128, 2, 0), 2);
+    }
+
+    #[test]
+    fn every_item_of_a_1d_dispatch_is_taken_once_and_spread() {
+        for n in 0..=3000u32 {
+            let order: Vec<u32> = (0..n).map(|i| interleaved_index(i, n)).collect();
+            let mut sorted = order.clone();
+            sorted.sort_unstable();
+            assert_eq!(sorted, (0..n).collect::<Vec<_>>(), "{n} items");
+            if n >= 128 {
+                // Each of 2–16 threads' blocks reaches every quarter of the list.
+                for threads in [2, 3, 4, 8, 16] {
+                    if order.len() / threads < 8 {
+                        continue;
+                    }
+                    for k in 0..threads {
+                        assert_eq!(quarters(&order, n, threads, k), 4, "{n} items, {threads}");
+                    }
+                }
+            }
+        }
+        assert_eq!(interleaved_index(7, 7), 7);
+        // 64 items in 8 classes: 0, 8, 16, … first.
+        assert_eq!([1, 8].map(|i| interleaved_index(i, 64)), [8, 1]);
     }
 
     #[test]
