@@ -16,10 +16,10 @@
 //                                gradients rotate with the instance's change since the previous
 //                                frame); a record shows its newest known value E_k (exact at frame
 //                                t_k), carried at most one frame forward at its measured rate; one
-//                                whose E_k is older than its lifespan, or whose view of the other
-//                                moving instances changed by more than a_t since t_k (below), is
-//                                listed: it is evaluated again one frame ahead, and shows E_k once
-//                                more this frame; with
+//                                whose E_k would be older than its lifespan at the next frame, or
+//                                whose view of the other moving instances changed by more than a_t
+//                                since t_k (below), is listed: it is evaluated again one frame
+//                                ahead, for that frame; with
 //                                `reclamp` (the camera moved) every record in front of the camera
 //                                takes the [R⁻, R⁺] clamp of its pixel footprint in this view, as a
 //                                record created now would (records kept from a distant view would
@@ -34,16 +34,15 @@
 //                                min(s·a_t·Y_k/|Y(t+1) − Y_k|, Δt_max·(1 ± 20 %)) (the stagger
 //                                hashed from the record and the frame; radcache_cache::temporal),
 //                                then E_k = E(t + 1), t_k = t + 1, and the moving cover at t + 1;
-//                                a recomputed kept record also takes its new gradients and its
-//                                radius if smaller
+//                                the record also takes the gradients and the radius of that
+//                                evaluation
 // Motion-aware expiry: the lifespan is measured from one frame's change, so it misses what comes
 // later — an object that approaches a record slowly at first. Each record keeps the cover C of
 // the other moving instances at t_k (Σ over their bounding spheres of the cosine-weighted fraction
 // of its hemisphere each covers, radcache_cache::moving_cover) and expires when |C(t) − C_k| > a_t:
 // a change of that fraction of the incident light is what the lifespan allows.
 // Every evaluation is one frame ahead: a record shows values that were exact at most `lifespan`
-// frames ago (one frame more while its next evaluation is made), and costs one evaluation per
-// refresh. Carrying E_k forward more than one frame at the rate (linear extrapolation,
+// frames ago (it is listed the frame before), and costs one evaluation per refresh. Carrying E_k forward more than one frame at the rate (linear extrapolation,
 // docs/temporal.md §3.4) measured worse: a difference between two evaluations carries the noise of
 // the paths that diverge between the two scenes (relMSE +12 % on the animated scene with one-frame
 // gradients).
@@ -189,17 +188,17 @@ void main() {
             move_record(gid, tr);
             // The newest known value E_k is exact at frame t_k (info.y) and `age` frames old.
             float age = float(pc.frame) - float(tr.info.y);
-            if (age >= 1.0) {
-                // Expired by age, else by a change of the moving instances' cover.
-                bool expired = age > tr.object_position.w;
-                if (!expired) {
-                    float cover = cover_of_moving(records[gid].position_radius.xyz,
-                                                  records[gid].normal_rorig.xyz, tr.info.x);
-                    expired = abs(cover - tr.birth_irradiance.w) > max(pc.accuracy, 0.0);
-                }
-                if (expired) {
-                    append(gid);
-                }
+            // Listed when its value at the next frame would outlive its lifespan (the look-ahead
+            // evaluates it for that frame, so no frame shows a value older than the lifespan),
+            // else by a change of the moving instances' cover.
+            bool expired = !temporal_is_valid(age + 1.0, tr.object_position.w);
+            if (!expired && age >= 1.0) {
+                float cover = cover_of_moving(records[gid].position_radius.xyz,
+                                              records[gid].normal_rorig.xyz, tr.info.x);
+                expired = abs(cover - tr.birth_irradiance.w) > max(pc.accuracy, 0.0);
+            }
+            if (expired) {
+                append(gid);
             }
             // The known value, carried at most one frame forward at the measured rate (see the
             // header).
@@ -284,9 +283,14 @@ void main() {
                                                    lookahead[i].normal_rorig.xyz, tr.info.x));
     tr.info.y = pc.frame + 1u;
     temporal[i] = tr;
-    if (span > 1.0) {
-        // A kept record recomputed: its newest gradients, and a radius no larger than the one
-        // neighbour clamping left it (a closer occluder may shrink it).
+    {
+        // The gradients and the radius of the same evaluation as E_k (docs/temporal.md §3.3):
+        // a new record's look-ahead is at t + 1, where E_k now is. The radius follows the
+        // geometry both ways (an occluder that comes closer shrinks it, one that leaves lets it
+        // grow): keeping the smaller of the old and the new, as before 2026-12-05, shrank the
+        // radii with every refresh (a minimum of noisy estimates) and left kept records 1.2×
+        // the error of a per-frame rebuild even when every record was re-evaluated every other
+        // frame.
         GpuRecord a = lookahead[i];
         GpuRecord r = records[i];
         r.grad_r_red.xyz = a.grad_r_red.xyz;
@@ -295,7 +299,7 @@ void main() {
         r.grad_t_red.xyz = a.grad_t_red.xyz;
         r.grad_t_green.xyz = a.grad_t_green.xyz;
         r.grad_t_blue.xyz = a.grad_t_blue.xyz;
-        float r_orig = min(r.normal_rorig.w, sanitize_radius(a.normal_rorig.w));
+        float r_orig = sanitize_radius(a.normal_rorig.w);
         r.normal_rorig.w = r_orig;
         r.position_radius.w = clamp_radius(r_orig, r.bounds.x, r.bounds.y);
         r.irradiance.w = gradient_attenuation(r_orig, r.bounds.x);

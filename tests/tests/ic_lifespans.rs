@@ -6,7 +6,6 @@
 
 use glam::Vec3;
 use radcache_cache::temporal::temporal_lifespan;
-use radcache_cache::IcParams;
 use radcache_render::{GpuScene, IcRenderer, IcSettings, IcStats};
 use radcache_scene::Scene;
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
@@ -16,8 +15,14 @@ use radcache_vk::Context;
 
 const SIZE: u32 = 48;
 
+/// The longest lifespan here: long enough that the rate of change decides who is refreshed
+/// (draft's own 5 frames refresh every record at least every 5 frames, far from the box too).
+const MAX_AGE: f32 = 20.0;
+
 fn settings(frame: u32) -> IcSettings {
-    sliding_box::settings(SIZE, frame)
+    let mut s = sliding_box::settings(SIZE, frame);
+    s.params.max_age_frames = MAX_AGE;
+    s
 }
 
 fn sliding_box_scene(tag: &str) -> Scene {
@@ -47,7 +52,7 @@ fn records_follow_their_instance_and_only_records_near_the_box_are_refreshed() {
     let (ctx, shaders) = (context(), shaders());
     let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
     let mut r = IcRenderer::new(&ctx, &shaders, &gpu, &settings(1)).unwrap();
-    let params = IcParams::draft();
+    let params = settings(1).params;
     let (mut near, mut far, mut on_box) = (0usize, 0usize, 0usize);
     let (mut near_kept, mut far_kept) = (0usize, 0usize);
     let mut refreshed_total = 0u64;
