@@ -283,26 +283,24 @@ void main() {
                                                    lookahead[i].normal_rorig.xyz, tr.info.x));
     tr.info.y = pc.frame + 1u;
     temporal[i] = tr;
-    {
-        // The gradients and the radius of the same evaluation as E_k (docs/temporal.md §3.3):
-        // a new record's look-ahead is at t + 1, where E_k now is. The radius follows the
-        // geometry both ways (an occluder that comes closer shrinks it, one that leaves lets it
-        // grow): keeping the smaller of the old and the new, as before 2026-12-05, shrank the
-        // radii with every refresh (a minimum of noisy estimates) and left kept records 1.2×
-        // the error of a per-frame rebuild even when every record was re-evaluated every other
-        // frame.
-        GpuRecord a = lookahead[i];
-        GpuRecord r = records[i];
-        r.grad_r_red.xyz = a.grad_r_red.xyz;
-        r.grad_r_green.xyz = a.grad_r_green.xyz;
-        r.grad_r_blue.xyz = a.grad_r_blue.xyz;
-        r.grad_t_red.xyz = a.grad_t_red.xyz;
-        r.grad_t_green.xyz = a.grad_t_green.xyz;
-        r.grad_t_blue.xyz = a.grad_t_blue.xyz;
-        float r_orig = sanitize_radius(a.normal_rorig.w);
-        r.normal_rorig.w = r_orig;
-        r.position_radius.w = clamp_radius(r_orig, r.bounds.x, r.bounds.y);
-        r.irradiance.w = gradient_attenuation(r_orig, r.bounds.x);
-        records[i] = r;
-    }
+    // The gradients and the radius of the same evaluation as E_k (docs/temporal.md §3.3):
+    // a new record's look-ahead is at t + 1, where E_k now is. The radius follows the
+    // geometry both ways (an occluder that comes closer shrinks it, one that leaves lets it
+    // grow): keeping the smaller of the old and the new, as before 2026-12-05, shrank the
+    // radii with every refresh (a minimum of noisy estimates) and left kept records 1.2×
+    // the error of a per-frame rebuild even when every record was re-evaluated every other
+    // frame.
+    GpuRecord a = lookahead[i];
+    GpuRecord r = records[i];
+    r.grad_r_red.xyz = a.grad_r_red.xyz;
+    r.grad_r_green.xyz = a.grad_r_green.xyz;
+    r.grad_r_blue.xyz = a.grad_r_blue.xyz;
+    r.grad_t_red.xyz = a.grad_t_red.xyz;
+    r.grad_t_green.xyz = a.grad_t_green.xyz;
+    r.grad_t_blue.xyz = a.grad_t_blue.xyz;
+    float r_orig = sanitize_radius(a.normal_rorig.w);
+    r.normal_rorig.w = r_orig;
+    r.position_radius.w = clamp_radius(r_orig, r.bounds.x, r.bounds.y);
+    r.irradiance.w = gradient_attenuation(r_orig, r.bounds.x);
+    records[i] = r;
 }

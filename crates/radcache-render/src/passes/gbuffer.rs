@@ -47,15 +47,15 @@ radcache_shared::gpu_struct! {
 /// says so.
 pub struct GBufferPass {
     pipeline: Pipeline,
-    /// The rasterized G-buffer's repair (`gbuffer.comp` with `GBUFFER_REPAIR`); `None` traced.
+    /// The rasterized G-buffer's repair (`gbuffer.comp` with `GBUFFER_REPAIR`); `None` where
+    /// the G-buffer is traced.
     repair: Option<Pipeline>,
-    traced: bool,
 }
 
 impl std::fmt::Debug for GBufferPass {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("GBufferPass")
-            .field("traced", &self.traced)
+            .field("traced", &self.traced())
             .finish_non_exhaustive()
     }
 }
@@ -91,7 +91,6 @@ impl GBufferPass {
             return Ok(GBufferPass {
                 pipeline: compute("gbuffer", &defines)?,
                 repair: None,
-                traced: true,
             });
         }
         let mut repair_defines = defines.clone();
@@ -121,13 +120,12 @@ impl GBufferPass {
         Ok(GBufferPass {
             pipeline,
             repair: Some(repair),
-            traced: false,
         })
     }
 
     /// The pass traces its G-buffer (the plan's `traced_gbuffer`).
     pub fn traced(&self) -> bool {
-        self.traced
+        self.repair.is_none()
     }
 
     /// Records the G-buffer of `scene`'s current view, clearing everything first, in the profiler
@@ -143,7 +141,7 @@ impl GBufferPass {
         gbuffer: &GBuffer,
         jitter: [f32; 2],
     ) -> Result<()> {
-        if self.traced {
+        if self.traced() {
             for image in gbuffer.images() {
                 rec.use_image(image, ImageUse::ComputeStorage);
             }
