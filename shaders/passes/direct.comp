@@ -28,19 +28,65 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 #include "../common/dispatch.glsl"
 
+layout(push_constant) uniform Push { DirectPush pc; };
+
 layout(binding = B_DIRECT_RAY_COUNT, std430) buffer RayCount { uint ray_count; };
-#ifdef HAS_ANALYTIC_EMITTERS
-// With pc.adaptive_shadows: what each pixel's neighbourhood saw of the emitters in this frame's
-// sub-frames so far, written at sub-frame 0 and raised to a penumbra by later ones
-// (docs/cache-frame.md §8.2).
-layout(binding = B_DIRECT_PENUMBRA, std430) buffer Penumbra { uint penumbra[]; };
-#endif
-// What a pixel's neighbourhood saw of the emitters (the values of `penumbra`).
+// With pc.adaptive_shadows, two words a pixel (docs/cache-frame.md §8.2): 2i, what its
+// neighbourhood saw of the emitters in this frame's sub-frames so far (written at sub-frame 0,
+// raised to a penumbra by later ones); 2i + 1, what sub-frame 0 saw, frozen for the later
+// sub-frames to compare with the neighbours': the emitters' word (bits 0–1, SHADOW_NONE where
+// the pixel was no surface) and the visibility of punctual lights 0 … REUSED_LIGHTS − 1 (bit
+// 2 + i set where light i's shadow ray was unoccluded).
+layout(binding = B_DIRECT_SHADOWS, std430) buffer Shadows { uint shadows[]; };
+// What a pixel's neighbourhood saw of the emitters (the values of the first word).
 const uint SHADOW_HIDDEN = 0u;
 const uint SHADOW_LIT = 1u;
 const uint SHADOW_PENUMBRA = 2u;
+const uint SHADOW_NONE = 3u;
+const uint REUSED_LIGHTS = 30u;
 
-layout(push_constant) uniform Push { DirectPush pc; };
+// After sub-frame 0 (pc.adaptive_shadows): which of sub-frame 0's answers this pixel's sample
+// may take without a ray. Every one of its 3×3 neighbours (inside the image) must have been a
+// surface and have seen the same: the same visibility of every reused punctual light
+// (`punctual`), and the emitters wholly visible or wholly hidden alike (`emitters`). A shadow
+// boundary at or next to the pixel therefore keeps its rays; what is reused is a pixel deep
+// inside light or shadow, whose jittered samples, within half a pixel of its centre, see what
+// nine centres around them saw (a shadow finer than the pixel grid can be missed).
+struct Reuse {
+    uint frozen;  // the pixel's sub-frame-0 word
+    bool punctual;
+    bool emitters;
+};
+
+Reuse shadow_reuse(ivec2 pixel) {
+    Reuse r;
+    r.frozen = SHADOW_NONE;
+    r.punctual = false;
+    r.emitters = false;
+    if (pc.adaptive_shadows == 0u || pc.sub_frame == 0u) {
+        return r;
+    }
+    uint own = shadows[2u * (uint(pixel.y) * frame.resolution.x + uint(pixel.x)) + 1u];
+    r.frozen = own;
+    if ((own & 3u) == SHADOW_NONE) {
+        return r;
+    }
+    r.punctual = true;
+    r.emitters = (own & 3u) != SHADOW_PENUMBRA;
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            ivec2 q = pixel + ivec2(dx, dy);
+            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(frame.resolution.xy)))) {
+                continue;
+            }
+            uint n = shadows[2u * (uint(q.y) * frame.resolution.x + uint(q.x)) + 1u];
+            bool surface = (n & 3u) != SHADOW_NONE;
+            r.punctual = r.punctual && surface && (n >> 2) == (own >> 2);
+            r.emitters = r.emitters && surface && (n & 3u) == (own & 3u);
+        }
+    }
+    return r;
+}
 
 #ifdef HAS_RADIANCE_CACHE
 // Radiance records for glossy lobes (docs/radiance-caching.md §6.2): where pc.radiance_cache is
@@ -210,6 +256,20 @@ vec3 one_sample(Surface s, vec3 origin, float u_pick, vec3 u3, vec2 u2) {
 #endif
 }
 
+// Whether punctual light `i` reaches the sample: sub-frame 0's answer where `reuse` allows
+// (lights below REUSED_LIGHTS), else a shadow ray, whose answer sets bit 2 + i of `seen`.
+bool punctual_visible(uint i, vec3 origin, vec3 position, vec3 dir, float dist, Reuse reuse,
+                      inout uint seen) {
+    if (i < REUSED_LIGHTS && reuse.punctual) {
+        return (reuse.frozen & (4u << i)) != 0u;
+    }
+    bool visible = unoccluded_to(origin, position, dir, dist);
+    if (visible && i < REUSED_LIGHTS) {
+        seen |= 4u << i;
+    }
+    return visible;
+}
+
 #ifdef HAS_SPECULAR
 #ifdef HAS_ANALYTIC_EMITTERS
 #error "the closed-form emitters assume Lambertian receivers (ScenePlan::analytic_emitters)"
@@ -284,8 +344,8 @@ vec3 one_sample_brdf(Surface s, Bsdf f, vec3 origin, float u_pick, vec3 u3, vec2
     return le * fc / (C_EMITTER * pdf_light + C_BSDF * bs.pdf);
 }
 
-// The punctual lights reflected by the full BRDF.
-vec3 punctual_brdf(Surface s, Bsdf f, vec3 origin) {
+// The punctual lights reflected by the full BRDF (visibility as in `punctual`).
+vec3 punctual_brdf(Surface s, Bsdf f, vec3 origin, Reuse reuse, inout uint seen) {
     vec3 sum = vec3(0.0);
 #ifdef HAS_LIGHTS
     for (uint i = 0u; i < frame.counts.y; ++i) {
@@ -294,7 +354,7 @@ vec3 punctual_brdf(Surface s, Bsdf f, vec3 origin) {
         vec3 e = punctual_incident(lights[i], s.position, dir, dist);
         vec3 fc = bsdf_f_cos(f, s, dir);
         if (any(greaterThan(fc, vec3(0.0))) && any(greaterThan(e, vec3(0.0))) &&
-            unoccluded_to(origin, s.position, dir, dist)) {
+            punctual_visible(i, origin, s.position, dir, dist, reuse, seen)) {
             sum += e * fc;
         }
     }
@@ -381,8 +441,10 @@ void emitter_ratio_sums(Surface s, vec3 origin, uint first, uint count, vec3 shi
 }
 #endif
 
-// Punctual lights (delta lights: no sampling, one shadow ray each, the same for every sample).
-vec3 punctual(Surface s, vec3 origin) {
+// Punctual lights (delta lights: no sampling, one shadow ray each, the same for every sample):
+// the light's visibility from the sample, or sub-frame 0's where `reuse` allows; a traced
+// answer for a reused light sets its bit in `seen`.
+vec3 punctual(Surface s, vec3 origin, Reuse reuse, inout uint seen) {
     vec3 sum = vec3(0.0);
 #ifdef HAS_LIGHTS
     for (uint i = 0u; i < frame.counts.y; ++i) {
@@ -391,7 +453,7 @@ vec3 punctual(Surface s, vec3 origin) {
         vec3 e = punctual_incident(lights[i], s.position, dir, dist);
         float cos_s = dot(s.shading_normal, dir);
         if (cos_s > 0.0 && dot(s.geometric_normal, dir) > 0.0 && any(greaterThan(e, vec3(0.0))) &&
-            unoccluded_to(origin, s.position, dir, dist)) {
+            punctual_visible(i, origin, s.position, dir, dist, reuse, seen)) {
             sum += e * cos_s;
         }
     }
@@ -408,6 +470,8 @@ struct PixelLight {
     vec3 sum_all;
     vec3 sum_visible;
     uint seen;  // with adaptive shadows after sub-frame 0: what sub-frame 0 saw (SHADOW_*)
+    bool reused;  // no emitter sample: sub-frame 0's answer stands (`Reuse`)
+    uint punctual_seen;  // the traced punctual lights' visibility bits (`punctual_visible`)
 };
 
 PixelLight pixel_light(GSample g, ivec2 pixel) {
@@ -425,6 +489,9 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     light.sum_all = vec3(0.0);
     light.sum_visible = vec3(0.0);
     light.seen = SHADOW_PENUMBRA;
+    light.reused = false;
+    light.punctual_seen = 0u;
+    Reuse reuse = shadow_reuse(pixel);
     uint samples = max(pc.samples, 1u);
     Rng rng = rng_init(index, 0xffffffffu, pc.seed);
     float shift_pick = rng_next(rng);
@@ -441,12 +508,14 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     n = max(1u, samples - n_emitters);
 #endif
     // After sub-frame 0, where no penumbra was seen one ray tells lit from hidden: the ratio is
-    // exact there whatever the count (docs/cache-frame.md §8.2). Sub-frame k's samples start
-    // at k × n_emitters of the sequence either way.
+    // exact there whatever the count, and none where the whole neighbourhood saw the same
+    // (`shadow_reuse`; docs/cache-frame.md §8.2). Sub-frame k's samples start at
+    // k × n_emitters of the sequence either way.
     if (pc.adaptive_shadows != 0u && pc.sub_frame > 0u) {
-        light.seen = penumbra[index];
+        light.seen = shadows[2u * index];
     }
-    uint n_shadow = light.seen == SHADOW_PENUMBRA ? n_emitters : 1u;
+    uint n_shadow = light.seen == SHADOW_PENUMBRA ? n_emitters : (reuse.emitters ? 0u : 1u);
+    light.reused = n_shadow == 0u;
     light.unshadowed = analytic_emitter_irradiance(origin, s.shading_normal);
     if (any(greaterThan(light.unshadowed, vec3(0.0)))) {
         emitter_ratio_sums(s, origin, pc.sub_frame * n_emitters, n_shadow, shift_light,
@@ -490,9 +559,10 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
             spec += e;
         }
     }
-    light.rest = sum / float(n) + punctual_brdf(s, f, origin) + spec / float(max(paths, 1u));
+    light.rest = sum / float(n) + punctual_brdf(s, f, origin, reuse, light.punctual_seen) +
+                 spec / float(max(paths, 1u));
 #else
-    light.rest = sum / float(n) + punctual(s, origin);
+    light.rest = sum / float(n) + punctual(s, origin, reuse, light.punctual_seen);
 #endif
     return light;
 }
@@ -556,9 +626,13 @@ void main() {
     light.sum_all = vec3(0.0);
     light.sum_visible = vec3(0.0);
     light.seen = SHADOW_PENUMBRA;
+    light.reused = false;
+    light.punctual_seen = 0u;
     if (g.surface) {
         light = pixel_light(g, pixel);
     }
+    // Sub-frame 0's emitter word for the frozen copy (HIDDEN for all without analytic emitters).
+    uint frozen_class = SHADOW_HIDDEN;
     vec3 e = light.rest;
 #ifdef HAS_ANALYTIC_EMITTERS
     // Every invocation of the workgroup reaches this barrier (no early return above).
@@ -591,7 +665,9 @@ void main() {
                 partly_hidden = partly_hidden || (!lit && !dark);
             }
         }
-        if (!reached) {
+        if (!reached && light.reused) {
+            own = light.seen;  // no sample by design: sub-frame 0's answer stands
+        } else if (!reached) {
             // Unknown where some light arrives unshadowed: every sample is kept.
             own = any(greaterThan(light.unshadowed, vec3(0.0))) ? SHADOW_PENUMBRA : SHADOW_HIDDEN;
         } else if (partly_hidden || (any_lit && any_dark)) {
@@ -617,16 +693,22 @@ void main() {
                 }
             }
         }
+        frozen_class = mark ? SHADOW_PENUMBRA : own;
         if (inside) {
             uint index = uint(pixel.y) * frame.resolution.x + uint(pixel.x);
             if (pc.sub_frame == 0u) {
-                penumbra[index] = mark ? SHADOW_PENUMBRA : own;
+                shadows[2u * index] = frozen_class;
             } else if (mark) {
-                penumbra[index] = SHADOW_PENUMBRA;
+                shadows[2u * index] = SHADOW_PENUMBRA;
             }
         }
     }
 #endif
+    if (pc.adaptive_shadows != 0u && pc.sub_frame == 0u && inside) {
+        // Read by later sub-frames only (other dispatches): no race with the neighbours' reads.
+        uint index = uint(pixel.y) * frame.resolution.x + uint(pixel.x);
+        shadows[2u * index + 1u] = g.surface ? frozen_class | light.punctual_seen : SHADOW_NONE;
+    }
     if (!inside) {
         return;
     }

@@ -33,6 +33,7 @@ void main() {
         counters.dropped_requests = 0u;
         counters.rejected_records = 0u;
         counters.batch_draw = DrawArgs(QUAD_VERTICES, 0u, 0u, 0u);
+        counters.radii_shrunk = 0u;
     } else if (pc.step == COUNTERS_BEGIN_LEVEL) {
         counters.requested = 0u;
         counters.holes = 0u;

@@ -34,7 +34,9 @@
 
 layout(local_size_x = 64) in;
 
-layout(binding = B_NEIGHBOURS_COUNTERS, std430) readonly buffer Counters { IcCounters counters; };
+// Read, except radii_shrunk: mode 2 counts there the records outside the batch whose used
+// radius it lowered (their coverage splat is then stale: crates/radcache-render/src/frame/ic/phases.rs).
+layout(binding = B_NEIGHBOURS_COUNTERS, std430) buffer Counters { IcCounters counters; };
 layout(binding = B_NEIGHBOURS_RECORDS, std430) buffer Records { GpuRecord records[]; };
 // The same buffer as 32-bit words, for the atomic minimum on R_orig (word 7 of 44 per record).
 layout(binding = B_NEIGHBOURS_RECORD_WORDS, std430) buffer RecordWords { uint record_words[]; };
@@ -148,7 +150,13 @@ void main() {
             local_min = min(local_min, neighbour_clamp(IC_FAR, r_j, d));
             float shrunk = neighbour_clamp(r_j, r_i, d);
             if (shrunk < r_j) {
-                atomicMin(record_words[j * GPU_RECORD_WORDS + GPU_RECORD_R_ORIG_WORD], floatBitsToUint(shrunk));
+                uint before = atomicMin(record_words[j * GPU_RECORD_WORDS + GPU_RECORD_R_ORIG_WORD],
+                                        floatBitsToUint(shrunk));
+                vec2 b = records[j].bounds.xy;
+                if (j < base &&
+                    clamp_radius(shrunk, b.x, b.y) < clamp_radius(uintBitsToFloat(before), b.x, b.y)) {
+                    atomicAdd(counters.radii_shrunk, 1u);
+                }
             }
         }
     }

@@ -4,6 +4,8 @@
 // clamped to [0, 4·E_i] (docs/irradiance-cache.md §6.2), and (w·Ẽ, w) added into the RGBA32F target
 // by (ONE, ONE) blending (and 1 into the record-count target). Weights are bounded (T&L ≤ 1,
 // Ward ≤ 1/10⁻³), so the float sums cannot overflow.
+// With SPLAT_COVERAGE (the cache phase's coverage splats, which hole selection reads for Σw
+// alone): (0, 0, 0, w), the same weights without the irradiance and without marking records.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -23,12 +25,15 @@ void main() {
         discard;
     }
     GpuRecord rec = records[v_record];
-    vec3 p_i = rec.position_radius.xyz;
-    vec3 n_i = rec.normal_rorig.xyz;
     float w = splat_weight_at(g, rec);
     if (!(w > pc.w_min)) {
         discard;
     }
+#ifdef SPLAT_COVERAGE
+    o_sum = vec4(0.0, 0.0, 0.0, w);
+#else
+    vec3 p_i = rec.position_radius.xyz;
+    vec3 n_i = rec.normal_rorig.xyz;
     float att = gradient_attenuation(rec.normal_rorig.w, rec.bounds.x);
     vec3 e = extrapolate_irradiance(rec.irradiance.rgb, rec.grad_r_red.xyz, rec.grad_r_green.xyz,
                                     rec.grad_r_blue.xyz, att * rec.grad_t_red.xyz,
@@ -39,5 +44,6 @@ void main() {
         last_used[v_record] = pc.mark_frame;
     }
     o_sum = vec4(w * e, w);
+#endif
     o_count = 1.0;
 }

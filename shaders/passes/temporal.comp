@@ -176,6 +176,7 @@ void main() {
             list_counters.request_capacity = pc.capacity;
             list_counters.dropped_requests = 0u;
             list_counters.rejected_records = 0u;
+            list_counters.radii_shrunk = 0u;
         }
         return;
     }

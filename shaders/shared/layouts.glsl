@@ -115,7 +115,8 @@ struct IcCounters {
     uint dropped_requests;
     uint rejected_records;
     DrawArgs batch_draw;
-};  // 80 bytes
+    uint radii_shrunk;
+};  // 84 bytes
 
 struct GpuRecordTemporal {
     vec4 object_position;

@@ -1,6 +1,7 @@
 //! The neighbour-clamping pass's hash grid on lavapipe against the all-pairs clamp on the CPU
 //! (`radcache_cache::neighbour_clamp`), over thousands of records whose R⁺ spans several grid
-//! levels, clustered so that many pairs interact.
+//! levels, clustered so that many pairs interact; and the count of old records' radii lowered
+//! (`IcCounters::radii_shrunk`, which decides whether the cache phase repeats).
 
 use glam::Vec3;
 use radcache_cache::radius::neighbour_clamp;
@@ -117,6 +118,7 @@ fn the_hash_grid_gives_the_all_pairs_clamp() {
         dropped_requests: 0,
         rejected_records: 0,
         batch_draw: DrawArgs::quads((n - base) as u32, base as u32),
+        radii_shrunk: 0,
     };
     let mut rec = ctx.begin("test.grid").unwrap();
     upload(&mut rec, &state, &records, counters);
@@ -124,12 +126,34 @@ fn the_hash_grid_gives_the_all_pairs_clamp() {
     pass.record(&mut rec, &state, SCENE_SCALE).unwrap();
     ctx.submit(rec).unwrap().wait().unwrap();
     let out: Vec<GpuRecord> = ctx.read_buffer(&state.records, n).unwrap();
+    let shrunk = state.read_counters().unwrap().radii_shrunk;
+
+    // The same batch moved far from every old record: it clamps only itself, and no old
+    // record's coverage goes stale.
+    let mut apart = records.clone();
+    for r in &mut apart[base..] {
+        r.position_radius[0] += 1000.0;
+    }
+    let mut rec = ctx.begin("test.grid_apart").unwrap();
+    upload(&mut rec, &state, &apart, counters);
+    pass.record_rebuild(&mut rec, &state, SCENE_SCALE).unwrap();
+    pass.record(&mut rec, &state, SCENE_SCALE).unwrap();
+    ctx.submit(rec).unwrap().wait().unwrap();
+    let apart_out: Vec<GpuRecord> = ctx.read_buffer(&state.records, n).unwrap();
+    let apart_shrunk = state.read_counters().unwrap().radii_shrunk;
     drop((pass, state));
     finish(ctx);
+    let new_clamped = (base..n)
+        .filter(|&k| {
+            apart_out[k].normal_rorig[3] < apart[k].normal_rorig[3].min(apart[k].bounds[1])
+        })
+        .count();
+    assert!(new_clamped > 0, "the batch must clamp itself");
+    assert_eq!(apart_shrunk, 0, "no old record is near the batch");
 
     let upper = cpu_clamp(&records, base, false);
     let lower = cpu_clamp(&records, base, true);
-    let (mut changed, mut chained) = (0, 0);
+    let (mut changed, mut chained, mut old_shrunk) = (0, 0, 0);
     for k in 0..n {
         let got = out[k].normal_rorig[3];
         let hi = records[k].bounds[1];
@@ -143,11 +167,19 @@ fn the_hash_grid_gives_the_all_pairs_clamp() {
         // The radius the splat uses agrees with the all-pairs clamp.
         if got.min(hi) < records[k].normal_rorig[3].min(hi) {
             changed += 1;
+            // (The lower bound is 0.05 R⁺, below every radius here.)
+            old_shrunk += usize::from(k < base);
         }
         if lower[k] < upper[k] {
             chained += 1;
         }
     }
+    // Every old record whose used radius went down is counted (once per lowering, so at least
+    // once): its coverage splat is stale (crates/radcache-render/src/frame/ic/phases.rs).
+    assert!(
+        shrunk as usize >= old_shrunk && old_shrunk > 0,
+        "radii_shrunk {shrunk}, old records shrunk {old_shrunk}"
+    );
     // The data must exercise the clamp: many records shrink, among them old and new ones.
     assert!(changed > n / 10, "only {changed} radii changed");
     assert!(

@@ -106,6 +106,7 @@ fn counters(records: u32, batch_base: u32) -> IcCounters {
         dropped_requests: 0,
         rejected_records: 0,
         batch_draw: DrawArgs::quads(records - batch_base, batch_base),
+        radii_shrunk: 0,
     }
 }
 
@@ -229,7 +230,8 @@ fn splat_sums_match_the_cpu_weight_and_extrapolation() {
 /// G-buffer (floor, ceiling and side walls seen obliquely, corners where zones reach another
 /// surface), Σw of records at random pixels, with random radii and normals tilted up to ~25°,
 /// equals the CPU's sum over every record at every pixel. A quad that missed a pixel of its
-/// zone would lose that record's weight there.
+/// zone would lose that record's weight there. The coverage splat (`SPLAT_COVERAGE`, what hole
+/// selection reads) gives the same Σw and no colour.
 #[test]
 fn splat_quads_cover_every_pixel_of_each_zone() {
     let scene = cornell();
@@ -284,6 +286,33 @@ fn splat_quads_cover_every_pixel_of_each_zone() {
         .unwrap();
     gpu.ctx.submit(rec).unwrap().wait().unwrap();
     let sums: Vec<[f32; 4]> = gpu.ctx.read_image(&splat.sum).unwrap();
+    // The cache phase's coverage splat: the same Σw, no colour.
+    let mut rec = gpu.ctx.begin("test.splat_coverage").unwrap();
+    splat
+        .record_coverage(
+            &mut rec,
+            SplatScope::All,
+            &gpu.scene,
+            &gpu.gbuffer,
+            &state,
+            &weights,
+        )
+        .unwrap();
+    gpu.ctx.submit(rec).unwrap().wait().unwrap();
+    let coverage: Vec<[f32; 4]> = gpu.ctx.read_image(&splat.sum).unwrap();
+    for (i, (c, s)) in coverage.iter().zip(&sums).enumerate() {
+        assert_eq!(
+            c[..3],
+            [0.0; 3],
+            "pixel {i}: the coverage splat wrote colour"
+        );
+        assert!(
+            (c[3] - s[3]).abs() <= 1e-6 * s[3].max(1.0),
+            "pixel {i}: coverage Σw {}, splat Σw {}",
+            c[3],
+            s[3]
+        );
+    }
     let (mut reached, mut oblique) = (0, 0);
     for &i in &surface {
         let (p, n) = (at(g.position[i]), at(g.normal[i]));

@@ -223,10 +223,10 @@ pass_bindings! {
         GLOSSY_WEIGHTS: StorageBuffer,
         /// The glossy lobe's SH table (`float[]`, read with `HAS_RADIANCE_CACHE`).
         GLOSSY_TABLE: StorageBuffer,
-        /// What each pixel's neighbourhood saw of the emitters: hidden, lit or a penumbra
-        /// (`uint[]`, with `HAS_ANALYTIC_EMITTERS` and adaptive emitter shadows;
-        /// docs/cache-frame.md §8.2).
-        PENUMBRA: StorageBuffer,
+        /// Adaptive shadows (docs/cache-frame.md §8.2), two `uint` a pixel: what its
+        /// neighbourhood saw of the emitters (hidden, lit or a penumbra) in the frame so far, and
+        /// sub-frame 0's answers frozen (the emitters' and the punctual lights' visibility).
+        SHADOWS: StorageBuffer,
     }
 }
 

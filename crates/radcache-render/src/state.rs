@@ -344,6 +344,7 @@ impl IcState {
             dropped_requests: 0,
             rejected_records: 0,
             batch_draw: DrawArgs::quads(0, 0),
+            radii_shrunk: 0,
         };
         rec.update_buffer(&self.counters, 0, std::slice::from_ref(&counters));
         rec.barrier(Access::TRANSFER_WRITE, Access::ALL);

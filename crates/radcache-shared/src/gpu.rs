@@ -269,6 +269,10 @@ gpu_struct! {
         /// The splat of the last batch only: one quad per record of the batch from its first
         /// record (no instance before a batch ends, none after a level that created nothing).
         pub batch_draw: DrawArgs => struct,
+        /// Records whose used radius neighbour clamping lowered after they had been splatted
+        /// into a coverage (outside the batch being clamped): a running count, compared before
+        /// and after a cache pass (wraps).
+        pub radii_shrunk: u32 => "uint",
     }
 }
 
@@ -288,6 +292,7 @@ impl IcCounters {
             dropped_requests: 0,
             rejected_records: 0,
             batch_draw: DrawArgs::quads(0, 0),
+            radii_shrunk: 0,
         }
     }
 }
@@ -378,7 +383,7 @@ mod tests {
         errors.extend(std430_violations::<GpuRecordTemporal>());
         assert_eq!(std::mem::size_of::<GpuRecord>(), 176);
         assert_eq!(std::mem::size_of::<GpuRecordTemporal>(), 96);
-        assert_eq!(std::mem::size_of::<IcCounters>(), 80);
+        assert_eq!(std::mem::size_of::<IcCounters>(), 84);
         assert_eq!(std::mem::size_of::<GpuMaterial>(), 240);
         assert_eq!(std::mem::size_of::<GpuEmitter>(), 128);
         assert!(errors.is_empty(), "{}", errors.join("\n"));

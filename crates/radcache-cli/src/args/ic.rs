@@ -53,9 +53,11 @@ pub enum Emitters {
 pub enum EmitterShadowsArg {
     /// After the first sub-frame, a quarter of the direct samples in penumbrae (as the
     /// sub-frames so far saw them), one ray where the emitters were wholly visible or wholly
-    /// hidden (default; docs/cache-frame.md §8.2).
+    /// hidden, none (and no punctual light's shadow ray) where the pixel's whole 3×3
+    /// neighbourhood saw the same in the first sub-frame (default; docs/cache-frame.md §8.2).
     Adaptive,
-    /// A quarter of the direct samples at every pixel.
+    /// A quarter of the direct samples at every pixel, every punctual light's shadow ray at
+    /// every sub-frame.
     Fixed,
 }
 

@@ -192,7 +192,9 @@ pub enum EmitterShadows {
     /// penumbra (dilated by the same neighbourhood). Later sub-frames cast one ray where the
     /// pixel was lit or hidden, where the ratio estimator is exact whatever the count, and a
     /// quarter of the samples in penumbrae; a sub-frame that sees a lit or hidden pixel
-    /// otherwise than sub-frame 0 did marks it a penumbra.
+    /// otherwise than sub-frame 0 did marks it a penumbra. Where the pixel and all its 3×3
+    /// neighbours saw the same at sub-frame 0 (the emitters, and each punctual light's shadow
+    /// ray), later sub-frames take that answer and cast no ray.
     #[default]
     Adaptive,
     /// A quarter of the direct samples at every pixel and sub-frame.

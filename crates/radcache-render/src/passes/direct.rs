@@ -32,8 +32,9 @@ radcache_shared::gpu_struct! {
         pub radiance_cache: u32 => "uint",
         /// 1: after sub-frame 0, pixels whose neighbourhood saw the emitters wholly visible or
         /// wholly hidden (and no neighbour a penumbra) cast one emitter shadow ray instead of a
-        /// quarter of the samples ([`DirectPass::with_adaptive_shadows`]; docs/cache-frame.md
-        /// §8.2).
+        /// quarter of the samples, none where every 3×3 neighbour saw the same, and punctual
+        /// lights' shadow rays are left out there likewise
+        /// ([`DirectPass::with_adaptive_shadows`]; docs/cache-frame.md §8.2).
         pub adaptive_shadows: u32 => "uint",
         /// Padding.
         pub pad1: u32 => "uint",
@@ -57,9 +58,12 @@ pub struct DirectPass {
     placeholder: Buffer,
     /// The emitters' light is taken in closed form (`HAS_ANALYTIC_EMITTERS`).
     analytic: bool,
-    /// One `uint` a pixel: what its neighbourhood saw of the emitters in this frame's
-    /// sub-frames so far ([`DirectPass::with_adaptive_shadows`]).
-    penumbra: Option<Buffer>,
+    /// The scene has punctual lights (`HAS_LIGHTS`).
+    punctual: bool,
+    /// Two `uint` a pixel: what its neighbourhood saw of the emitters in this frame's
+    /// sub-frames so far, and what sub-frame 0 saw of them and of the punctual lights
+    /// ([`DirectPass::with_adaptive_shadows`]).
+    shadows: Option<Buffer>,
 }
 
 impl std::fmt::Debug for DirectPass {
@@ -133,28 +137,32 @@ impl DirectPass {
             rays,
             placeholder,
             analytic: analytic.is_some(),
-            penumbra: None,
+            punctual: scene.plan().has_punctual_lights(),
+            shadows: None,
         })
     }
 
-    /// Makes a pass whose emitters' light is in closed form spend its emitter shadow rays
-    /// where they are needed ([`crate::EmitterShadows::Adaptive`]), for images of `pixels`
-    /// pixels (4 bytes each): sub-frame 0 casts every pixel's quarter of the samples and
-    /// stores what its 3×3 neighbourhood saw (lit, hidden, or a penumbra, dilated by the
-    /// neighbourhood); later sub-frames cast one ray at lit and hidden pixels and mark the
-    /// penumbrae their rays find (docs/cache-frame.md §8.2). Other passes are returned as they
-    /// are, and so is every pass for `pixels` `None` (a quarter of the samples always).
+    /// Makes a pass whose emitters' light is in closed form, or whose scene has punctual
+    /// lights, spend its shadow rays where they are needed ([`crate::EmitterShadows::Adaptive`]),
+    /// for images of `pixels` pixels (8 bytes each): sub-frame 0 casts every pixel's rays (a
+    /// quarter of the samples toward the emitters, one per punctual light) and stores what its
+    /// 3×3 neighbourhood saw of the emitters (lit, hidden, or a penumbra, dilated by the
+    /// neighbourhood) and what it saw of each punctual light; later sub-frames cast no ray
+    /// where every 3×3 neighbour saw the same as the pixel, one toward the emitters at other
+    /// lit and hidden pixels, and mark the penumbrae their rays find (docs/cache-frame.md
+    /// §8.2). Other passes are returned as they are, and so is every pass for `pixels` `None`
+    /// (every ray always).
     pub fn with_adaptive_shadows(
         mut self,
         ctx: &Context,
         pixels: Option<u32>,
     ) -> Result<DirectPass> {
-        if let (true, Some(pixels)) = (self.analytic, pixels) {
-            self.penumbra = Some(Buffer::new(
+        if let (true, Some(pixels)) = (self.analytic || self.punctual, pixels) {
+            self.shadows = Some(Buffer::new(
                 ctx,
                 &BufferDesc {
-                    name: "direct.penumbra",
-                    size: u64::from(pixels.max(1)) * 4,
+                    name: "direct.shadows",
+                    size: u64::from(pixels.max(1)) * 8,
                     usage: vk::BufferUsageFlags::STORAGE_BUFFER,
                     location: MemoryLocation::GpuOnly,
                     alignment: 0,
@@ -204,18 +212,18 @@ impl DirectPass {
         bindings.push((b::GLOSSY_WEIGHTS, Resource::Buffer(weights)));
         bindings.push((b::GLOSSY_TABLE, Resource::Buffer(table)));
         let (w, h) = (gbuffer.width, gbuffer.height);
-        let penumbra = self.penumbra.as_ref();
-        if let Some(buffer) = penumbra {
-            if buffer.size() < u64::from(w) * u64::from(h) * 4 {
+        let shadows = self.shadows.as_ref();
+        if let Some(buffer) = shadows {
+            if buffer.size() < u64::from(w) * u64::from(h) * 8 {
                 return Err(Error::Invalid(format!(
-                    "the direct pass's penumbra marks hold {} pixels, the G-buffer has {w}x{h}",
-                    buffer.size() / 4
+                    "the direct pass's shadow marks hold {} pixels, the G-buffer has {w}x{h}",
+                    buffer.size() / 8
                 )));
             }
         }
         bindings.push((
-            b::PENUMBRA,
-            Resource::Buffer(penumbra.unwrap_or(&self.placeholder)),
+            b::SHADOWS,
+            Resource::Buffer(shadows.unwrap_or(&self.placeholder)),
         ));
         let push = DirectPush {
             samples: samples.max(1),
@@ -223,7 +231,7 @@ impl DirectPass {
             sub_frame,
             specular_paths: specular_paths(samples),
             radiance_cache: u32::from(glossy.is_some()),
-            adaptive_shadows: u32::from(penumbra.is_some()),
+            adaptive_shadows: u32::from(shadows.is_some()),
             pad1: 0,
             pad2: 0,
         };

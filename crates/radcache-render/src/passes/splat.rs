@@ -70,9 +70,11 @@ impl SplatWeights {
     }
 }
 
-/// The splat pipeline and its accumulation target.
+/// The splat pipelines and their accumulation target.
 pub struct SplatPass {
     pipeline: Pipeline,
+    /// The same weights without the irradiance (`SPLAT_COVERAGE`): Σ w alone, for hole selection.
+    coverage: Pipeline,
     /// Σ w·Ẽ (rgb) and Σ w (a) per pixel.
     pub sum: Image,
     /// Number of records that reach each pixel (R32F).
@@ -89,24 +91,28 @@ impl SplatPass {
     /// Compiles the pass and allocates the `width × height` accumulation target.
     pub fn new(ctx: &Context, shaders: &ShaderCompiler, width: u32, height: u32) -> Result<Self> {
         let vertex = shaders.compile("passes/splat.vert", &[])?;
-        let fragment = shaders.compile("passes/splat.frag", &[])?;
         let bindings = b::layout();
         let format = vk::Format::R32G32B32A32_SFLOAT;
-        let pipeline = Pipeline::graphics(
-            ctx,
-            &GraphicsDesc {
-                name: "splat",
-                vertex: &vertex,
-                fragment: &fragment,
-                bindings: &bindings,
-                push_constant_size: std::mem::size_of::<SplatWeights>() as u32,
-                color_formats: &[format, COUNT_FORMAT],
-                depth: None,
-                blend: Blend::Additive,
-                cull: vk::CullModeFlags::NONE,
-                topology: vk::PrimitiveTopology::TRIANGLE_LIST,
-            },
-        )?;
+        let pipeline_for = |name: &str, defines: &[(&str, &str)]| -> Result<Pipeline> {
+            let fragment = shaders.compile("passes/splat.frag", defines)?;
+            Ok(Pipeline::graphics(
+                ctx,
+                &GraphicsDesc {
+                    name,
+                    vertex: &vertex,
+                    fragment: &fragment,
+                    bindings: &bindings,
+                    push_constant_size: std::mem::size_of::<SplatWeights>() as u32,
+                    color_formats: &[format, COUNT_FORMAT],
+                    depth: None,
+                    blend: Blend::Additive,
+                    cull: vk::CullModeFlags::NONE,
+                    topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+                },
+            )?)
+        };
+        let pipeline = pipeline_for("splat", &[])?;
+        let coverage = pipeline_for("splat.coverage", &[("SPLAT_COVERAGE", "1")])?;
         let sum = Image::new(
             ctx,
             &ImageDesc {
@@ -129,16 +135,66 @@ impl SplatPass {
         )?;
         Ok(SplatPass {
             pipeline,
+            coverage,
             sum,
             count,
         })
     }
 
     /// Records splatting the records of `scope` with `weights`, in a profiler scope named `name`
-    /// (e.g. `splat` or `splat.coverage`).
+    /// (e.g. `splat`).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
+        rec: &mut Recorder,
+        name: &str,
+        scope: SplatScope,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        state: &IcState,
+        weights: &SplatWeights,
+    ) -> Result<()> {
+        self.record_with(
+            &self.pipeline,
+            rec,
+            name,
+            scope,
+            scene,
+            gbuffer,
+            state,
+            weights,
+        )
+    }
+
+    /// Records the coverage splat of `scope` (profiler scope `splat.coverage`): the same weights
+    /// as [`SplatPass::record`] and the same Σ w in the target's alpha, with zero in its colour
+    /// (hole selection reads Σ w alone), so the fragments skip the irradiance's extrapolation.
+    pub fn record_coverage(
+        &self,
+        rec: &mut Recorder,
+        scope: SplatScope,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        state: &IcState,
+        weights: &SplatWeights,
+    ) -> Result<()> {
+        let name = "splat.coverage";
+        self.record_with(
+            &self.coverage,
+            rec,
+            name,
+            scope,
+            scene,
+            gbuffer,
+            state,
+            weights,
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn record_with(
+        &self,
+        pipeline: &Pipeline,
         rec: &mut Recorder,
         name: &str,
         scope: SplatScope,
@@ -175,7 +231,7 @@ impl SplatPass {
                 ],
                 None,
             );
-            rec.bind_pipeline(&self.pipeline);
+            rec.bind_pipeline(pipeline);
             rec.push_bindings(&bindings);
             rec.push_constants(weights);
             rec.draw_indirect(&state.counters, offset, 1);

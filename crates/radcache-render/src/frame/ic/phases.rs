@@ -160,7 +160,11 @@ impl IcRenderer {
     /// sub-frame shrink earlier ones (neighbour clamping), which can uncover a pixel an earlier
     /// sub-frame had covered: with `settle_records`, passes repeat until one creates nothing (at
     /// most [`MAX_CACHE_PASSES`]), so the records left are a fixed point and the next frame of a
-    /// static scene creates none and shades identically.
+    /// static scene creates none and shades identically. A pass after which no record's used
+    /// radius was lowered (`IcCounters::radii_shrunk`) and whose every sub-frame ended on a
+    /// selection that found no hole is already that fixed point: coverage only grew since those
+    /// selections, so the next pass would create nothing, and it is skipped (its first splat
+    /// redraws every record; a kept frame's few new records rarely shrink one).
     pub(super) fn cache_phase(
         &self,
         ctx: &Context,
@@ -178,14 +182,17 @@ impl IcRenderer {
         };
         for pass in 0..passes {
             let before = run.records_created();
+            let shrunk_before = self.state.read_counters()?.radii_shrunk;
+            let mut covered = true;
             for k in 0..run.sub_frames {
-                self.fill_holes(ctx, gpu, settings, k, run)?;
+                covered &= self.fill_holes(ctx, gpu, settings, k, run)?;
                 if pass == 0 {
                     run.report(k + 1);
                 }
             }
             run.stats.cache_passes = pass + 1;
-            if run.records_created() == before {
+            let shrunk = self.state.read_counters()?.radii_shrunk != shrunk_before;
+            if run.records_created() == before || (covered && !shrunk) {
                 break;
             }
         }
@@ -195,7 +202,8 @@ impl IcRenderer {
     /// The cache phase of sub-frame `k`: its G-buffer, then hole filling level by level. Each
     /// level is two submissions, selection (coverage splat, holes) and creation (records,
     /// neighbours), so the creation's wall time is the record pass's own. A level that finds no
-    /// hole ends the sub-frame (finer levels would find none either).
+    /// hole ends the sub-frame (finer levels would find none either); whether one did is
+    /// returned (false: the last level created records or left holes no request reached).
     fn fill_holes(
         &self,
         ctx: &Context,
@@ -203,7 +211,7 @@ impl IcRenderer {
         settings: &IcSettings,
         k: u32,
         run: &mut FrameRun<'_>,
-    ) -> Result<()> {
+    ) -> Result<bool> {
         let creation = self.params.for_creation();
         let creation_weights = SplatWeights::from_params(&creation);
         let seed = creation_seed(settings.seed, k);
@@ -230,16 +238,8 @@ impl IcRenderer {
                 SplatScope::LastBatch
             };
             let (gbuffer, state) = (&self.gbuffer, &self.state);
-            let name = "splat.coverage";
-            self.splat.record(
-                &mut rec,
-                name,
-                scope,
-                gpu,
-                gbuffer,
-                state,
-                &creation_weights,
-            )?;
+            self.splat
+                .record_coverage(&mut rec, scope, gpu, gbuffer, state, &creation_weights)?;
             let selection_mode = HoleSelection::Request {
                 spacing: self.params.level_spacing_px(level),
                 threshold: creation.coverage_threshold(),
@@ -254,7 +254,7 @@ impl IcRenderer {
             run.clock.lap("hole_selection");
             if c.dispatch.x == 0 {
                 if c.holes == 0 {
-                    break;
+                    return Ok(true);
                 }
                 continue;
             }
@@ -281,7 +281,7 @@ impl IcRenderer {
             run.stats.records_per_level[level as usize] += u64::from(c.dispatch.x);
             run.clock.lap("record_creation");
         }
-        Ok(())
+        Ok(false)
     }
 
     /// **Shade** sub-frame `k`: its G-buffer, direct light, the splat of every record with the
