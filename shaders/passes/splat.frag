@@ -6,6 +6,7 @@
 // Ward ≤ 1/10⁻³), so the float sums cannot overflow.
 // With SPLAT_COVERAGE (the cache phase's coverage splats, which hole selection reads for Σw
 // alone): (0, 0, 0, w), the same weights without the irradiance and without marking records.
+// The record-count target (the debug AOV) is drawn only with SPLAT_COUNT.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -17,7 +18,9 @@
 
 layout(location = 0) flat in uint v_record;
 layout(location = 0) out vec4 o_sum;
+#ifdef SPLAT_COUNT
 layout(location = 1) out float o_count;  // records reaching the pixel (debug AOV)
+#endif
 
 void main() {
     GSample g = gbuffer_load(ivec2(gl_FragCoord.xy));
@@ -39,11 +42,14 @@ void main() {
                                     rec.grad_r_blue.xyz, att * rec.grad_t_red.xyz,
                                     att * rec.grad_t_green.xyz, att * rec.grad_t_blue.xyz,
                                     g.position, g.normal, p_i, n_i);
-    if (pc.mark_frame != 0u) {
-        // Every writer stores the same value: the race is benign.
+    // Every writer stores the same value: the race is benign. Only the first fragment of the
+    // frame stores it (a store to a line other cores read makes them fetch it again).
+    if (pc.mark_frame != 0u && last_used[v_record] != pc.mark_frame) {
         last_used[v_record] = pc.mark_frame;
     }
     o_sum = vec4(w * e, w);
 #endif
+#ifdef SPLAT_COUNT
     o_count = 1.0;
+#endif
 }

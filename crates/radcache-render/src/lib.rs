@@ -42,7 +42,7 @@ pub use passes::record::{
     RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE, RECORD_INSTANCE_SHIFT,
 };
 pub use passes::record::{RecordPass, MAX_STRATA, R_EPS_REL};
-pub use passes::splat::{SplatPass, SplatScope, SplatWeights};
+pub use passes::splat::{SplatOutput, SplatPass, SplatScope, SplatWeights};
 pub use passes::splat_glossy::GlossySplatPass;
 pub use passes::temporal::{Lifespans, TemporalPass};
 pub use scene::env_map::{gpu_alias, texel_solid_angle, EnvMap};

@@ -70,10 +70,24 @@ impl SplatWeights {
     }
 }
 
+/// What a splat draws (a pipeline each).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplatOutput {
+    /// Σ w·Ẽ and Σ w into [`SplatPass::sum`].
+    Irradiance,
+    /// The same and the number of records per pixel into [`SplatPass::count`] (the debug AOV).
+    IrradianceAndCount,
+    /// Σ w alone (`SPLAT_COVERAGE`, the colour zero): what hole selection reads.
+    Coverage,
+}
+
 /// The splat pipelines and their accumulation target.
 pub struct SplatPass {
-    pipeline: Pipeline,
-    /// The same weights without the irradiance (`SPLAT_COVERAGE`): Σ w alone, for hole selection.
+    /// [`SplatOutput::Irradiance`].
+    irradiance: Pipeline,
+    /// [`SplatOutput::IrradianceAndCount`].
+    counted: Pipeline,
+    /// [`SplatOutput::Coverage`].
     coverage: Pipeline,
     /// Σ w·Ẽ (rgb) and Σ w (a) per pixel.
     pub sum: Image,
@@ -95,6 +109,8 @@ impl SplatPass {
         let format = vk::Format::R32G32B32A32_SFLOAT;
         let pipeline_for = |name: &str, defines: &[(&str, &str)]| -> Result<Pipeline> {
             let fragment = shaders.compile("passes/splat.frag", defines)?;
+            let counted = defines.iter().any(|(d, _)| *d == "SPLAT_COUNT");
+            let formats = [format, COUNT_FORMAT];
             Ok(Pipeline::graphics(
                 ctx,
                 &GraphicsDesc {
@@ -103,7 +119,7 @@ impl SplatPass {
                     fragment: &fragment,
                     bindings: &bindings,
                     push_constant_size: std::mem::size_of::<SplatWeights>() as u32,
-                    color_formats: &[format, COUNT_FORMAT],
+                    color_formats: &formats[..if counted { 2 } else { 1 }],
                     depth: None,
                     blend: Blend::Additive,
                     cull: vk::CullModeFlags::NONE,
@@ -111,7 +127,8 @@ impl SplatPass {
                 },
             )?)
         };
-        let pipeline = pipeline_for("splat", &[])?;
+        let irradiance = pipeline_for("splat", &[])?;
+        let counted = pipeline_for("splat.counted", &[("SPLAT_COUNT", "1")])?;
         let coverage = pipeline_for("splat.coverage", &[("SPLAT_COVERAGE", "1")])?;
         let sum = Image::new(
             ctx,
@@ -134,7 +151,8 @@ impl SplatPass {
             },
         )?;
         Ok(SplatPass {
-            pipeline,
+            irradiance,
+            counted,
             coverage,
             sum,
             count,
@@ -142,7 +160,7 @@ impl SplatPass {
     }
 
     /// Records splatting the records of `scope` with `weights`, in a profiler scope named `name`
-    /// (e.g. `splat`).
+    /// (e.g. `splat`), counting the records per pixel too ([`SplatOutput::IrradianceAndCount`]).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -154,16 +172,8 @@ impl SplatPass {
         state: &IcState,
         weights: &SplatWeights,
     ) -> Result<()> {
-        self.record_with(
-            &self.pipeline,
-            rec,
-            name,
-            scope,
-            scene,
-            gbuffer,
-            state,
-            weights,
-        )
+        let output = SplatOutput::IrradianceAndCount;
+        self.record_output(output, rec, name, scope, scene, gbuffer, state, weights)
     }
 
     /// Records the coverage splat of `scope` (profiler scope `splat.coverage`): the same weights
@@ -178,23 +188,16 @@ impl SplatPass {
         state: &IcState,
         weights: &SplatWeights,
     ) -> Result<()> {
-        let name = "splat.coverage";
-        self.record_with(
-            &self.coverage,
-            rec,
-            name,
-            scope,
-            scene,
-            gbuffer,
-            state,
-            weights,
-        )
+        let (output, name) = (SplatOutput::Coverage, "splat.coverage");
+        self.record_output(output, rec, name, scope, scene, gbuffer, state, weights)
     }
 
+    /// As [`SplatPass::record`], drawing `output`; the count target is left as it is unless
+    /// `output` draws it.
     #[allow(clippy::too_many_arguments)]
-    fn record_with(
+    pub fn record_output(
         &self,
-        pipeline: &Pipeline,
+        output: SplatOutput,
         rec: &mut Recorder,
         name: &str,
         scope: SplatScope,
@@ -203,6 +206,12 @@ impl SplatPass {
         state: &IcState,
         weights: &SplatWeights,
     ) -> Result<()> {
+        let pipeline = match output {
+            SplatOutput::Irradiance => &self.irradiance,
+            SplatOutput::IrradianceAndCount => &self.counted,
+            SplatOutput::Coverage => &self.coverage,
+        };
+        let counted = output == SplatOutput::IrradianceAndCount;
         let (clear, offset) = match scope {
             SplatScope::All => (Some([0.0; 4]), 32),
             SplatScope::LastBatch => (None, 64),
@@ -211,26 +220,26 @@ impl SplatPass {
             rec.use_image(image, ImageUse::FragmentStorage);
         }
         rec.use_image(&self.sum, ImageUse::ColorAttachment);
-        rec.use_image(&self.count, ImageUse::ColorAttachment);
+        if counted {
+            rec.use_image(&self.count, ImageUse::ColorAttachment);
+        }
         let scene_bindings = scene.bindings();
         let mut bindings = vec![scene_bindings[FRAME as usize]];
         bindings.extend(gbuffer.bindings());
         bindings.push((b::RECORDS, Resource::Buffer(&state.records)));
         bindings.push((b::LAST_USED, Resource::Buffer(&state.last_used)));
         rec.pass(name, |rec| {
-            rec.begin_rendering(
-                &[
-                    ColorTarget {
-                        image: &self.sum,
-                        clear,
-                    },
-                    ColorTarget {
-                        image: &self.count,
-                        clear,
-                    },
-                ],
-                None,
-            );
+            let targets = [
+                ColorTarget {
+                    image: &self.sum,
+                    clear,
+                },
+                ColorTarget {
+                    image: &self.count,
+                    clear,
+                },
+            ];
+            rec.begin_rendering(&targets[..if counted { 2 } else { 1 }], None);
             rec.bind_pipeline(pipeline);
             rec.push_bindings(&bindings);
             rec.push_constants(weights);
@@ -238,7 +247,9 @@ impl SplatPass {
             rec.end_rendering();
         });
         rec.use_image(&self.sum, ImageUse::ComputeStorage);
-        rec.use_image(&self.count, ImageUse::ComputeStorage);
+        if counted {
+            rec.use_image(&self.count, ImageUse::ComputeStorage);
+        }
         Ok(())
     }
 }

@@ -18,7 +18,7 @@ use crate::frame::settings::{sub_frame_jitter, AntiAliasing, IcSettings, IcStats
 use crate::passes::composite::CentreSamples;
 use crate::passes::holes::HoleSelection;
 use crate::passes::record::creation_seed;
-use crate::passes::splat::{SplatScope, SplatWeights};
+use crate::passes::splat::{SplatOutput, SplatScope, SplatWeights};
 use crate::scene::GpuScene;
 
 /// Most passes of the cache phase over the sub-frames (see [`IcRenderer::cache_phase`]).
@@ -326,7 +326,14 @@ impl IcRenderer {
             glossy,
         )?;
         if splats {
-            self.splat.record(
+            // The records per pixel only for the debug AOVs (a second blended target).
+            let output = if settings.debug_aovs {
+                SplatOutput::IrradianceAndCount
+            } else {
+                SplatOutput::Irradiance
+            };
+            self.splat.record_output(
+                output,
                 &mut rec,
                 "splat",
                 SplatScope::All,
