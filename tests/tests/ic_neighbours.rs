@@ -120,13 +120,17 @@ fn the_hash_grid_gives_the_all_pairs_clamp() {
         batch_draw: DrawArgs::quads((n - base) as u32, base as u32),
         radii_shrunk: 0,
     };
-    let mut rec = ctx.begin("test.grid").unwrap();
-    upload(&mut rec, &state, &records, counters);
-    pass.record_rebuild(&mut rec, &state, SCENE_SCALE).unwrap();
-    pass.record(&mut rec, &state, SCENE_SCALE).unwrap();
-    ctx.submit(rec).unwrap().wait().unwrap();
-    let out: Vec<GpuRecord> = ctx.read_buffer(&state.records, n).unwrap();
-    let shrunk = state.read_counters().unwrap().radii_shrunk;
+    // The grid built and the batch clamped: the records and the count of old radii lowered.
+    let clamp = |records: &[GpuRecord]| -> (Vec<GpuRecord>, u32) {
+        let mut rec = ctx.begin("test.grid").unwrap();
+        upload(&mut rec, &state, records, counters);
+        pass.record_rebuild(&mut rec, &state, SCENE_SCALE).unwrap();
+        pass.record(&mut rec, &state, SCENE_SCALE).unwrap();
+        ctx.submit(rec).unwrap().wait().unwrap();
+        let out = ctx.read_buffer(&state.records, n).unwrap();
+        (out, state.read_counters().unwrap().radii_shrunk)
+    };
+    let (out, shrunk) = clamp(&records);
 
     // The same batch moved far from every old record: it clamps only itself, and no old
     // record's coverage goes stale.
@@ -134,13 +138,7 @@ fn the_hash_grid_gives_the_all_pairs_clamp() {
     for r in &mut apart[base..] {
         r.position_radius[0] += 1000.0;
     }
-    let mut rec = ctx.begin("test.grid_apart").unwrap();
-    upload(&mut rec, &state, &apart, counters);
-    pass.record_rebuild(&mut rec, &state, SCENE_SCALE).unwrap();
-    pass.record(&mut rec, &state, SCENE_SCALE).unwrap();
-    ctx.submit(rec).unwrap().wait().unwrap();
-    let apart_out: Vec<GpuRecord> = ctx.read_buffer(&state.records, n).unwrap();
-    let apart_shrunk = state.read_counters().unwrap().radii_shrunk;
+    let (apart_out, apart_shrunk) = clamp(&apart);
     drop((pass, state));
     finish(ctx);
     let new_clamped = (base..n)

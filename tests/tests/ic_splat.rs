@@ -5,8 +5,8 @@
 use glam::Vec3;
 use radcache_cache::{extrapolate_irradiance, record_weight, IcParams, WeightKind};
 use radcache_render::{
-    GBuffer, GpuScene, HolePass, HoleSelection, IcState, NeighbourPass, SplatPass, SplatScope,
-    SplatWeights,
+    GBuffer, GpuScene, HolePass, HoleSelection, IcState, NeighbourPass, SplatOutput, SplatPass,
+    SplatScope, SplatWeights,
 };
 use radcache_scene::{LoadOptions, Scene};
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
@@ -268,38 +268,32 @@ fn splat_quads_cover_every_pixel_of_each_zone() {
             )
         })
         .collect();
-    let mut rec = gpu.ctx.begin("test.splat_bounds").unwrap();
-    set_state(&mut rec, &state, &recs, counters(recs.len() as u32, 0));
-    for image in gpu.gbuffer.images() {
-        rec.use_image(image, ImageUse::ComputeStorage);
-    }
-    splat
-        .record(
-            &mut rec,
-            "splat",
-            SplatScope::All,
-            &gpu.scene,
-            &gpu.gbuffer,
-            &state,
-            &weights,
-        )
-        .unwrap();
-    gpu.ctx.submit(rec).unwrap().wait().unwrap();
-    let sums: Vec<[f32; 4]> = gpu.ctx.read_image(&splat.sum).unwrap();
+    // Every record splatted into the sum target with `output`; its read-back.
+    let splat_all = |output: SplatOutput| -> Vec<[f32; 4]> {
+        let mut rec = gpu.ctx.begin("test.splat_bounds").unwrap();
+        set_state(&mut rec, &state, &recs, counters(recs.len() as u32, 0));
+        for image in gpu.gbuffer.images() {
+            rec.use_image(image, ImageUse::ComputeStorage);
+        }
+        let (scene, gbuffer) = (&gpu.scene, &gpu.gbuffer);
+        splat
+            .record_output(
+                output,
+                &mut rec,
+                "splat",
+                SplatScope::All,
+                scene,
+                gbuffer,
+                &state,
+                &weights,
+            )
+            .unwrap();
+        gpu.ctx.submit(rec).unwrap().wait().unwrap();
+        gpu.ctx.read_image(&splat.sum).unwrap()
+    };
+    let sums = splat_all(SplatOutput::IrradianceAndCount);
     // The cache phase's coverage splat: the same Σw, no colour.
-    let mut rec = gpu.ctx.begin("test.splat_coverage").unwrap();
-    splat
-        .record_coverage(
-            &mut rec,
-            SplatScope::All,
-            &gpu.scene,
-            &gpu.gbuffer,
-            &state,
-            &weights,
-        )
-        .unwrap();
-    gpu.ctx.submit(rec).unwrap().wait().unwrap();
-    let coverage: Vec<[f32; 4]> = gpu.ctx.read_image(&splat.sum).unwrap();
+    let coverage = splat_all(SplatOutput::Coverage);
     for (i, (c, s)) in coverage.iter().zip(&sums).enumerate() {
         assert_eq!(
             c[..3],

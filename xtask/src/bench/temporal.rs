@@ -4,7 +4,8 @@
 //! and turns, a cube bounces).
 //!
 //! The sequence (frames 1 … N at 24 fps, time (f − 1)/24 s, default 60 frames at 256², draft) is
-//! rendered twice with the irradiance cache: **kept** records (temporal caching: records follow
+//! rendered twice with the irradiance cache, the two runs alternating frame by frame (so that a
+//! drift in the machine's speed weighs on both alike): **kept** records (temporal caching: records follow
 //! their instances, carry look-ahead gradients and lifespans, expired ones are refreshed in place;
 //! what `radcache render --frames` does) and **rebuilt** every frame (`--no-temporal`). Per run:
 //! time per frame, record rays (creation, refreshes, look-ahead) and all rays per frame after the
@@ -133,34 +134,62 @@ fn image(out: &FrameOutput) -> Result<Image> {
     )?)
 }
 
-#[allow(clippy::too_many_arguments)]
-fn run_sequence(
-    ctx: &Context,
-    shaders: &ShaderCompiler,
-    scene: &Scene,
-    gpu: &mut GpuScene,
-    o: &Options,
+/// One of the two runs (kept records or a per-frame rebuild), rendered a frame at a time.
+struct Sequence {
+    renderer: IcRenderer,
     keep: bool,
-    reference_range: std::ops::RangeInclusive<u32>,
-) -> Result<Run> {
-    let settings = |frame: u32| IcSettings {
-        width: o.size,
-        height: o.size,
-        params: o.params(),
-        seed: 1,
-        frame,
-        time: (frame - 1) as f32 / FPS,
-        settle_records: keep,
-        time_step_s: if keep { 1.0 / FPS } else { 0.0 },
-        ..IcSettings::default()
-    };
-    let mut renderer = IcRenderer::new(ctx, shaders, gpu, &settings(1))?;
-    let mut run = Run::default();
-    for frame in 1..=o.frames {
-        if !keep {
-            renderer.forget();
+    run: Run,
+}
+
+impl Sequence {
+    fn settings(o: &Options, keep: bool, frame: u32) -> IcSettings {
+        IcSettings {
+            width: o.size,
+            height: o.size,
+            params: o.params(),
+            seed: 1,
+            frame,
+            time: (frame - 1) as f32 / FPS,
+            settle_records: keep,
+            time_step_s: if keep { 1.0 / FPS } else { 0.0 },
+            ..IcSettings::default()
         }
-        let (out, stats) = renderer.render(ctx, scene, gpu, &settings(frame), &mut |_| {})?;
+    }
+
+    fn new(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        gpu: &mut GpuScene,
+        o: &Options,
+        keep: bool,
+    ) -> Result<Sequence> {
+        let renderer = IcRenderer::new(ctx, shaders, gpu, &Self::settings(o, keep, 1))?;
+        Ok(Sequence {
+            renderer,
+            keep,
+            run: Run::default(),
+        })
+    }
+
+    /// Renders `frame` (every render sets the scene's time and view itself, so the two runs
+    /// can share the scene on the GPU and alternate).
+    fn frame(
+        &mut self,
+        ctx: &Context,
+        scene: &Scene,
+        gpu: &mut GpuScene,
+        o: &Options,
+        frame: u32,
+        reference_range: &std::ops::RangeInclusive<u32>,
+    ) -> Result<()> {
+        let (keep, run) = (self.keep, &mut self.run);
+        if !keep {
+            self.renderer.forget();
+        }
+        let settings = Self::settings(o, keep, frame);
+        let (out, stats) = self
+            .renderer
+            .render(ctx, scene, gpu, &settings, &mut |_| {})?;
         anyhow::ensure!(
             out.nonfinite_pixels == 0,
             "frame {frame}: non-finite pixels"
@@ -176,7 +205,7 @@ fn run_sequence(
         if reference_range.contains(&frame) {
             run.images.push(image(&out)?);
         }
-        if frame % 10 == 0 {
+        if frame.is_multiple_of(10) {
             println!(
                 "  {} frame {frame}: {:.2} s, {} records ({} kept, {} refreshed), {:.2} M record rays",
                 if keep { "kept" } else { "rebuilt" },
@@ -187,8 +216,8 @@ fn run_sequence(
                 stats.record_rays as f64 / 1e6
             );
         }
+        Ok(())
     }
-    Ok(run)
 }
 
 pub fn run(args: &[&str]) -> Result<()> {
@@ -217,8 +246,16 @@ pub fn run(args: &[&str]) -> Result<()> {
     };
     bench.warm_up_ic(&scene, &mut gpu, warm)?;
 
-    let kept = run_sequence(ctx, shaders, &scene, &mut gpu, &o, true, range.clone())?;
-    let rebuilt = run_sequence(ctx, shaders, &scene, &mut gpu, &o, false, range.clone())?;
+    // The two runs alternate frame by frame: this machine's speed drifts (by up to 1.7× over
+    // minutes on a shared 2-core VM), and one run after the other put a drift into their ratio.
+    let mut kept = Sequence::new(ctx, shaders, &mut gpu, &o, true)?;
+    let mut rebuilt = Sequence::new(ctx, shaders, &mut gpu, &o, false)?;
+    for frame in 1..=o.frames {
+        kept.frame(ctx, &scene, &mut gpu, &o, frame, &range)?;
+        rebuilt.frame(ctx, &scene, &mut gpu, &o, frame, &range)?;
+    }
+    // The renderers go here (their GPU memory before the bench's leak check).
+    let [kept, rebuilt] = [kept, rebuilt].map(|s| s.run);
 
     // The reference, and a second path-traced sequence with other seeds: its error and flicker
     // against the reference are twice the reference's own (independent noise adds), which is

@@ -176,24 +176,10 @@ impl SplatPass {
         self.record_output(output, rec, name, scope, scene, gbuffer, state, weights)
     }
 
-    /// Records the coverage splat of `scope` (profiler scope `splat.coverage`): the same weights
-    /// as [`SplatPass::record`] and the same Σ w in the target's alpha, with zero in its colour
-    /// (hole selection reads Σ w alone), so the fragments skip the irradiance's extrapolation.
-    pub fn record_coverage(
-        &self,
-        rec: &mut Recorder,
-        scope: SplatScope,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        state: &IcState,
-        weights: &SplatWeights,
-    ) -> Result<()> {
-        let (output, name) = (SplatOutput::Coverage, "splat.coverage");
-        self.record_output(output, rec, name, scope, scene, gbuffer, state, weights)
-    }
-
     /// As [`SplatPass::record`], drawing `output`; the count target is left as it is unless
-    /// `output` draws it.
+    /// `output` draws it. [`SplatOutput::Coverage`] gives the same Σ w in the target's alpha as
+    /// the others, with zero in its colour (hole selection reads Σ w alone), so its fragments
+    /// skip the irradiance's extrapolation.
     #[allow(clippy::too_many_arguments)]
     pub fn record_output(
         &self,

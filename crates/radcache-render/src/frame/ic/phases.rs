@@ -238,8 +238,11 @@ impl IcRenderer {
                 SplatScope::LastBatch
             };
             let (gbuffer, state) = (&self.gbuffer, &self.state);
-            self.splat
-                .record_coverage(&mut rec, scope, gpu, gbuffer, state, &creation_weights)?;
+            let (coverage, weights) = (SplatOutput::Coverage, &creation_weights);
+            let name = "splat.coverage";
+            self.splat.record_output(
+                coverage, &mut rec, name, scope, gpu, gbuffer, state, weights,
+            )?;
             let selection_mode = HoleSelection::Request {
                 spacing: self.params.level_spacing_px(level),
                 threshold: creation.coverage_threshold(),
