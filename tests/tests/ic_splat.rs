@@ -275,19 +275,12 @@ fn splat_quads_cover_every_pixel_of_each_zone() {
         for image in gpu.gbuffer.images() {
             rec.use_image(image, ImageUse::ComputeStorage);
         }
-        let (scene, gbuffer) = (&gpu.scene, &gpu.gbuffer);
-        splat
-            .record_output(
-                output,
-                &mut rec,
-                "splat",
-                SplatScope::All,
-                scene,
-                gbuffer,
-                &state,
-                &weights,
-            )
-            .unwrap();
+        let (scene, gbuffer, all) = (&gpu.scene, &gpu.gbuffer, SplatScope::All);
+        let (state, weights) = (&state, &weights);
+        let r = splat.record_output(
+            output, &mut rec, "splat", all, scene, gbuffer, state, weights,
+        );
+        r.unwrap();
         gpu.ctx.submit(rec).unwrap().wait().unwrap();
         gpu.ctx.read_image(&splat.sum).unwrap()
     };
