@@ -52,6 +52,11 @@ const uint REUSED_LIGHTS = 30u;
 // boundary at or next to the pixel therefore keeps its rays; what is reused is a pixel deep
 // inside light or shadow, whose jittered samples, within half a pixel of its centre, see what
 // nine centres around them saw (a shadow finer than the pixel grid can be missed).
+// The linear index of `pixel` (its word pair in `shadows`, its sample sequences' seed).
+uint pixel_index(ivec2 pixel) {
+    return uint(pixel.y) * frame.resolution.x + uint(pixel.x);
+}
+
 struct Reuse {
     uint frozen;  // the pixel's sub-frame-0 word
     bool punctual;
@@ -66,7 +71,7 @@ Reuse shadow_reuse(ivec2 pixel) {
     if (pc.adaptive_shadows == 0u || pc.sub_frame == 0u) {
         return r;
     }
-    uint own = shadows[2u * (uint(pixel.y) * frame.resolution.x + uint(pixel.x)) + 1u];
+    uint own = shadows[2u * pixel_index(pixel) + 1u];
     r.frozen = own;
     if ((own & 3u) == SHADOW_NONE) {
         return r;
@@ -79,7 +84,7 @@ Reuse shadow_reuse(ivec2 pixel) {
             if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(frame.resolution.xy)))) {
                 continue;
             }
-            uint n = shadows[2u * (uint(q.y) * frame.resolution.x + uint(q.x)) + 1u];
+            uint n = shadows[2u * pixel_index(q) + 1u];
             bool surface = (n & 3u) != SHADOW_NONE;
             r.punctual = r.punctual && surface && (n >> 2) == (own >> 2);
             r.emitters = r.emitters && surface && (n & 3u) == (own & 3u);
@@ -474,6 +479,19 @@ struct PixelLight {
     uint punctual_seen;  // the traced punctual lights' visibility bits (`punctual_visible`)
 };
 
+// A pixel's light before anything is added (also a pixel without a surface).
+PixelLight no_light() {
+    PixelLight light;
+    light.rest = vec3(0.0);
+    light.unshadowed = vec3(0.0);
+    light.sum_all = vec3(0.0);
+    light.sum_visible = vec3(0.0);
+    light.seen = SHADOW_PENUMBRA;
+    light.reused = false;
+    light.punctual_seen = 0u;
+    return light;
+}
+
 PixelLight pixel_light(GSample g, ivec2 pixel) {
     Surface s;
     s.position = g.position;
@@ -483,14 +501,8 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     s.material = g.material;
     s.front_face = true;
     vec3 origin = offset_ray_origin(s.position, s.geometric_normal);
-    uint index = uint(pixel.y) * frame.resolution.x + uint(pixel.x);
-    PixelLight light;
-    light.unshadowed = vec3(0.0);
-    light.sum_all = vec3(0.0);
-    light.sum_visible = vec3(0.0);
-    light.seen = SHADOW_PENUMBRA;
-    light.reused = false;
-    light.punctual_seen = 0u;
+    uint index = pixel_index(pixel);
+    PixelLight light = no_light();
     Reuse reuse = shadow_reuse(pixel);
     uint samples = max(pc.samples, 1u);
     Rng rng = rng_init(index, 0xffffffffu, pc.seed);
@@ -620,14 +632,7 @@ void main() {
     if (inside) {
         g = gbuffer_load(pixel);
     }
-    PixelLight light;
-    light.rest = vec3(0.0);
-    light.unshadowed = vec3(0.0);
-    light.sum_all = vec3(0.0);
-    light.sum_visible = vec3(0.0);
-    light.seen = SHADOW_PENUMBRA;
-    light.reused = false;
-    light.punctual_seen = 0u;
+    PixelLight light = no_light();
     if (g.surface) {
         light = pixel_light(g, pixel);
     }
@@ -695,7 +700,7 @@ void main() {
         }
         frozen_class = mark ? SHADOW_PENUMBRA : own;
         if (inside) {
-            uint index = uint(pixel.y) * frame.resolution.x + uint(pixel.x);
+            uint index = pixel_index(pixel);
             if (pc.sub_frame == 0u) {
                 shadows[2u * index] = frozen_class;
             } else if (mark) {
@@ -706,8 +711,7 @@ void main() {
 #endif
     if (pc.adaptive_shadows != 0u && pc.sub_frame == 0u && inside) {
         // Read by later sub-frames only (other dispatches): no race with the neighbours' reads.
-        uint index = uint(pixel.y) * frame.resolution.x + uint(pixel.x);
-        shadows[2u * index + 1u] = g.surface ? frozen_class | light.punctual_seen : SHADOW_NONE;
+        shadows[2u * pixel_index(pixel) + 1u] = g.surface ? frozen_class | light.punctual_seen : SHADOW_NONE;
     }
     if (!inside) {
         return;
