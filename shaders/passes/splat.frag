@@ -16,7 +16,6 @@
 #include "../common/ircache_math.glsl"
 #include "splat_common.glsl"
 
-layout(location = 0) flat in uint v_record;
 layout(location = 0) out vec4 o_sum;
 #ifdef SPLAT_COUNT
 layout(location = 1) out float o_count;  // records reaching the pixel (debug AOV)
@@ -27,21 +26,16 @@ void main() {
     if (!g.surface) {
         discard;
     }
-    GpuRecord rec = records[v_record];
-    float w = splat_weight_at(g, rec);
+    float w = splat_weight_at(g);
     if (!(w > pc.w_min)) {
         discard;
     }
 #ifdef SPLAT_COVERAGE
     o_sum = vec4(0.0, 0.0, 0.0, w);
 #else
-    vec3 p_i = rec.position_radius.xyz;
-    vec3 n_i = rec.normal_rorig.xyz;
-    float att = gradient_attenuation(rec.normal_rorig.w, rec.bounds.x);
-    vec3 e = extrapolate_irradiance(rec.irradiance.rgb, rec.grad_r_red.xyz, rec.grad_r_green.xyz,
-                                    rec.grad_r_blue.xyz, att * rec.grad_t_red.xyz,
-                                    att * rec.grad_t_green.xyz, att * rec.grad_t_blue.xyz,
-                                    g.position, g.normal, p_i, n_i);
+    vec3 e = extrapolate_irradiance(v_irradiance, v_grad_r[0], v_grad_r[1], v_grad_r[2],
+                                    v_grad_t[0], v_grad_t[1], v_grad_t[2], g.position, g.normal,
+                                    v_zone.xyz, v_normal.xyz);
     // Every writer stores the same value: the race is benign. Only the first fragment of the
     // frame stores it (a store to a line other cores read makes them fetch it again).
     if (pc.mark_frame != 0u && last_used[v_record] != pc.mark_frame) {

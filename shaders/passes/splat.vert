@@ -16,9 +16,8 @@
 #include "../shared/bindings.glsl"
 #include "../common/gbuffer.glsl"
 #include "../common/ircache_math.glsl"
+#define SPLAT_VERTEX 1
 #include "splat_common.glsl"
-
-layout(location = 0) flat out uint v_record;
 
 void main() {
     uint r = uint(gl_InstanceIndex);
@@ -82,5 +81,5 @@ void main() {
     // An empty rectangle (the ball projects outside the view) collapses to a point: no fragments.
     vec2 xy = any(greaterThanEqual(lo, hi)) ? vec2(-2.0) : mix(lo, hi, t);
     gl_Position = vec4(xy, 0.5, 1.0);
-    v_record = r;
+    splat_varyings(r, rec);
 }

@@ -23,16 +23,43 @@ float splat_extent(GpuRecord rec) {
     return splat_radius(pc.kind, record_radius(rec), pc.param, pc.w_min);
 }
 
+// What a record's fragments need, handed from the vertex shader to every fragment of its quad as
+// flat varyings: read from the records buffer per fragment, each field costs lavapipe a gather
+// (the record index is not known to be uniform over a fragment block), which was 55 % of the
+// final splat's time (docs/cache-frame.md §6.3).
+#ifdef SPLAT_VERTEX
+#define SPLAT_IO out
+#else
+#define SPLAT_IO in
+#endif
+layout(location = 0) flat SPLAT_IO uint v_record;
+layout(location = 1) flat SPLAT_IO vec4 v_zone;        // p_i; w: the weight's radius (record_radius)
+layout(location = 2) flat SPLAT_IO vec4 v_normal;      // n_i; w: the gradient attenuation
+layout(location = 3) flat SPLAT_IO vec3 v_irradiance;  // E_i
+layout(location = 4) flat SPLAT_IO mat3 v_grad_r;      // rotational gradients (red, green, blue)
+layout(location = 7) flat SPLAT_IO mat3 v_grad_t;      // translational ones, attenuated
+
+#ifdef SPLAT_VERTEX
+// The varyings of record `r`.
+void splat_varyings(uint r, GpuRecord rec) {
+    float att = gradient_attenuation(rec.normal_rorig.w, rec.bounds.x);
+    v_record = r;
+    v_zone = vec4(rec.position_radius.xyz, record_radius(rec));
+    v_normal = vec4(rec.normal_rorig.xyz, att);
+    v_irradiance = rec.irradiance.rgb;
+    v_grad_r = mat3(rec.grad_r_red.xyz, rec.grad_r_green.xyz, rec.grad_r_blue.xyz);
+    v_grad_t = att * mat3(rec.grad_t_red.xyz, rec.grad_t_green.xyz, rec.grad_t_blue.xyz);
+}
+#endif
+
 #ifdef RADCACHE_GBUFFER_GLSL
-// The weight of record `rec` at the G-buffer sample g: the pass's weight with the normal and
+// The weight of the quad's record at the G-buffer sample g: the pass's weight with the normal and
 // in-front tests (0 outside the record's zone; splat.frag and splat_glossy.frag discard at or
 // below pc.w_min).
-float splat_weight_at(GSample g, GpuRecord rec) {
-    vec3 p_i = rec.position_radius.xyz;
-    vec3 n_i = rec.normal_rorig.xyz;
-    float r_i = record_radius(rec);
+float splat_weight_at(GSample g) {
     float tol = pc.front_tol_px * g.footprint;
-    return record_weight(pc.kind, g.position, g.normal, p_i, n_i, r_i, pc.param, tol);
+    return record_weight(pc.kind, g.position, g.normal, v_zone.xyz, v_normal.xyz, v_zone.w,
+                         pc.param, tol);
 }
 #endif
 

@@ -30,7 +30,6 @@
 layout(binding = B_SPLAT_GLOSSY_RADIANCE, std430) readonly buffer Radiance { uvec4 radiance[]; };
 layout(binding = B_SPLAT_GLOSSY_GLOSSY_WEIGHTS, std430) readonly buffer Weights { vec4 glossy_w[]; };
 
-layout(location = 0) flat in uint v_record;
 layout(location = 0) out vec4 o_sum;
 
 void main() {
@@ -39,8 +38,7 @@ void main() {
     if (!g.surface || g.roughness < GLOSSY_ROUGHNESS_MIN) {
         discard;
     }
-    GpuRecord rec = records[v_record];
-    float w = splat_weight_at(g, rec);
+    float w = splat_weight_at(g);
     if (!(w > pc.w_min)) {
         discard;
     }
@@ -50,8 +48,7 @@ void main() {
     // (coefficient, channel) terms; lane l of vec4 q is float 4q + l, channel (4q + l) % 3.
 #ifdef GLOSSY_GRADIENTS
     float scale = uintBitsToFloat(radiance[base + RADIANCE_VEC4S].x);
-    float att = gradient_attenuation(rec.normal_rorig.w, rec.bounds.x);
-    vec3 dp = (g.position - rec.position_radius.xyz) * (att * scale);
+    vec3 dp = (g.position - v_zone.xyz) * (v_normal.w * scale);
     uint grads = base + RADIANCE_VEC4S + 1u;
 #endif
     vec3 l0 = vec3(0.0);
