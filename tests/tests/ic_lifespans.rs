@@ -2,11 +2,12 @@
 //! box slides along the floor, records follow their instance, only records near the box are
 //! refreshed, lifespans follow the CPU formula (`radcache_cache::temporal`), and a frame
 //! rendered with kept records stays as close to a path-traced reference of that frame as a
-//! fresh cache.
+//! fresh cache; a record no pixel used in the previous frame is dropped when its lifespan ends
+//! instead of being evaluated again.
 
 use glam::Vec3;
 use radcache_cache::temporal::temporal_lifespan;
-use radcache_render::{GpuScene, IcRenderer, IcSettings, IcStats};
+use radcache_render::{expires_at, GpuScene, IcRenderer, IcSettings, IcStats};
 use radcache_scene::Scene;
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
 use radcache_tests::sliding_box::{self, box_centre, distance_to_path, FAR, HALF, NEAR};
@@ -167,5 +168,97 @@ fn a_frame_with_kept_records_is_as_close_to_the_reference_as_a_fresh_cache() {
         assert!((r - 1.0).abs() <= 0.03, "channel {c} mean ratio {r}");
     }
     drop((kept, gpu));
+    finish(ctx);
+}
+
+#[test]
+fn records_unseen_when_their_lifespan_ends_are_dropped_not_refreshed() {
+    let scene = sliding_box_scene("ic-lifespans-unseen");
+    let (ctx, shaders) = (context(), shaders());
+    let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
+    // Draft's own lifespans (at most 5 frames ± 20 %): records expire every few frames.
+    let s = |frame| sliding_box::settings(SIZE, frame);
+    let mut r = IcRenderer::new(&ctx, &shaders, &gpu, &s(1)).unwrap();
+    // Every third record is made unseen in the last frame rendered (it last weighed on a pixel
+    // the frame before); the first frame after which enough of them expire, and enough stay
+    // valid, and enough seen ones expire, is the one the test renders next.
+    let unseen = |i: usize, t: &GpuRecordTemporal| i % 3 == 0 && t.info[2] & 1 != 0;
+    let mut found = None;
+    for last in 1..=16u32 {
+        r.render(&ctx, &scene, &mut gpu, &s(last), &mut |_| {})
+            .unwrap();
+        let (records, temporal, marks) = r.state().download(&ctx).unwrap();
+        let next = last + 1;
+        let count = |f: &dyn Fn(usize, &GpuRecordTemporal) -> bool| {
+            temporal
+                .iter()
+                .enumerate()
+                .filter(|(i, t)| f(*i, t))
+                .count()
+        };
+        let dropping = count(&|i, t| unseen(i, t) && expires_at(t, next));
+        let staying = count(&|i, t| unseen(i, t) && !expires_at(t, next));
+        let refreshing = count(&|i, t| !unseen(i, t) && expires_at(t, next));
+        eprintln!(
+            "after frame {last}: {} records, {dropping} unseen and expiring, {staying} unseen \
+             and valid, {refreshing} seen and expiring",
+            records.len()
+        );
+        if last >= 2 && dropping >= 10 && staying >= 10 && refreshing >= 10 {
+            found = Some((last, records, temporal, marks));
+            break;
+        }
+    }
+    let (last, records, temporal, mut marks) =
+        found.expect("no frame with enough expiring records");
+    for (i, m) in marks.iter_mut().enumerate() {
+        if unseen(i, &temporal[i]) {
+            assert_eq!(*m, last, "record {i} was not used in frame {last}");
+            *m = last - 1;
+        }
+    }
+    r.state().upload(&ctx, &records, &temporal, &marks).unwrap();
+    let next = last + 1;
+    // Dropped: unseen in the frame before and expiring, or out of use for too long (eviction).
+    let limit = s(next).evict_after_frames;
+    let dropped: Vec<bool> = (0..records.len())
+        .map(|i| {
+            let (m, t) = (marks[i], &temporal[i]);
+            m == 0 || next - m > limit || (next - m > 1 && expires_at(t, next))
+        })
+        .collect();
+    let made_unseen = (0..records.len())
+        .filter(|&i| dropped[i] && unseen(i, &temporal[i]))
+        .count();
+    assert!(
+        made_unseen >= 10,
+        "{made_unseen} of the records made unseen dropped"
+    );
+    let (_, stats) = r
+        .render(&ctx, &scene, &mut gpu, &s(next), &mut |_| {})
+        .unwrap();
+    let n_dropped = dropped.iter().filter(|&&d| d).count();
+    assert_eq!(stats.records_evicted, n_dropped as u64, "{stats:?}");
+    // The kept records, in their order, are the others; every expiring one was evaluated again
+    // for the frame after (the CPU twin of the advance's lifespan test agrees with the GPU's).
+    let (_, after, _) = r.state().download(&ctx).unwrap();
+    let survivors: Vec<usize> = (0..records.len()).filter(|&i| !dropped[i]).collect();
+    assert_eq!(stats.records_kept as usize, survivors.len());
+    for (k, &i) in survivors.iter().enumerate() {
+        let (old, new) = (&temporal[i], &after[k]);
+        assert_eq!(
+            (xyz(old.object_position), old.info[0]),
+            (xyz(new.object_position), new.info[0]),
+            "kept record {k} is not record {i}"
+        );
+        if expires_at(old, next) {
+            assert_eq!(
+                new.info[1],
+                next + 1,
+                "record {i} expired and was not evaluated again"
+            );
+        }
+    }
+    drop((r, gpu));
     finish(ctx);
 }

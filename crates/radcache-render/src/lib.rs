@@ -44,7 +44,7 @@ pub use passes::record::{
 pub use passes::record::{RecordPass, MAX_STRATA, R_EPS_REL};
 pub use passes::splat::{SplatOutput, SplatPass, SplatScope, SplatWeights};
 pub use passes::splat_glossy::GlossySplatPass;
-pub use passes::temporal::{Lifespans, TemporalPass};
+pub use passes::temporal::{expires_at, Lifespans, TemporalPass};
 pub use scene::env_map::{gpu_alias, texel_solid_angle, EnvMap};
 pub use scene::upload::vulkan_clip_from_view;
 pub use scene::{GpuScene, UploadStats, REFITS_PER_REBUILD};

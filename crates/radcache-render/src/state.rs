@@ -189,23 +189,30 @@ impl IcState {
         self.step(rec, CounterStep::EndBatch)
     }
 
-    /// Keeps the records `keep` selects (by index and last use) and drops the others, moving the
-    /// kept ones (with their temporal state and radiance blocks) to the front in their order;
-    /// returns how many were dropped. The caller must rebuild the neighbour grid afterwards. Rare (eviction), so it goes through the host.
-    pub fn compact(&self, ctx: &Context, keep: impl Fn(usize, u32) -> bool) -> Result<u32> {
+    /// Keeps the records `keep` selects (by index, last use and temporal state) and drops the
+    /// others, moving the kept ones (with their temporal state and radiance blocks) to the front
+    /// in their order; returns how many were dropped. The caller must rebuild the neighbour grid
+    /// afterwards. It goes through the host (a few hundred kilobytes at most each frame).
+    pub fn compact(
+        &self,
+        ctx: &Context,
+        keep: impl Fn(usize, u32, &GpuRecordTemporal) -> bool,
+    ) -> Result<u32> {
         let counters = self.read_counters()?;
         let count = counters.record_count.min(self.record_capacity) as usize;
         if count == 0 {
             return Ok(0);
         }
         let used: Vec<u32> = ctx.read_buffer(&self.last_used, count)?;
-        let kept: Vec<usize> = (0..count).filter(|&i| keep(i, used[i])).collect();
+        let temporal: Vec<GpuRecordTemporal> = ctx.read_buffer(&self.temporal, count)?;
+        let kept: Vec<usize> = (0..count)
+            .filter(|&i| keep(i, used[i], &temporal[i]))
+            .collect();
         let dropped = (count - kept.len()) as u32;
         if dropped == 0 {
             return Ok(0);
         }
         let records: Vec<GpuRecord> = ctx.read_buffer(&self.records, count)?;
-        let temporal: Vec<GpuRecordTemporal> = ctx.read_buffer(&self.temporal, count)?;
         let blocks: Vec<RadianceBlock> = match &self.radiance {
             Some(b) => ctx.read_buffer(b, count)?,
             None => Vec::new(),

@@ -36,9 +36,11 @@
 //! change, already bounds how stale it gets), and since they are in world space a kept record on
 //! a rotating instance keeps them unrotated until its refresh.
 
+use radcache_cache::temporal::temporal_is_valid;
 use radcache_cache::IcParams;
 use radcache_scene::Scene;
-use radcache_shared::gpu::{GpuInstance, GpuRecord, IcCounters};
+use radcache_shared::consts::TEMPORAL_FLAG_ADOPTED;
+use radcache_shared::gpu::{GpuInstance, GpuRecord, GpuRecordTemporal, IcCounters};
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
     ShaderCompiler,
@@ -470,4 +472,14 @@ impl TemporalPass {
         let c = self.list_counters.read::<IcCounters>(1)?[0];
         Ok(c.requested.min(self.capacity))
     }
+}
+
+/// Whether the advance at `frame` lists the record of temporal state `t` for its lifespan
+/// (`temporal.comp`, `TEMPORAL_ADVANCE`: its known value would outlive its lifespan at the next
+/// frame); false for a record without lifespans (never adopted). The motion-aware expiry is not
+/// included: it needs the moving instances.
+pub fn expires_at(t: &GpuRecordTemporal, frame: u32) -> bool {
+    let adopted = t.info[2] & TEMPORAL_FLAG_ADOPTED != 0;
+    let age = frame as f32 - t.info[1] as f32;
+    adopted && !temporal_is_valid(age + 1.0, t.object_position[3])
 }

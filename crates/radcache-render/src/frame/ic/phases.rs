@@ -19,6 +19,7 @@ use crate::passes::composite::CentreSamples;
 use crate::passes::holes::HoleSelection;
 use crate::passes::record::creation_seed;
 use crate::passes::splat::{SplatOutput, SplatScope, SplatWeights};
+use crate::passes::temporal::expires_at;
 use crate::scene::GpuScene;
 
 /// Most passes of the cache phase over the sub-frames (see [`IcRenderer::cache_phase`]).
@@ -116,9 +117,13 @@ impl IcRenderer {
         let now = self.frames;
         if self.has_records {
             let limit = settings.evict_after_frames;
-            let evicted = self
-                .state
-                .compact(ctx, |_, used| used != 0 && now - used <= limit)?;
+            // With lifespans, a record that no pixel used in the previous frame is dropped
+            // when its lifespan ends rather than evaluated again (docs/temporal.md §2.3).
+            let lifespans = settings.time_step_s > 0.0 && self.temporal.is_some();
+            let evicted = self.state.compact(ctx, |_, used, t| {
+                let recent = used != 0 && now - used <= limit;
+                recent && !(lifespans && now - used > 1 && expires_at(t, now))
+            })?;
             run.stats.records_evicted = u64::from(evicted);
             run.kept = self.state.read_counters()?.record_count;
         }
