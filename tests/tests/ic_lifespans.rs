@@ -182,7 +182,7 @@ fn records_unseen_when_their_lifespan_ends_are_dropped_not_refreshed() {
     // Every third record is made unseen in the last frame rendered (it last weighed on a pixel
     // the frame before); the first frame after which enough of them expire, and enough stay
     // valid, and enough seen ones expire, is the one the test renders next.
-    let unseen = |i: usize, t: &GpuRecordTemporal| i % 3 == 0 && t.info[2] & 1 != 0;
+    let unseen = |i: usize, t: &GpuRecordTemporal| i.is_multiple_of(3) && t.info[2] & 1 != 0;
     let mut found = None;
     for last in 1..=16u32 {
         r.render(&ctx, &scene, &mut gpu, &s(last), &mut |_| {})
