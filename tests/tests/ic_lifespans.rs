@@ -9,6 +9,7 @@ use glam::Vec3;
 use radcache_cache::temporal::temporal_lifespan;
 use radcache_render::{expires_at, GpuScene, IcRenderer, IcSettings, IcStats};
 use radcache_scene::Scene;
+use radcache_shared::consts::TEMPORAL_FLAG_ADOPTED;
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
 use radcache_tests::sliding_box::{self, box_centre, distance_to_path, FAR, HALF, NEAR};
 use radcache_tests::{context, finish, shaders};
@@ -182,7 +183,8 @@ fn records_unseen_when_their_lifespan_ends_are_dropped_not_refreshed() {
     // Every third record is made unseen in the last frame rendered (it last weighed on a pixel
     // the frame before); the first frame after which enough of them expire, and enough stay
     // valid, and enough seen ones expire, is the one the test renders next.
-    let unseen = |i: usize, t: &GpuRecordTemporal| i.is_multiple_of(3) && t.info[2] & 1 != 0;
+    let adopted = |t: &GpuRecordTemporal| t.info[2] & TEMPORAL_FLAG_ADOPTED != 0;
+    let unseen = |i: usize, t: &GpuRecordTemporal| i.is_multiple_of(3) && adopted(t);
     let mut found = None;
     for last in 1..=16u32 {
         r.render(&ctx, &scene, &mut gpu, &s(last), &mut |_| {})

@@ -62,7 +62,7 @@ fn compaction_moves_each_radiance_block_with_its_record() {
         bytemuck::cast_slice::<RadianceBlock, u8>(&blocks)
     );
     // Keep the records used at frames 2 and 3.
-    let dropped = state.compact(&ctx, |_, used, _| used >= 2).unwrap();
+    let dropped = state.compact(&ctx, |_, used| used >= 2).unwrap();
     let (kept, _, _) = state.download(&ctx).unwrap();
     let kept_blocks = state.download_radiance(&ctx).unwrap();
     assert_eq!(dropped as usize, n as usize - kept.len());

@@ -4,6 +4,7 @@
 //! bookkeeping pass ([`crate::passes::ic_counters`]) keeps consistent on the GPU, so the host never
 //! reads a count to size a dispatch or a draw.
 
+use bytemuck::Zeroable;
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, GpuRecordTemporal, IcCounters};
 use radcache_vk::{
     vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Recorder, ShaderCompiler,
@@ -189,13 +190,29 @@ impl IcState {
         self.step(rec, CounterStep::EndBatch)
     }
 
-    /// Keeps the records `keep` selects (by index, last use and temporal state) and drops the
-    /// others, moving the kept ones (with their temporal state and radiance blocks) to the front
-    /// in their order; returns how many were dropped. The caller must rebuild the neighbour grid
-    /// afterwards. It goes through the host (a few hundred kilobytes at most each frame).
-    pub fn compact(
+    /// Keeps the records `keep` selects (by index and last use) and drops the others, moving the
+    /// kept ones (with their temporal state and radiance blocks) to the front in their order;
+    /// returns how many were dropped. The caller must rebuild the neighbour grid afterwards. It
+    /// goes through the host: the marks are read back, and the records only when some go.
+    pub fn compact(&self, ctx: &Context, keep: impl Fn(usize, u32) -> bool) -> Result<u32> {
+        self.compact_where(ctx, false, |i, used, _| keep(i, used))
+    }
+
+    /// As [`Self::compact`], with each record's temporal state read back too for `keep`.
+    pub fn compact_temporal(
         &self,
         ctx: &Context,
+        keep: impl Fn(usize, u32, &GpuRecordTemporal) -> bool,
+    ) -> Result<u32> {
+        self.compact_where(ctx, true, keep)
+    }
+
+    /// [`Self::compact`]; `keep` sees the temporal states where `read_temporal` (zeroed ones
+    /// otherwise).
+    fn compact_where(
+        &self,
+        ctx: &Context,
+        read_temporal: bool,
         keep: impl Fn(usize, u32, &GpuRecordTemporal) -> bool,
     ) -> Result<u32> {
         let counters = self.read_counters()?;
@@ -204,13 +221,21 @@ impl IcState {
             return Ok(0);
         }
         let used: Vec<u32> = ctx.read_buffer(&self.last_used, count)?;
-        let temporal: Vec<GpuRecordTemporal> = ctx.read_buffer(&self.temporal, count)?;
+        let mut temporal: Vec<GpuRecordTemporal> = if read_temporal {
+            ctx.read_buffer(&self.temporal, count)?
+        } else {
+            Vec::new()
+        };
+        let none = GpuRecordTemporal::zeroed();
         let kept: Vec<usize> = (0..count)
-            .filter(|&i| keep(i, used[i], &temporal[i]))
+            .filter(|&i| keep(i, used[i], temporal.get(i).unwrap_or(&none)))
             .collect();
         let dropped = (count - kept.len()) as u32;
         if dropped == 0 {
             return Ok(0);
+        }
+        if !read_temporal {
+            temporal = ctx.read_buffer(&self.temporal, count)?;
         }
         let records: Vec<GpuRecord> = ctx.read_buffer(&self.records, count)?;
         let blocks: Vec<RadianceBlock> = match &self.radiance {

@@ -117,13 +117,16 @@ impl IcRenderer {
         let now = self.frames;
         if self.has_records {
             let limit = settings.evict_after_frames;
-            // With lifespans, a record that no pixel used in the previous frame is dropped
-            // when its lifespan ends rather than evaluated again (docs/temporal.md §2.3).
-            let lifespans = settings.time_step_s > 0.0 && self.temporal.is_some();
-            let evicted = self.state.compact(ctx, |_, used, t| {
-                let recent = used != 0 && now - used <= limit;
-                recent && !(lifespans && now - used > 1 && expires_at(t, now))
-            })?;
+            let recent = |used: u32| used != 0 && now - used <= limit;
+            let evicted = if settings.time_step_s > 0.0 && self.temporal.is_some() {
+                // With lifespans, a record that no pixel used in the previous frame is dropped
+                // when its lifespan ends rather than evaluated again (docs/temporal.md §2.3).
+                self.state.compact_temporal(ctx, |_, used, t| {
+                    recent(used) && !(now - used > 1 && expires_at(t, now))
+                })?
+            } else {
+                self.state.compact(ctx, |_, used| recent(used))?
+            };
             run.stats.records_evicted = u64::from(evicted);
             run.kept = self.state.read_counters()?.record_count;
         }
