@@ -6,7 +6,10 @@
 // At each diffuse vertex: next-event estimation of emissive triangles (MIS with BSDF sampling,
 // power heuristic), punctual lights (no MIS: delta lights) and the environment map (MIS);
 // emission hit by BSDF sampling is counted with the complementary MIS weight, so every light path
-// is counted once. Russian roulette from the fourth vertex on (camera paths; the cache's gather
+// is counted once. In the cache's gathers of a Lambertian scene with few emitters
+// (PATH_CLOSED_FORM_EMITTERS), the emissive triangles' light at a vertex is instead their
+// closed-form unshadowed irradiance less a one-sample estimate of its hidden part (a control
+// variate, unbiased), and emission hit by BSDF sampling counts nothing. Russian roulette from the fourth vertex on (camera paths; the cache's gather
 // paths from their second vertex), with continuation probability the throughput's largest
 // component capped at 0.99; a safety cap of 4096 vertices (reached with
 // probability < 0.99^4093, invisible).
@@ -15,6 +18,34 @@
 
 #include "random.glsl"
 #include "lights.glsl"
+
+// Gathers (record.comp, PATH_CLOSED_FORM_EMITTERS) in a Lambertian scene whose few emitters have a
+// closed form take the emitters' light at each vertex as a control variate (direct_light).
+#if defined(PATH_CLOSED_FORM_EMITTERS) && defined(HAS_EMITTERS) && !defined(HAS_SPECULAR)
+#define PATH_EMITTERS_IN_CLOSED_FORM 1
+#endif
+
+#if defined(HAS_ANALYTIC_EMITTERS) || defined(PATH_EMITTERS_IN_CLOSED_FORM)
+#include "polygon.glsl"
+
+// The unshadowed irradiance of every emissive triangle at `origin` (normal n), in closed form
+// (common/polygon.glsl). The plan compiles this in only for a few untextured emitters
+// (radcache_scene::ScenePlan::analytic_emitters), so the radiance is the material's constant.
+vec3 analytic_emitter_irradiance(vec3 origin, vec3 n) {
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < frame.counts.x; ++i) {
+        GpuEmitter e = emitters[i];
+        vec3 ng = cross(e.p1.xyz - e.p0.xyz, e.p2.xyz - e.p0.xyz);
+        bool front = dot(origin - e.p0.xyz, ng) > 0.0;
+        vec3 le = material_emission(uint(e.uv2_material.z), TexCoords(0.0), front);
+        if (any(greaterThan(le, vec3(0.0)))) {
+            vec3 t[3] = vec3[3](e.p0.xyz, e.p1.xyz, e.p2.xyz);
+            sum += le * triangle_projected_solid_angle(origin, n, t);
+        }
+    }
+    return sum;
+}
+#endif
 
 const uint MAX_VERTICES = 4096u;
 const uint RR_START = 3u;
@@ -43,7 +74,28 @@ Ray camera_ray(uvec2 pixel, vec2 jitter) {
 vec3 direct_light(Surface s, inout Rng rng) {
     vec3 sum = vec3(0.0);
     vec3 origin = offset_ray_origin(s.position, s.geometric_normal);
-#ifdef HAS_EMITTERS
+#if defined(PATH_EMITTERS_IN_CLOSED_FORM)
+    {
+        // The unshadowed light in closed form less a one-sample estimate of what is hidden:
+        // E − f(x)(1 − V(x))/p(x) has the expectation ∫ f·V, exact (no noise) wherever the
+        // emitters are wholly visible; emission that a BSDF sample hits counts nothing
+        // (path_step). docs/cache-frame.md §4.
+        sum += analytic_emitter_irradiance(origin, s.shading_normal);
+        vec3 dir, le;
+        float dist, pdf;
+        vec3 u = vec3(rng_next(rng), rng_next2(rng));
+        if (sample_emitter(s.position, u, dir, dist, le, pdf)) {
+            float cos_s = dot(s.shading_normal, dir);
+            if (cos_s > 0.0 && (dot(s.geometric_normal, dir) <= 0.0 ||
+                                !unoccluded_to(origin, s.position, dir, dist))) {
+                vec3 f = le * cos_s / pdf;
+                if (!any(isnan(f)) && !any(isinf(f))) {
+                    sum -= f;
+                }
+            }
+        }
+    }
+#elif defined(HAS_EMITTERS)
     {
         vec3 dir, le;
         float dist, pdf;
@@ -131,7 +183,28 @@ float bsdf_pdf_dir(Bsdf f, vec3 dir) { return brdf_pdf(f.m, f.v, bsdf_local(f, d
 vec3 direct_reflected(Surface s, Bsdf f, inout Rng rng) {
     vec3 sum = vec3(0.0);
     vec3 origin = offset_ray_origin(s.position, s.geometric_normal);
-#ifdef HAS_EMITTERS
+#if defined(PATH_EMITTERS_IN_CLOSED_FORM)
+    {
+        // The unshadowed light in closed form less a one-sample estimate of what is hidden:
+        // E − f(x)(1 − V(x))/p(x) has the expectation ∫ f·V, exact (no noise) wherever the
+        // emitters are wholly visible; emission that a BSDF sample hits counts nothing
+        // (path_step). docs/cache-frame.md §4.
+        sum += analytic_emitter_irradiance(origin, s.shading_normal);
+        vec3 dir, le;
+        float dist, pdf;
+        vec3 u = vec3(rng_next(rng), rng_next2(rng));
+        if (sample_emitter(s.position, u, dir, dist, le, pdf)) {
+            float cos_s = dot(s.shading_normal, dir);
+            if (cos_s > 0.0 && (dot(s.geometric_normal, dir) <= 0.0 ||
+                                !unoccluded_to(origin, s.position, dir, dist))) {
+                vec3 f = le * cos_s / pdf;
+                if (!any(isnan(f)) && !any(isinf(f))) {
+                    sum -= f;
+                }
+            }
+        }
+    }
+#elif defined(HAS_EMITTERS)
     {
         vec3 dir, le;
         float dist, pdf;
@@ -235,7 +308,11 @@ void path_step(inout PathState st, inout Rng rng) {
     vec3 le = count_sources ? material_emission(s.material, s.uv, s.front_face) : vec3(0.0);
     if (any(greaterThan(le, vec3(0.0)))) {
         float w = 1.0;
-#ifdef HAS_EMITTERS
+#if defined(PATH_EMITTERS_IN_CLOSED_FORM)
+        if (st.bsdf_pdf > 0.0) {
+            w = 0.0;  // the vertex before took all of the emitters' light (direct_light)
+        }
+#elif defined(HAS_EMITTERS)
         if (st.bsdf_pdf > 0.0) {
             GpuMaterial m = materials[s.material];
             float cos_l = abs(dot(s.geometric_normal, st.ray.dir));

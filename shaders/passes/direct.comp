@@ -21,9 +21,6 @@
 #include "../common/path.glsl"
 #include "../common/gbuffer.glsl"
 #include "../shared/push.glsl"
-#ifdef HAS_ANALYTIC_EMITTERS
-#include "../common/polygon.glsl"
-#endif
 
 layout(local_size_x = 8, local_size_y = 8) in;
 #include "../common/dispatch.glsl"
@@ -397,24 +394,6 @@ vec3 specular_indirect(Surface s, Bsdf f, vec3 origin, inout Rng rng) {
 #endif
 
 #ifdef HAS_ANALYTIC_EMITTERS
-// The unshadowed irradiance of every emissive triangle at `origin` (normal n), in closed form
-// (common/polygon.glsl). The plan compiles this in only for a few untextured emitters
-// (radcache_scene::ScenePlan::analytic_emitters), so the radiance is the material's constant.
-vec3 analytic_emitter_irradiance(vec3 origin, vec3 n) {
-    vec3 sum = vec3(0.0);
-    for (uint i = 0u; i < frame.counts.x; ++i) {
-        GpuEmitter e = emitters[i];
-        vec3 ng = cross(e.p1.xyz - e.p0.xyz, e.p2.xyz - e.p0.xyz);
-        bool front = dot(origin - e.p0.xyz, ng) > 0.0;
-        vec3 le = material_emission(uint(e.uv2_material.z), TexCoords(0.0), front);
-        if (any(greaterThan(le, vec3(0.0)))) {
-            vec3 t[3] = vec3[3](e.p0.xyz, e.p1.xyz, e.p2.xyz);
-            sum += le * triangle_projected_solid_angle(origin, n, t);
-        }
-    }
-    return sum;
-}
-
 // The sums of the ratio estimator of the emitters' direct light (Heitz, Hill, McGuire 2018,
 // "Combining analytic direct illumination and stochastic shadows"; docs/cache-frame.md §8.2):
 // over `count` light samples (g = first .. first + count of the pixel's R3 sequence), Σ f/p and

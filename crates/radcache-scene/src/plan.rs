@@ -76,6 +76,15 @@ pub struct AnimationPlan {
 /// integral per sub-frame, a few dozen flops beside a shadow ray's traversal.
 pub const ANALYTIC_EMITTERS_MAX: usize = 16;
 
+/// Smallest share of the scene's bounding-box surface that its emitters must cover for the
+/// cache's gathers to take their light in closed form ([`ScenePlan::closed_form_gathers`]).
+/// Measured on lavapipe at 256², default preset, against 8192-spp Mitsuba references
+/// (docs/cache-frame.md §4): in the furnace (emitters 100 % of it) relMSE 1.81e-5 → 9.75e-6 and
+/// 8×8-block RMSE 6.37e-3 → 3.81e-3 for a frame 1.16 → 1.72 s; in the Cornell box (0.7 %)
+/// relMSE only −2 % for a record pass 14 % longer: a small emitter's sampled light varies little
+/// but by its visibility, which the closed form does not help.
+pub const CLOSED_FORM_GATHER_MIN_EMITTER_SHARE: f32 = 0.1;
+
 /// Fewest instanced triangles for which the cache's G-buffer is ray traced
 /// ([`ScenePlan::traced_gbuffer`]). Measured on lavapipe (docs/cache-frame.md §2): at 32
 /// triangles (the Cornell box) rasterization is level at 256² and 25 % faster at 1024²; from
@@ -95,6 +104,12 @@ pub struct ScenePlan {
     /// test (the closed form takes the whole triangle), and only Lambertian materials (Lambert's
     /// formula gives irradiance, not a glossy lobe's integral).
     pub analytic_emitters: bool,
+    /// The cache's gather paths take the emitters' light at each vertex in closed form, less a
+    /// one-sample estimate of its hidden part (`PATH_CLOSED_FORM_EMITTERS`,
+    /// `shaders/common/path.glsl`): with [`Self::analytic_emitters`], where the emitters cover at
+    /// least [`CLOSED_FORM_GATHER_MIN_EMITTER_SHARE`] of the bounding box's surface. False: one
+    /// sampled shadow ray per vertex with MIS.
+    pub closed_form_gathers: bool,
     /// Some material has a specular lobe (metallic, or a dielectric specular layer): the passes
     /// compile the full metallic-roughness BRDF (`HAS_SPECULAR`). False when every material is
     /// Lambertian ([`Material::is_lambertian`](crate::Material::is_lambertian)).
@@ -175,12 +190,19 @@ impl ScenePlan {
             .iter()
             .filter(|m| !m.is_lambertian() && m.roughness >= GLOSSY_ROUGHNESS_MIN)
             .count();
+        let analytic_emitters =
+            count > 0 && count <= ANALYTIC_EMITTERS_MAX && !textured_emission && !specular;
+        let emitter_area: f32 = emitters.triangles.iter().map(|t| t.area).sum();
+        let b = scene.bounds_at(t0);
+        let e = (b.max - b.min).max(glam::Vec3::ZERO);
+        let box_area = 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
+        let closed_form_gathers = analytic_emitters
+            && box_area > 0.0
+            && emitter_area >= CLOSED_FORM_GATHER_MIN_EMITTER_SHARE * box_area;
         ScenePlan {
             glossy_materials,
-            analytic_emitters: count > 0
-                && count <= ANALYTIC_EMITTERS_MAX
-                && !textured_emission
-                && !specular,
+            analytic_emitters,
+            closed_form_gathers,
             specular,
             alpha,
             normal_maps: scene.meshes.iter().any(|m| !m.tangents.is_empty()),
@@ -259,10 +281,13 @@ impl fmt::Display for ScenePlan {
                 "  emissive triangles: {} (power {:.4} W; cache frames: {})",
                 self.emissive_triangles,
                 self.emissive_power,
-                if self.analytic_emitters {
-                    "unshadowed light in closed form, shadows sampled"
-                } else {
-                    "sampled with MIS"
+                match (self.analytic_emitters, self.closed_form_gathers) {
+                    (true, true) => {
+                        "unshadowed light in closed form, shadows sampled; in the records' \
+                         gathers too"
+                    }
+                    (true, false) => "unshadowed light in closed form, shadows sampled",
+                    _ => "sampled with MIS",
                 }
             )?;
         } else {

@@ -183,6 +183,11 @@ impl RecordPass {
         if params.error_control == ErrorControl::Hessian {
             defines.push(("IC_HESSIAN", "1"));
         }
+        if scene.plan().closed_form_gathers {
+            // The emitters' light at each gather vertex in closed form less a one-sample
+            // estimate of its hidden part (`shaders/common/path.glsl`).
+            defines.push(("PATH_CLOSED_FORM_EMITTERS", "1"));
+        }
         if radiance {
             defines.push(("HAS_RADIANCE_CACHE", "1"));
             if spacing == GlossySpacing::Lobe {
