@@ -9,10 +9,10 @@
 // is counted once. In the cache's gathers of a Lambertian scene with few emitters
 // (PATH_CLOSED_FORM_EMITTERS), the emissive triangles' light at a vertex is instead their
 // closed-form unshadowed irradiance less a one-sample estimate of its hidden part (a control
-// variate, unbiased), and emission hit by BSDF sampling counts nothing. Russian roulette from the fourth vertex on (camera paths; the cache's gather
-// paths from their second vertex), with continuation probability the throughput's largest
-// component capped at 0.99; a safety cap of 4096 vertices (reached with
-// probability < 0.99^4093, invisible).
+// variate, unbiased), and emission hit by BSDF sampling counts nothing. Russian roulette from
+// the fourth vertex on (camera paths; the cache's gather paths from their second vertex), with
+// continuation probability the throughput's largest component capped at 0.99; a safety cap of
+// 4096 vertices (reached with probability < 0.99^4093, invisible).
 #ifndef RADCACHE_PATH_GLSL
 #define RADCACHE_PATH_GLSL
 
@@ -183,28 +183,7 @@ float bsdf_pdf_dir(Bsdf f, vec3 dir) { return brdf_pdf(f.m, f.v, bsdf_local(f, d
 vec3 direct_reflected(Surface s, Bsdf f, inout Rng rng) {
     vec3 sum = vec3(0.0);
     vec3 origin = offset_ray_origin(s.position, s.geometric_normal);
-#if defined(PATH_EMITTERS_IN_CLOSED_FORM)
-    {
-        // The unshadowed light in closed form less a one-sample estimate of what is hidden:
-        // E − f(x)(1 − V(x))/p(x) has the expectation ∫ f·V, exact (no noise) wherever the
-        // emitters are wholly visible; emission that a BSDF sample hits counts nothing
-        // (path_step). docs/cache-frame.md §4.
-        sum += analytic_emitter_irradiance(origin, s.shading_normal);
-        vec3 dir, le;
-        float dist, pdf;
-        vec3 u = vec3(rng_next(rng), rng_next2(rng));
-        if (sample_emitter(s.position, u, dir, dist, le, pdf)) {
-            float cos_s = dot(s.shading_normal, dir);
-            if (cos_s > 0.0 && (dot(s.geometric_normal, dir) <= 0.0 ||
-                                !unoccluded_to(origin, s.position, dir, dist))) {
-                vec3 f = le * cos_s / pdf;
-                if (!any(isnan(f)) && !any(isinf(f))) {
-                    sum -= f;
-                }
-            }
-        }
-    }
-#elif defined(HAS_EMITTERS)
+#ifdef HAS_EMITTERS
     {
         vec3 dir, le;
         float dist, pdf;
