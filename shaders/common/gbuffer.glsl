@@ -1,7 +1,9 @@
 // common/gbuffer.glsl: the G-buffer of crates/radcache-render/src/passes/gbuffer.rs as compute
 // and fragment passes read it: storage images at B_GBUFFER_* (crates/radcache-render/src/bindings.rs).
 //
-//   +0 position   xyz world position of the first hit; w = 1 on a surface, 0 on the background
+//   +0 position   xyz world position of the first hit; w = 1 on a surface, 0 on the background,
+//                 −1 where per-pixel adaptive anti-aliasing has stopped the pixel (no sample in
+//                 this sub-frame: docs/cache-frame.md §7.2; the other images are then stale)
 //   +1 normal     xyz unit shading normal, turned toward the camera; w = pixel footprint (world
 //                 size of one pixel at the point, ircache_math.glsl `pixel_footprint`)
 //   +2 geometric  xyz unit geometric normal, turned toward the camera; w = material index
@@ -33,6 +35,7 @@ layout(binding = B_GBUFFER_DIRECT, rgba32f) GBUFFER_DIRECT_ACCESS uniform image2
 
 struct GSample {
     bool surface;
+    bool stopped;      // no sample in this sub-frame (position w = −1); `surface` is false
     vec3 position;
     vec3 normal;       // shading, toward the camera
     float footprint;   // world size of one pixel at `position`
@@ -53,6 +56,7 @@ GSample gbuffer_load(ivec2 pixel) {
     vec4 g = imageLoad(g_geometric, pixel);
     GSample s;
     s.surface = p.w > 0.5;
+    s.stopped = p.w < -0.5;
     s.position = p.xyz;
     s.normal = n.xyz;
     s.footprint = n.w;

@@ -12,6 +12,9 @@
 // centres stores each pixel's centre point and normal (pc.centre = 1); every later sub-frame
 // (pc.centre = 2) interpolates its sample's cached light between the centres around it that
 // match it (`cached_light_from_centres`), and counts the samples no centre matches.
+// A pixel that per-pixel adaptive anti-aliasing has stopped (G-buffer position w = −1,
+// docs/cache-frame.md §7.2) gets nothing: its sums and counts stay as they are, and its mean
+// (sum / count) is over the sub-frames that shaded it.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -162,6 +165,9 @@ void main() {
     }
     uint index = uint(pixel.y) * frame.resolution.x + uint(pixel.x);
     GSample g = gbuffer_load(pixel);
+    if (g.stopped) {
+        return;  // per-pixel adaptive anti-aliasing has stopped the pixel: no sample
+    }
     vec3 l;
     vec3 emitted = vec3(0.0);
     if (pc.centre == 1u) {

@@ -5,7 +5,9 @@
 // albedo/π × the estimate (emission itself is in the G-buffer's emission image). With
 // HAS_SPECULAR (a scene with non-Lambertian materials) the estimate weighs each sample with the
 // full BRDF (one_sample_brdf), and the specular lobe's indirect light is added, path traced
-// (specular_indirect); the written value is that reflected radiance.
+// (specular_indirect); the written value is that reflected radiance. A pixel that per-pixel
+// adaptive anti-aliasing has stopped (G-buffer position w = −1, docs/cache-frame.md §7.2) is
+// no surface here: it traces nothing, and the composite skips it.
 //
 // Sample g of a pixel (g = sub_frame · count + k; sub-frames continue the sequence) draws its random
 // numbers from Kronecker sequences (Roberts 2018, the R_d sequences: point g is fract(shift + g·α),

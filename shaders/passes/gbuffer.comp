@@ -40,6 +40,10 @@ layout(binding = B_GBUFFER_GEOMETRIC, rgba32f) GBUFFER_READ uniform image2D o_ge
 layout(binding = B_GBUFFER_ALBEDO, rgba32f) writeonly uniform image2D o_albedo;
 layout(binding = B_GBUFFER_EMISSION, rgba32f) writeonly uniform image2D o_emission;
 layout(binding = B_GBUFFER_DIRECT, rgba32f) GBUFFER_READ uniform image2D o_direct;
+// 1 where this sub-frame shades the pixel, 0 where per-pixel adaptive anti-aliasing has stopped
+// it (docs/cache-frame.md §7.2): its position is written with w = −1 and nothing else, and the
+// direct and composite passes leave it alone.
+layout(binding = B_GBUFFER_PASS_ACTIVE, std430) readonly buffer Active { uint active_mask[]; };
 
 #ifdef HAS_ALPHA
 // The seed of this pixel's BLEND tests in this sub-frame, as gbuffer.frag draws it.
@@ -100,6 +104,12 @@ void main() {
         }
         return;
     }
+    // Stage 1 reads no neighbour: a stopped pixel may be marked now.
+    if (active_mask[pixel.y * frame.resolution.x + pixel.x] == 0u) {
+        imageStore(o_position, at, vec4(0.0, 0.0, 0.0, -1.0));
+        imageStore(o_direct, at, vec4(0.0));
+        return;
+    }
     if (imageLoad(o_direct, at).x == 0.0) {
         return;
     }
@@ -118,6 +128,10 @@ void main() {
     }
 #else
     imageStore(o_direct, at, vec4(0.0));
+    if (active_mask[pixel.y * frame.resolution.x + pixel.x] == 0u) {
+        imageStore(o_position, at, vec4(0.0, 0.0, 0.0, -1.0));
+        return;
+    }
     Ray r = camera_ray(pixel, vec2(0.5) + pc.jitter);
     scene_trace_seeded(q, 0u, r.origin, r.dir, IC_FAR, alpha_seed);
     if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {

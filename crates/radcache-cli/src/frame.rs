@@ -301,6 +301,7 @@ pub fn stats_entry(r: &Rendered, frame: u32, time: f32) -> Value {
         entry["holes_left"] = json!(ic.holes_left);
         entry["unmatched_samples"] = json!(ic.unmatched_samples);
         entry["sub_frames_shaded"] = json!(ic.sub_frames_shaded);
+        entry["mean_pixel_sub_frames"] = json!(ic.mean_pixel_sub_frames);
         entry["dropped_requests"] = json!(ic.dropped_requests);
         entry["rejected_records"] = json!(ic.rejected_records);
         entry["phases_wall_s"] = json!(ic.phases_s);

@@ -176,6 +176,16 @@ pub const GBUFFER_END: u32 = PASS_BASE + GBUFFER.len() as u32;
 pub const FRAME_ONLY: [BindingLayout; 1] = [SCENE[0]];
 
 pass_bindings! {
+    /// `passes/gbuffer.comp` (traced, and the rasterized G-buffer's repair): which pixels the
+    /// sub-frame shades.
+    pub mod gbuffer_pass("GBUFFER_PASS", base = GBUFFER_END, prefix = [SCENE, GBUFFER]) {
+        /// 1 where the pixel is shaded in this sub-frame, 0 where per-pixel adaptive
+        /// anti-aliasing has stopped it (`uint[]`; docs/cache-frame.md §7.2).
+        ACTIVE: StorageBuffer,
+    }
+}
+
+pass_bindings! {
     /// `passes/aov.comp`: first-hit albedo, normal and depth.
     pub mod aov("AOV", base = PASS_BASE, prefix = [SCENE]) {
         /// Albedo per pixel (`vec4[]`).
@@ -391,6 +401,7 @@ pub fn generated_glsl() -> String {
     }
     for table in [
         gbuffer::glsl(),
+        gbuffer_pass::glsl(),
         aov::glsl(),
         composite::glsl(),
         direct::glsl(),

@@ -94,6 +94,16 @@ pub enum Splat {
     PerSubFrame,
 }
 
+/// What adaptive anti-aliasing's added sub-frames shade (docs/cache-frame.md §7.1, §7.2).
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AaScope {
+    /// Only the pixels whose own sampling error still needs samples, each batch as far as
+    /// they need (default).
+    Pixel,
+    /// Every pixel, until the whole frame's estimate meets the target.
+    Frame,
+}
+
 /// The rule that sets a record's radius.
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ErrorControlArg {
@@ -152,6 +162,9 @@ pub struct IcArgs {
     /// The most sub-frames adaptive anti-aliasing shades (`--method ic`); default 64.
     #[arg(long, value_name = "N")]
     pub max_sub_frames: Option<u32>,
+    /// What adaptive anti-aliasing shades after the cache's sub-frames (`--method ic`).
+    #[arg(long, value_enum, default_value_t = AaScope::Pixel)]
+    pub aa_scope: AaScope,
     /// Direct-lighting samples per pixel and sub-frame (`--method ic`; one ray each); default 16.
     #[arg(long)]
     pub direct_samples: Option<u32>,
@@ -216,6 +229,7 @@ impl IcArgs {
         Ok((target > 0.0).then_some(AntiAliasing {
             target,
             max_sub_frames,
+            per_pixel: self.aa_scope == AaScope::Pixel,
         }))
     }
 

@@ -53,6 +53,106 @@ pub fn next_sub_frames(done: u32, estimate: f64, target: f64, max: u32) -> u32 {
     wanted.max(done + 1).min(max)
 }
 
+/// Each pixel's relative variance per sample, `(1/3) Σ_c s_c² / (m_c² + 0.01)` from its sums
+/// (0 with fewer than two samples or non-finite sums): its term of [`sampling_relmse`] is this
+/// over its sample count.
+fn relative_variance(s: &[f32; 4], q: &[f32; 4]) -> f64 {
+    let n = f64::from(s[3]);
+    if n < 2.0 {
+        return 0.0;
+    }
+    let mut v = 0.0;
+    for c in 0..3 {
+        let (sum, sq) = (f64::from(s[c]), f64::from(q[c]));
+        let mean = sum / n;
+        let term = ((sq - sum * mean) / (n - 1.0)).max(0.0) / (mean * mean + REL_EPS);
+        if term.is_finite() {
+            v += term;
+        }
+    }
+    v / 3.0
+}
+
+/// The mean of the pixels' sample counts (the `w` of each pixel's sums).
+pub fn mean_count(sums: &[[f32; 4]]) -> f64 {
+    if sums.is_empty() {
+        return 0.0;
+    }
+    sums.iter().map(|s| f64::from(s[3])).sum::<f64>() / sums.len() as f64
+}
+
+/// What per-pixel adaptive anti-aliasing shades next (docs/cache-frame.md §7.2).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PixelPlan {
+    /// Per pixel (row-major), 1 where the next sub-frames shade it, else 0.
+    pub mask: Vec<u32>,
+    /// Pixels with a 1.
+    pub active: usize,
+    /// The sub-frame count to shade up to (exclusive end of the next batch).
+    pub next: u32,
+}
+
+/// The pixels that still need samples after `done` sub-frames, and how far to shade them,
+/// from each pixel's sums `(Σl rgb, n)` and `(Σl² rgb, ·)` of a `width × height` frame.
+///
+/// The image's sampling relMSE is `(1/P) Σ_p v_p / n_p` ([`sampling_relmse`]; `v_p` the
+/// pixel's relative variance per sample). For a given total of samples it is smallest with
+/// `n_p ∝ √v_p` (Lagrange), which meets `target` at `n_p = √v_p · Σ_q √v_q / (P · target)`. A
+/// pixel is shaded on while that is above the samples it has. `v_p` is the largest of its 3×3
+/// neighbourhood's: a pixel whose few samples happened to agree beside an edge or a noisy
+/// neighbour keeps going, and the estimate errs toward more samples. The batch ends where the
+/// active pixels' largest want (10 % to spare) says, but at most twice `done` (the estimates
+/// are remade after each batch), at least `done + 1`, at most `max`.
+pub fn plan_pixels(
+    sums: &[[f32; 4]],
+    squares: &[[f32; 4]],
+    width: u32,
+    height: u32,
+    done: u32,
+    target: f64,
+    max: u32,
+) -> PixelPlan {
+    let (w, h) = (width as usize, height as usize);
+    let pixels = (w * h).min(sums.len()).min(squares.len());
+    let own: Vec<f64> = (0..pixels)
+        .map(|i| relative_variance(&sums[i], &squares[i]))
+        .collect();
+    let mut dilated = vec![0.0f64; pixels];
+    for (i, d) in dilated.iter_mut().enumerate() {
+        let (x, y) = (i % w, i / w);
+        for ny in y.saturating_sub(1)..=(y + 1).min(h - 1) {
+            for nx in x.saturating_sub(1)..=(x + 1).min(w - 1) {
+                if let Some(&v) = own.get(ny * w + nx) {
+                    *d = d.max(v);
+                }
+            }
+        }
+    }
+    let root_sum: f64 = dilated.iter().map(|v| v.sqrt()).sum();
+    let scale = if target > 0.0 && pixels > 0 {
+        root_sum / (pixels as f64 * target)
+    } else {
+        f64::INFINITY
+    };
+    let mut mask = vec![0u32; w * h];
+    let (mut active, mut want) = (0usize, 0.0f64);
+    for i in 0..pixels {
+        let wanted = dilated[i].sqrt() * scale;
+        if wanted > f64::from(sums[i][3]) {
+            mask[i] = 1;
+            active += 1;
+            want = want.max(wanted);
+        }
+    }
+    let next = if want.is_finite() {
+        (1.1 * want).ceil().min(f64::from(u32::MAX)) as u32
+    } else {
+        max
+    };
+    let next = next.min(done.saturating_mul(2)).max(done + 1).min(max);
+    PixelPlan { mask, active, next }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -126,6 +226,78 @@ mod tests {
         let one = [1.0, 1.0, 1.0, 1.0];
         assert_eq!(sampling_relmse(&[nan, one], &[nan, one]), 0.0);
         assert_eq!(sampling_relmse(&[], &[]), 0.0);
+    }
+
+    #[test]
+    fn pixels_with_noise_go_on_and_flat_ones_stop() {
+        // An 8×8 frame after 8 sub-frames: one pixel alternates 0 and 1 (an edge), the rest is
+        // flat. The edge and its 3×3 neighbours go on; every other pixel stops.
+        let (w, h) = (8u32, 8u32);
+        let flat = moments(&[[0.5; 3]; 8]);
+        let edge_samples: Vec<[f32; 3]> = (0..8)
+            .map(|i| if i % 2 == 0 { [1.0; 3] } else { [0.0; 3] })
+            .collect();
+        let edge = moments(&edge_samples);
+        let mut sums = vec![flat.0; 64];
+        let mut squares = vec![flat.1; 64];
+        sums[3 * 8 + 3] = edge.0;
+        squares[3 * 8 + 3] = edge.1;
+        let plan = plan_pixels(&sums, &squares, w, h, 8, 5e-4, 64);
+        for y in 0..8usize {
+            for x in 0..8usize {
+                let near = x.abs_diff(3) <= 1 && y.abs_diff(3) <= 1;
+                assert_eq!(plan.mask[y * 8 + x], u32::from(near), "pixel ({x}, {y})");
+            }
+        }
+        assert_eq!(plan.active, 9);
+        // v = (2/7)/0.26 ≈ 1.1 over the 9 pixels: each wants √v · 9√v / (64 · 5e-4) ≈ 309
+        // samples, so the batch is capped at twice the sub-frames done.
+        assert_eq!(plan.next, 16);
+    }
+
+    #[test]
+    fn the_wanted_counts_meet_the_target_with_square_root_allocation() {
+        // Two noisy pixels (v = 4 and v = 1, flat neighbours far away) in a 16×1 frame: with
+        // n ∝ √v the counts that meet the target are √v · (Σ√v over every dilated pixel) /
+        // (P · target). Pixel 2 (v = 4, dilated over 1…3) and pixel 12 (v = 1, over 11…13):
+        // Σ√v = 3·2 + 3·1 = 9; at target 9/16/10 the wanted counts are 20 and 10.
+        let frame = |n: usize| -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+            // Mean 0 (m² + 0.01 = 0.01) and sample variance 0.01·v from n samples ±a.
+            let noisy = |v: f32| {
+                let a = (0.01 * v * (n as f32 - 1.0) / n as f32).sqrt();
+                let samples: Vec<[f32; 3]> = (0..n)
+                    .map(|i| if i % 2 == 0 { [a; 3] } else { [-a; 3] })
+                    .collect();
+                moments(&samples)
+            };
+            let flat = moments(&vec![[0.0; 3]; n]);
+            let (mut sums, mut squares) = (vec![flat.0; 16], vec![flat.1; 16]);
+            (sums[2], squares[2]) = noisy(4.0);
+            (sums[12], squares[12]) = noisy(1.0);
+            (sums, squares)
+        };
+        let on =
+            |plan: &PixelPlan| -> Vec<usize> { (0..16).filter(|&i| plan.mask[i] == 1).collect() };
+        let target = 9.0 / 16.0 / 10.0;
+        let (sums, squares) = frame(8);
+        let plan = plan_pixels(&sums, &squares, 16, 1, 8, target, 64);
+        assert_eq!(on(&plan), vec![1, 2, 3, 11, 12, 13]);
+        // The largest want is 20 (pixel 2's neighbourhood): 1.1 × 20 = 22, but at most 16.
+        assert_eq!(plan.next, 16);
+        let (sums, squares) = frame(16);
+        let later = plan_pixels(&sums, &squares, 16, 1, 16, target, 64);
+        // At 16 samples pixel 12's neighbourhood (want 10) stops; pixel 2's goes on.
+        assert_eq!(on(&later), vec![1, 2, 3]);
+        // 1.1 × 20 in floating point: 22 or, rounded up past it, 23.
+        assert!((22..=23).contains(&later.next), "{}", later.next);
+        assert_eq!(plan_pixels(&sums, &squares, 16, 1, 16, target, 20).next, 20);
+    }
+
+    #[test]
+    fn a_flat_frame_needs_no_more_samples() {
+        let flat = moments(&[[0.25; 3]; 8]);
+        let plan = plan_pixels(&[flat.0; 4], &[flat.1; 4], 2, 2, 8, 5e-4, 64);
+        assert_eq!((plan.active, plan.mask), (0, vec![0; 4]));
     }
 
     #[test]

@@ -29,6 +29,7 @@ use crate::passes::temporal::TemporalPass;
 use crate::scene::GpuScene;
 use crate::state::IcState;
 
+mod anti_alias;
 mod cache;
 mod phases;
 mod temporal;

@@ -103,6 +103,10 @@ pub struct AntiAliasing {
     pub target: f64,
     /// The most sub-frames a frame shades.
     pub max_sub_frames: u32,
+    /// Per pixel (docs/cache-frame.md §7.2): the added sub-frames shade only the pixels whose
+    /// own sampling error still needs samples ([`crate::frame::aa::plan_pixels`]); otherwise
+    /// every pixel.
+    pub per_pixel: bool,
 }
 
 impl AntiAliasing {
@@ -119,6 +123,7 @@ impl AntiAliasing {
         AntiAliasing {
             target,
             max_sub_frames: 64,
+            per_pixel: true,
         }
     }
 }
@@ -297,6 +302,9 @@ pub struct IcStats {
     pub sub_frames_shaded: u32,
     /// With adaptive anti-aliasing: the sampling relMSE estimated after the last sub-frame.
     pub aa_relmse_estimate: Option<f64>,
+    /// The mean of the pixels' sub-frames: `sub_frames_shaded` unless per-pixel adaptive
+    /// anti-aliasing stopped some pixels earlier (docs/cache-frame.md §7.2).
+    pub mean_pixel_sub_frames: f64,
     /// The debug AOVs, when asked for.
     pub debug: Option<IcDebug>,
 }

@@ -264,11 +264,17 @@ impl CompositePass {
     ) -> Result<(Vec<f32>, Vec<f32>, Vec<f32>)> {
         let n = (self.width * self.height) as usize;
         let raw: Vec<[f32; 4]> = ctx.read_buffer(&self.debug_accum, 2 * n)?;
-        let k = sub_frames.max(1) as f32;
+        // Each pixel's own sub-frames (per-pixel adaptive anti-aliasing stops some early).
+        let sums: Vec<[f32; 4]> = ctx.read_buffer(&self.accum, n)?;
         let mut indirect = Vec::with_capacity(3 * n);
         let mut weight = Vec::with_capacity(n);
         let mut count = Vec::with_capacity(n);
-        for px in raw.chunks_exact(2) {
+        for (px, s) in raw.chunks_exact(2).zip(&sums) {
+            let k = if s[3] > 0.0 {
+                s[3]
+            } else {
+                sub_frames.max(1) as f32
+            };
             indirect.extend(px[0][..3].iter().map(|v| v / k));
             weight.push(px[0][3] / k);
             count.push(px[1][0] / k);
@@ -284,13 +290,22 @@ impl CompositePass {
     /// The sampling relMSE of the mean over the sub-frames accumulated so far
     /// ([`crate::frame::aa::sampling_relmse`]); `None` for a pass made without moments.
     pub fn read_sampling_relmse(&self, ctx: &Context) -> Result<Option<f64>> {
+        Ok(self
+            .read_moments(ctx)?
+            .map(|(sums, squares)| crate::frame::aa::sampling_relmse(&sums, &squares)))
+    }
+
+    /// Each pixel's sums `(Σl rgb, n)` and `(Σl² rgb, ·)` over the sub-frames accumulated so
+    /// far; `None` for a pass made without moments.
+    #[allow(clippy::type_complexity)]
+    pub fn read_moments(&self, ctx: &Context) -> Result<Option<(Vec<[f32; 4]>, Vec<[f32; 4]>)>> {
         if !self.moments {
             return Ok(None);
         }
         let n = (self.width * self.height) as usize;
         let sums: Vec<[f32; 4]> = ctx.read_buffer(&self.accum, n)?;
         let squares: Vec<[f32; 4]> = ctx.read_buffer(&self.accum_sq, n)?;
-        Ok(Some(crate::frame::aa::sampling_relmse(&sums, &squares)))
+        Ok(Some((sums, squares)))
     }
 
     /// Samples of the sub-frames composited with [`CentreSamples::Match`] that no centre of

@@ -14,7 +14,10 @@
 //!
 //! Either writes the five images of `shaders/common/gbuffer.glsl` (position, shading normal +
 //! footprint, geometric normal + material, albedo, emission), zero on the background, and clears
-//! the direct-light image. Both read the scene bindings 0–15.
+//! the direct-light image. Both read the scene bindings 0–15. The traced pass and the repair
+//! also read the G-buffer's activity mask (`gbuffer_pass::ACTIVE`): a pixel that per-pixel
+//! adaptive anti-aliasing has stopped gets position w = −1 and nothing else
+//! (docs/cache-frame.md §7.2).
 
 use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
@@ -22,7 +25,7 @@ use radcache_vk::{
     Recorder, ShaderCompiler,
 };
 
-use crate::bindings::{GBUFFER, SCENE};
+use crate::bindings::SCENE;
 use crate::error::Result;
 use crate::scene::GpuScene;
 
@@ -78,12 +81,11 @@ impl GBufferPass {
         let defines = scene.material_defines();
         let compute = |name: &str, defines: &[(&str, &str)]| -> Result<Pipeline> {
             let spirv = shaders.compile("passes/gbuffer.comp", defines)?;
-            let layout: Vec<_> = SCENE.iter().chain(GBUFFER.iter()).copied().collect();
             Ok(Pipeline::compute(
                 ctx,
                 name,
                 &spirv,
-                &layout,
+                &crate::bindings::gbuffer_pass::layout(),
                 std::mem::size_of::<GBufferPush>() as u32,
             )?)
         };
@@ -147,6 +149,7 @@ impl GBufferPass {
             }
             let mut bindings = scene.bindings();
             bindings.extend(gbuffer.bindings());
+            bindings.push(gbuffer.active_binding());
             let (w, h) = (gbuffer.width, gbuffer.height);
             rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
             rec.pass("gbuffer", |rec| {
@@ -205,6 +208,7 @@ impl GBufferPass {
         if let Some(repair) = &self.repair {
             let mut bindings = scene.bindings();
             bindings.extend(gbuffer.bindings());
+            bindings.push(gbuffer.active_binding());
             let [x, y, z] = image_dispatch(gbuffer.width, gbuffer.height);
             rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
             rec.pass("gbuffer.repair", |rec| {

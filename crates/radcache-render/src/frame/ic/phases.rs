@@ -11,10 +11,9 @@ use radcache_vk::Context;
 
 use super::IcRenderer;
 use crate::error::Result;
-use crate::frame::aa::next_sub_frames;
 use crate::frame::clock::FrameClock;
 use crate::frame::path::{FrameOutput, Progress};
-use crate::frame::settings::{sub_frame_jitter, AntiAliasing, IcSettings, IcStats, SplatMode};
+use crate::frame::settings::{sub_frame_jitter, IcSettings, IcStats, SplatMode};
 use crate::passes::composite::CentreSamples;
 use crate::passes::holes::HoleSelection;
 use crate::passes::record::creation_seed;
@@ -391,35 +390,6 @@ impl IcRenderer {
         Ok(())
     }
 
-    /// **Adaptive anti-aliasing** (docs/cache-frame.md §7.1): while the sampling relMSE estimated
-    /// from the accumulated moments is above `aa.target`, shades the sub-frames that `1/n`
-    /// predicts (at least one more, at most `aa.max_sub_frames`) with the records as they are.
-    pub(super) fn anti_alias(
-        &self,
-        ctx: &Context,
-        gpu: &GpuScene,
-        settings: &IcSettings,
-        aa: AntiAliasing,
-        run: &mut FrameRun<'_>,
-    ) -> Result<()> {
-        loop {
-            let Some(estimate) = self.composite.read_sampling_relmse(ctx)? else {
-                return Ok(());
-            };
-            run.stats.aa_relmse_estimate = Some(estimate);
-            run.clock.lap("anti_aliasing");
-            let done = run.shaded;
-            if estimate <= aa.target || done >= aa.max_sub_frames {
-                return Ok(());
-            }
-            let next = next_sub_frames(done, estimate, aa.target, aa.max_sub_frames);
-            run.shade_total = next;
-            for k in done..next {
-                self.shade_sub_frame(ctx, gpu, settings, k, run)?;
-            }
-        }
-    }
-
     /// **Finish**: the box-filtered emission, the instances kept for the next frame's motion,
     /// the look-ahead's radiance blocks promoted for the next frame, the read-back of the mean over the sub-frames (and of the debug AOVs), the figures.
     pub(super) fn finish(
@@ -449,6 +419,9 @@ impl IcRenderer {
         }
         run.clock.lap("readback");
         run.stats.sub_frames_shaded = run.shaded;
+        if settings.anti_aliasing.is_none() || run.stats.mean_pixel_sub_frames == 0.0 {
+            run.stats.mean_pixel_sub_frames = f64::from(run.shaded);
+        }
         run.stats.unmatched_samples = self.composite.read_unmatched()?;
         let mut clock = run.clock;
         run.stats.phases_s = std::mem::take(&mut clock.phases_s);

@@ -1,7 +1,9 @@
 //! The irradiance cache's G-buffer: the images every IC pass reads (layout in
 //! `shaders/common/gbuffer.glsl`), bound at `PASS_BASE + 0..5`.
 
-use radcache_vk::{vk, BindingLayout, Context, Image, ImageDesc, Resource};
+use radcache_vk::{
+    vk, BindingLayout, Buffer, BufferDesc, Context, Image, ImageDesc, MemoryLocation, Resource,
+};
 
 use crate::bindings::{gbuffer as b, GBUFFER};
 use crate::error::Result;
@@ -33,6 +35,14 @@ pub struct GBuffer {
     pub direct: Image,
     /// Depth attachment of the rasterization.
     pub depth: Image,
+    /// One `uint` a pixel, host-visible: 1 where the next sub-frames shade the pixel, 0 where
+    /// per-pixel adaptive anti-aliasing has stopped it (docs/cache-frame.md §7.2). The G-buffer
+    /// pass marks a stopped pixel's position with w = −1 instead of finding its surface, and
+    /// the direct and composite passes leave it alone. All 1 unless [`GBuffer::set_active`]
+    /// says otherwise.
+    active: Buffer,
+    /// Whether `active` holds a 0 somewhere.
+    partly_active: bool,
 }
 
 impl std::fmt::Debug for GBuffer {
@@ -78,7 +88,56 @@ impl GBuffer {
                     usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
                 },
             )?,
+            active: {
+                let mut active = Buffer::new(
+                    ctx,
+                    &BufferDesc {
+                        name: "gbuffer.active",
+                        size: 4 * u64::from(width) * u64::from(height),
+                        usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                        location: MemoryLocation::CpuToGpu,
+                        alignment: 0,
+                    },
+                )?;
+                active.write(0, &vec![1u32; (width * height) as usize])?;
+                active
+            },
+            partly_active: false,
         })
+    }
+
+    /// Which pixels the following sub-frames shade: `mask[i]` non-zero for pixel i (row-major),
+    /// `None` for all of them. No submission that uses the G-buffer may be in flight.
+    pub fn set_active(&mut self, mask: Option<&[u32]>) -> Result<()> {
+        match mask {
+            Some(mask) => {
+                if mask.len() != (self.width * self.height) as usize {
+                    return Err(crate::error::Error::Invalid(format!(
+                        "an activity mask of {} pixels for a {}x{} G-buffer",
+                        mask.len(),
+                        self.width,
+                        self.height
+                    )));
+                }
+                self.active.write(0, mask)?;
+                self.partly_active = mask.contains(&0);
+            }
+            None if self.partly_active => {
+                self.active
+                    .write(0, &vec![1u32; (self.width * self.height) as usize])?;
+                self.partly_active = false;
+            }
+            None => {}
+        }
+        Ok(())
+    }
+
+    /// The activity mask's binding for the G-buffer pass (`gbuffer_pass::ACTIVE`).
+    pub fn active_binding(&self) -> (u32, Resource<'_>) {
+        (
+            crate::bindings::gbuffer_pass::ACTIVE,
+            Resource::Buffer(&self.active),
+        )
     }
 
     /// The binding layout of the G-buffer images (storage images at `PASS_BASE + 0..5`).
