@@ -155,8 +155,10 @@ vec3 direct_environment(vec3 d) {
 // weight 1 per source kind, BSDF sampling 0.25 (1 when a constant environment, which only BSDF
 // sampling finds, is present), normalized.
 // With HAS_ANALYTIC_EMITTERS the emitters are outside the one-sample MIS (their own estimate is
-// emitter_ratio_estimate) and BSDF sampling serves the environment alone.
-#if defined(HAS_EMITTERS) && !defined(HAS_ANALYTIC_EMITTERS)
+// emitter_ratio_estimate) and BSDF sampling serves the environment alone — with HAS_SPECULAR at
+// Lambertian pixels only: a pixel with a specular lobe keeps the emitters in its MIS
+// (`Techniques`, chosen per pixel; docs/cache-frame.md §8.2).
+#if defined(HAS_EMITTERS) && (!defined(HAS_ANALYTIC_EMITTERS) || defined(HAS_SPECULAR))
 #define MIS_EMITTERS
 const float W_EMITTER = 1.0;
 #else
@@ -180,6 +182,11 @@ const float W_BSDF = 0.25;
 // A specular lobe takes a constant sky here even when the records carry it (one_sample_brdf).
 #if defined(HAS_SPECULAR) && defined(HAS_ENV_CONSTANT) && !defined(HAS_SAMPLED_SOURCES)
 #define HAS_SAMPLED_SOURCES
+#endif
+// Sources the one-sample MIS finds besides the emitters (a closed-form pixel needs no loop
+// without them).
+#if defined(HAS_ENV_MAP) || defined(DIRECT_ENV_CONSTANT)
+#define MIS_ENVIRONMENT
 #endif
 const float C_EMITTER = W_EMITTER / (W_EMITTER + W_ENV + W_BSDF);
 const float C_ENV = W_ENV / (W_EMITTER + W_ENV + W_BSDF);
@@ -275,15 +282,28 @@ bool punctual_visible(uint i, vec3 origin, vec3 position, vec3 dir, float dist, 
 }
 
 #ifdef HAS_SPECULAR
-#ifdef HAS_ANALYTIC_EMITTERS
-#error "the closed-form emitters assume Lambertian receivers (ScenePlan::analytic_emitters)"
-#endif
+// The technique probabilities of one pixel's one-sample MIS: C_EMITTER, C_ENV and C_BSDF, or,
+// at a pixel whose emitters' light is taken in closed form, the same without the emitters.
+struct Techniques {
+    float emitter;
+    float env;
+    float bsdf;
+};
+
+Techniques techniques(bool emitters) {
+    float w_emitter = emitters ? W_EMITTER : 0.0;
+    float total = w_emitter + W_ENV + W_BSDF;
+    return Techniques(w_emitter / total, W_ENV / total, W_BSDF / total);
+}
+
 // One sample of the reflected radiance Σ f·L·cos/pdf with the full BRDF: the one-sample MIS of
-// one_sample, with brdf_sample (docs/materials.md §5) as the BSDF technique; `u_pick` in the BSDF
-// technique's share of [0, 1), rescaled, chooses its lobe.
-vec3 one_sample_brdf(Surface s, Bsdf f, vec3 origin, float u_pick, vec3 u3, vec2 u2) {
+// one_sample with the probabilities `c`, with brdf_sample (docs/materials.md §5) as the BSDF
+// technique; `u_pick` in the BSDF technique's share of [0, 1), rescaled, chooses its lobe. With
+// c.emitter = 0 (HAS_ANALYTIC_EMITTERS: a Lambertian pixel) an emitter that BSDF sampling hits
+// counts 0: the closed form accounts for it.
+vec3 one_sample_brdf(Surface s, Bsdf f, vec3 origin, Techniques c, float u_pick, vec3 u3, vec2 u2) {
 #ifdef MIS_EMITTERS
-    if (u_pick < C_EMITTER) {
+    if (u_pick < c.emitter) {
         vec3 dir, le;
         float dist, pdf;
         if (!sample_emitter(s.position, u3, dir, dist, le, pdf)) {
@@ -293,11 +313,11 @@ vec3 one_sample_brdf(Surface s, Bsdf f, vec3 origin, float u_pick, vec3 u3, vec2
         if (all(equal(fc, vec3(0.0))) || !unoccluded_to(origin, s.position, dir, dist)) {
             return vec3(0.0);
         }
-        return le * fc / (C_EMITTER * pdf + C_BSDF * bsdf_pdf_dir(f, dir));
+        return le * fc / (c.emitter * pdf + c.bsdf * bsdf_pdf_dir(f, dir));
     }
 #endif
 #ifdef HAS_ENV_MAP
-    if (u_pick < C_EMITTER + C_ENV) {
+    if (u_pick < c.emitter + c.env) {
         vec3 dir, le;
         float pdf;
         if (!sample_environment(u3, dir, le, pdf)) {
@@ -307,10 +327,10 @@ vec3 one_sample_brdf(Surface s, Bsdf f, vec3 origin, float u_pick, vec3 u3, vec2
         if (all(equal(fc, vec3(0.0))) || !unoccluded(origin, dir, 1e30)) {
             return vec3(0.0);
         }
-        return direct_environment(dir) * fc / (C_ENV * pdf + C_BSDF * bsdf_pdf_dir(f, dir));
+        return direct_environment(dir) * fc / (c.env * pdf + c.bsdf * bsdf_pdf_dir(f, dir));
     }
 #endif
-    float u_lobe = min((u_pick - (C_EMITTER + C_ENV)) / C_BSDF, ONE_MINUS_EPS);
+    float u_lobe = min((u_pick - (c.emitter + c.env)) / c.bsdf, ONE_MINUS_EPS);
     BrdfSample bs = brdf_sample(f.m, f.v, vec3(u2, max(u_lobe, 0.0)));
     vec3 dir = bsdf_world(f, bs.l);
     if (bs.pdf <= 0.0 || dot(dir, s.geometric_normal) <= 0.0) {
@@ -321,13 +341,13 @@ vec3 one_sample_brdf(Surface s, Bsdf f, vec3 origin, float u_pick, vec3 u3, vec2
     rayQueryEXT q;
     scene_trace(q, 0u, origin, dir, 1e30);
     if (rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionTriangleEXT) {
-        vec3 sky = direct_environment(dir) * fc / (C_ENV * env_technique_pdf(dir) + C_BSDF * bs.pdf);
+        vec3 sky = direct_environment(dir) * fc / (c.env * env_technique_pdf(dir) + c.bsdf * bs.pdf);
 #if defined(IC_SKY_IN_RECORDS) && defined(HAS_ENV_CONSTANT)
         // The records carry the constant sky for the diffuse lobe (its share is applied in
         // passes/composite.comp); the specular lobe takes it here, from the BSDF technique
         // alone (no other technique finds the constant).
         vec3 spec_fc = brdf_eval_lobes(f.m, f.v, bs.l).specular * bs.l.z;
-        sky += frame.environment.rgb * spec_fc / (C_BSDF * bs.pdf);
+        sky += frame.environment.rgb * spec_fc / (c.bsdf * bs.pdf);
 #endif
         return sky;
     }
@@ -338,6 +358,11 @@ vec3 one_sample_brdf(Surface s, Bsdf f, vec3 origin, float u_pick, vec3 u3, vec2
     if (all(equal(le, vec3(0.0)))) {
         return vec3(0.0);
     }
+#ifdef HAS_ANALYTIC_EMITTERS
+    if (c.emitter == 0.0) {
+        return vec3(0.0);  // an emitter of a closed-form pixel: emitter_ratio_sums accounts for it
+    }
+#endif
     float pdf_light = 0.0;
 #ifdef MIS_EMITTERS
     GpuMaterial m = materials[h.material];
@@ -345,7 +370,7 @@ vec3 one_sample_brdf(Surface s, Bsdf f, vec3 origin, float u_pick, vec3 u3, vec2
     float cos_l = abs(dot(h.geometric_normal, dir));
     pdf_light = emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t / max(cos_l, 1e-8);
 #endif
-    return le * fc / (C_EMITTER * pdf_light + C_BSDF * bs.pdf);
+    return le * fc / (c.emitter * pdf_light + c.bsdf * bs.pdf);
 }
 
 // The punctual lights reflected by the full BRDF (visibility as in `punctual`).
@@ -458,6 +483,7 @@ struct PixelLight {
     uint seen;  // with adaptive shadows after sub-frame 0: what sub-frame 0 saw (SHADOW_*)
     bool reused;  // no emitter sample: sub-frame 0's answer stands (`Reuse`)
     uint punctual_seen;  // the traced punctual lights' visibility bits (`punctual_visible`)
+    bool closed_form;  // the emitters' light in closed form (false: in the MIS, HAS_SPECULAR)
 };
 
 // A pixel's light before anything is added (also a pixel without a surface).
@@ -470,6 +496,7 @@ PixelLight no_light() {
     light.seen = SHADOW_PENUMBRA;
     light.reused = false;
     light.punctual_seen = 0u;
+    light.closed_form = true;
     return light;
 }
 
@@ -492,13 +519,29 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     vec2 shift_bsdf = rng_next2(rng);
     // Samples of the one-sample MIS loop per sub-frame (sub-frames continue its sequences).
     uint n = samples;
+#ifdef HAS_SPECULAR
+    // Everything here is reflected radiance (the full BRDF), not irradiance.
+    Bsdf f = bsdf_at(s, gbuffer_material(g), normalize(frame.camera_position.xyz - g.position));
+#endif
 #ifdef HAS_ANALYTIC_EMITTERS
+#ifdef HAS_SPECULAR
+    // The closed form is the diffuse lobe's, exact where that lobe is all there is (no metal, no
+    // specular layer: base colour / π); a pixel with a specular lobe samples the emitters in
+    // its MIS as without HAS_ANALYTIC_EMITTERS (docs/cache-frame.md §8.2).
+    bool closed_form = f.m.metallic == 0.0 && f.m.specular_factor == 0.0;
+    light.closed_form = closed_form;
+#else
+    const bool closed_form = true;
+#endif
     // The emitters take their own shadow rays, a quarter of the samples (the ratio estimator
     // with its neighbourhood reaches about the noise of `samples` MIS samples with them:
-    // docs/cache-frame.md §8.2); the one-sample MIS loop keeps the rest for the environment.
+    // docs/cache-frame.md §8.2); the one-sample MIS loop keeps the rest for the environment
+    // (none where nothing else is sampled).
     uint n_emitters = max(1u, (samples + 3u) / 4u);
-#ifdef HAS_SAMPLED_SOURCES
-    n = max(1u, samples - n_emitters);
+#if defined(HAS_SAMPLED_SOURCES) && (!defined(HAS_SPECULAR) || defined(MIS_ENVIRONMENT))
+    n = closed_form ? max(1u, samples - n_emitters) : samples;
+#elif defined(HAS_SAMPLED_SOURCES)
+    n = closed_form ? 0u : samples;
 #endif
     // After sub-frame 0, where no penumbra was seen one ray tells lit from hidden: the ratio is
     // exact there whatever the count, and none where the whole neighbourhood saw the same
@@ -509,16 +552,23 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     }
     uint n_shadow = light.seen == SHADOW_PENUMBRA ? n_emitters : (reuse.emitters ? 0u : 1u);
     light.reused = n_shadow == 0u;
-    light.unshadowed = analytic_emitter_irradiance(origin, s.shading_normal);
+    light.unshadowed = closed_form ? analytic_emitter_irradiance(origin, s.shading_normal) : vec3(0.0);
+#ifdef HAS_SPECULAR
+    // Reflected radiance: the irradiance times the diffuse lobe, base colour / π.
+    light.unshadowed *= f.m.base_colour * INV_PI;
+#endif
     if (any(greaterThan(light.unshadowed, vec3(0.0)))) {
         emitter_ratio_sums(s, origin, pc.sub_frame * n_emitters, n_shadow, shift_light,
                            light.sum_all, light.sum_visible);
     }
 #endif
     vec3 sum = vec3(0.0);
-#ifdef HAS_SPECULAR
-    // Everything here is reflected radiance (the full BRDF), not irradiance.
-    Bsdf f = bsdf_at(s, gbuffer_material(g), normalize(frame.camera_position.xyz - g.position));
+#if defined(HAS_SPECULAR) && defined(HAS_SAMPLED_SOURCES)
+#ifdef HAS_ANALYTIC_EMITTERS
+    Techniques c = techniques(!closed_form);
+#else
+    Techniques c = techniques(true);
+#endif
 #endif
 #ifdef HAS_SAMPLED_SOURCES
     for (uint k = 0u; k < n; ++k) {
@@ -526,7 +576,7 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
         // The technique from the golden-ratio sequence, so each pixel's picks are stratified too.
         float u_pick = min(fract(shift_pick + float(g) * 0.6180339887), ONE_MINUS_EPS);
 #ifdef HAS_SPECULAR
-        vec3 e = one_sample_brdf(s, f, origin, u_pick, kronecker3(g, shift_light),
+        vec3 e = one_sample_brdf(s, f, origin, c, u_pick, kronecker3(g, shift_light),
                                  kronecker2(g, shift_bsdf));
 #else
         vec3 e = one_sample(s, origin, u_pick, kronecker3(g, shift_light), kronecker2(g, shift_bsdf));
@@ -552,10 +602,10 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
             spec += e;
         }
     }
-    light.rest = sum / float(n) + punctual_brdf(s, f, origin, reuse, light.punctual_seen) +
-                 spec / float(max(paths, 1u));
+    light.rest = (n > 0u ? sum / float(n) : vec3(0.0)) +
+                 punctual_brdf(s, f, origin, reuse, light.punctual_seen) + spec / float(max(paths, 1u));
 #else
-    light.rest = sum / float(n) + punctual(s, origin, reuse, light.punctual_seen);
+    light.rest = (n > 0u ? sum / float(n) : vec3(0.0)) + punctual(s, origin, reuse, light.punctual_seen);
 #endif
     return light;
 }
@@ -692,7 +742,9 @@ void main() {
 #endif
     if (pc.adaptive_shadows != 0u && pc.sub_frame == 0u && inside) {
         // Read by later sub-frames only (other dispatches): no race with the neighbours' reads.
-        shadows[2u * pixel_index(pixel) + 1u] = g.surface ? frozen_class | light.punctual_seen : SHADOW_NONE;
+        // A pixel whose emitters are in its MIS (HAS_SPECULAR) has no class: none for reuse.
+        bool classed = g.surface && light.closed_form;
+        shadows[2u * pixel_index(pixel) + 1u] = classed ? frozen_class | light.punctual_seen : SHADOW_NONE;
     }
     if (!inside) {
         return;

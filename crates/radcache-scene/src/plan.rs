@@ -101,14 +101,15 @@ pub struct ScenePlan {
     /// The cache's direct pass computes the emitters' unshadowed light in closed form and
     /// samples only their visibility (the ratio estimator, docs/cache-frame.md §8.2): at most
     /// [`ANALYTIC_EMITTERS_MAX`] emissive triangles, none with an emissive texture or an alpha
-    /// test (the closed form takes the whole triangle), and only Lambertian materials (Lambert's
-    /// formula gives irradiance, not a glossy lobe's integral).
+    /// test (the closed form takes the whole triangle). Lambert's formula gives irradiance, not
+    /// a glossy lobe's integral: in a scene with specular materials only the pixels of
+    /// Lambertian ones take the closed form, the others sample the emitters as before.
     pub analytic_emitters: bool,
     /// The cache's gather paths take the emitters' light at each vertex in closed form, less a
     /// one-sample estimate of its hidden part (`PATH_CLOSED_FORM_EMITTERS`,
-    /// `shaders/common/path.glsl`): with [`Self::analytic_emitters`], where the emitters cover at
-    /// least [`CLOSED_FORM_GATHER_MIN_EMITTER_SHARE`] of the bounding box's surface. False: one
-    /// sampled shadow ray per vertex with MIS.
+    /// `shaders/common/path.glsl`): with [`Self::analytic_emitters`] and no specular material,
+    /// where the emitters cover at least [`CLOSED_FORM_GATHER_MIN_EMITTER_SHARE`] of the bounding
+    /// box's surface. False: one sampled shadow ray per vertex with MIS.
     pub closed_form_gathers: bool,
     /// Some material has a specular lobe (metallic, or a dielectric specular layer): the passes
     /// compile the full metallic-roughness BRDF (`HAS_SPECULAR`). False when every material is
@@ -190,13 +191,13 @@ impl ScenePlan {
             .iter()
             .filter(|m| !m.is_lambertian() && m.roughness >= GLOSSY_ROUGHNESS_MIN)
             .count();
-        let analytic_emitters =
-            count > 0 && count <= ANALYTIC_EMITTERS_MAX && !textured_emission && !specular;
+        let analytic_emitters = count > 0 && count <= ANALYTIC_EMITTERS_MAX && !textured_emission;
         let emitter_area: f32 = emitters.triangles.iter().map(|t| t.area).sum();
         let b = scene.bounds_at(t0);
         let e = (b.max - b.min).max(glam::Vec3::ZERO);
         let box_area = 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
         let closed_form_gathers = analytic_emitters
+            && !specular
             && box_area > 0.0
             && emitter_area >= CLOSED_FORM_GATHER_MIN_EMITTER_SHARE * box_area;
         ScenePlan {

@@ -100,9 +100,10 @@ pub struct PixelPlan {
 /// `n_p ∝ √v_p` (Lagrange), which meets `target` at `n_p = √v_p · Σ_q √v_q / (P · target)`. A
 /// pixel is shaded on while that is above the samples it has. `v_p` is the largest of its 3×3
 /// neighbourhood's: a pixel whose few samples happened to agree beside an edge or a noisy
-/// neighbour keeps going, and the estimate errs toward more samples. The batch ends where the
-/// active pixels' largest want (10 % to spare) says, but at most twice `done` (the estimates
-/// are remade after each batch), at least `done + 1`, at most `max`.
+/// neighbour keeps going, and the estimate errs toward more samples. The batch ends at the
+/// smallest count that brings the image's predicted estimate to `target` with 10 % to spare:
+/// each active pixel's own term falling as `1/n` while it is shaded, the others' staying
+/// (at least `done + 1`, at most `max`; the estimates are remade after each batch).
 pub fn plan_pixels(
     sums: &[[f32; 4]],
     squares: &[[f32; 4]],
@@ -135,22 +136,43 @@ pub fn plan_pixels(
         f64::INFINITY
     };
     let mut mask = vec![0u32; w * h];
-    let (mut active, mut want) = (0usize, 0.0f64);
+    let mut active = 0usize;
     for i in 0..pixels {
-        let wanted = dilated[i].sqrt() * scale;
-        if wanted > f64::from(sums[i][3]) {
+        if dilated[i].sqrt() * scale > f64::from(sums[i][3]) {
             mask[i] = 1;
             active += 1;
-            want = want.max(wanted);
         }
     }
-    let next = if want.is_finite() {
-        (1.1 * want).ceil().min(f64::from(u32::MAX)) as u32
-    } else {
-        max
+    // The image's estimate once the active pixels have `next` samples (monotone in `next`).
+    let predicted = |next: u32| -> f64 {
+        let total: f64 = (0..pixels)
+            .filter(|&i| own[i] > 0.0)
+            .map(|i| {
+                let n = f64::from(sums[i][3]);
+                let n = if mask[i] == 1 {
+                    n.max(f64::from(next))
+                } else {
+                    n
+                };
+                own[i] / n
+            })
+            .sum();
+        total / pixels.max(1) as f64
     };
-    let next = next.min(done.saturating_mul(2)).max(done + 1).min(max);
-    PixelPlan { mask, active, next }
+    let (mut lo, mut hi) = (done.saturating_add(1).min(max), max);
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if predicted(mid) <= target / 1.1 {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    PixelPlan {
+        mask,
+        active,
+        next: lo,
+    }
 }
 
 #[cfg(test)]
@@ -250,17 +272,18 @@ mod tests {
             }
         }
         assert_eq!(plan.active, 9);
-        // v = (2/7)/0.26 ≈ 1.1 over the 9 pixels: each wants √v · 9√v / (64 · 5e-4) ≈ 309
-        // samples, so the batch is capped at twice the sub-frames done.
-        assert_eq!(plan.next, 16);
+        // v = (2/7)/0.26 ≈ 1.099 over the 9 pixels: each wants √v · 9√v / (64 · 5e-4) ≈ 309
+        // samples; the image's estimate, the edge's v/n/64, meets 5e-4/1.1 from n = 38.
+        assert_eq!(plan.next, 38);
+        assert_eq!(plan_pixels(&sums, &squares, w, h, 8, 5e-4, 32).next, 32);
     }
 
     #[test]
-    fn the_wanted_counts_meet_the_target_with_square_root_allocation() {
+    fn the_wanted_counts_follow_square_root_allocation() {
         // Two noisy pixels (v = 4 and v = 1, flat neighbours far away) in a 16×1 frame: with
         // n ∝ √v the counts that meet the target are √v · (Σ√v over every dilated pixel) /
         // (P · target). Pixel 2 (v = 4, dilated over 1…3) and pixel 12 (v = 1, over 11…13):
-        // Σ√v = 3·2 + 3·1 = 9; at target 9/16/10 the wanted counts are 20 and 10.
+        // Σ√v = 3·2 + 3·1 = 9; at target 0.02 the wanted counts are 56.25 and 28.1.
         let frame = |n: usize| -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
             // Mean 0 (m² + 0.01 = 0.01) and sample variance 0.01·v from n samples ±a.
             let noisy = |v: f32| {
@@ -278,19 +301,18 @@ mod tests {
         };
         let on =
             |plan: &PixelPlan| -> Vec<usize> { (0..16).filter(|&i| plan.mask[i] == 1).collect() };
-        let target = 9.0 / 16.0 / 10.0;
+        let target = 0.02;
         let (sums, squares) = frame(8);
         let plan = plan_pixels(&sums, &squares, 16, 1, 8, target, 64);
         assert_eq!(on(&plan), vec![1, 2, 3, 11, 12, 13]);
-        // The largest want is 20 (pixel 2's neighbourhood): 1.1 × 20 = 22, but at most 16.
-        assert_eq!(plan.next, 16);
-        let (sums, squares) = frame(16);
-        let later = plan_pixels(&sums, &squares, 16, 1, 16, target, 64);
-        // At 16 samples pixel 12's neighbourhood (want 10) stops; pixel 2's goes on.
+        // Both shaded on: (4 + 1)/(16 n) ≤ 0.02/1.1 from n = 17.2, so 18.
+        assert_eq!(plan.next, 18);
+        // At 32 samples pixel 12's neighbourhood (want 28.1) stops and pixel 2's goes on; the
+        // estimate is already below the target, so one more sub-frame is the batch.
+        let (sums, squares) = frame(32);
+        let later = plan_pixels(&sums, &squares, 16, 1, 32, target, 64);
         assert_eq!(on(&later), vec![1, 2, 3]);
-        // 1.1 × 20 in floating point: 22 or, rounded up past it, 23.
-        assert!((22..=23).contains(&later.next), "{}", later.next);
-        assert_eq!(plan_pixels(&sums, &squares, 16, 1, 16, target, 20).next, 20);
+        assert_eq!(later.next, 33);
     }
 
     #[test]
