@@ -6,7 +6,9 @@
 //! frame's time (everything `render_ic` does, pipeline creation included), records and rays and
 //! its relMSE; the path tracer's relMSE at 4, 16 and 64 spp and its time per spp; the
 //! path tracer's time to reach the IC's relMSE, from relMSE ∝ 1/spp fitted to the measured points
-//! (an unbiased estimator's MSE falls as 1/N); and their ratio. Errors are each method's own: the
+//! (an unbiased estimator's MSE falls as 1/N) and its time per spp timed at 16 spp just before
+//! each IC frame (this machine's speed drifts by up to 2× over minutes: a time per spp from the
+//! end of the run once doubled the ratios); and their ratio. Errors are each method's own: the
 //! reference's noise (the same fit at the reference's spp) is taken off the IC's measured relMSE,
 //! as the path tracer's fit at low spp barely contains it. At 512² (no reference): the
 //! default preset's time, records and rays. The record pass's ray rate is its rays over the wall
@@ -167,8 +169,32 @@ pub fn run(args: &[&str]) -> Result<()> {
     }
     cases.push((256, Preset::Default, UniformStrata));
     cases.push((256, Preset::Default, AaUniformStrata));
-    let mut matched = Vec::new(); // (case, relMSE, time) of the frames with a reference
+    // (case, relMSE, time, the path tracer's time per spp timed just before) of the frames with
+    // a reference.
+    let mut matched = Vec::new();
+    let pt_settings = |spp: u32| PathSettings {
+        width: reference.width(),
+        height: reference.height(),
+        budget: Budget::Samples(spp),
+        seed: 777,
+        ..PathSettings::default()
+    };
     for (size, preset, variant) in cases {
+        // This machine's speed drifts by up to 2× over minutes: the path tracer's time per spp
+        // is timed next to each frame with a reference, and the comparison uses that.
+        let pt_local_s = if size == reference.width() {
+            let out = render_path(
+                ctx,
+                shaders,
+                &scene,
+                &mut gpu,
+                &pt_settings(16),
+                &mut |_| {},
+            )?;
+            out.time_s / 16.0
+        } else {
+            0.0
+        };
         let mut settings = IcSettings {
             width: size,
             height: size,
@@ -279,7 +305,7 @@ pub fn run(args: &[&str]) -> Result<()> {
             );
             figures.push(Figure::new(&case, "ic_relmse", m.relmse, "relMSE"));
             figures.push(Figure::new(&case, "ic_block_rmse", m.block_rmse, "rmse"));
-            matched.push((case, m.relmse, out.time_s));
+            matched.push((case, m.relmse, out.time_s, pt_local_s));
         }
     }
 
@@ -287,14 +313,14 @@ pub fn run(args: &[&str]) -> Result<()> {
     let mut fit = Vec::new();
     let mut per_spp_s = Vec::new();
     for spp in [4u32, 16, 64] {
-        let settings = PathSettings {
-            width: reference.width(),
-            height: reference.height(),
-            budget: Budget::Samples(spp),
-            seed: 777,
-            ..PathSettings::default()
-        };
-        let out = render_path(ctx, shaders, &scene, &mut gpu, &settings, &mut |_| {})?;
+        let out = render_path(
+            ctx,
+            shaders,
+            &scene,
+            &mut gpu,
+            &pt_settings(spp),
+            &mut |_| {},
+        )?;
         let image = Image::from_pixels(out.width, out.height, out.pixels)?;
         let m = compare(&reference, &image)?;
         println!(
@@ -332,18 +358,20 @@ pub fn run(args: &[&str]) -> Result<()> {
         e_ref,
         "relMSE",
     ));
-    for (case, relmse, time) in matched {
+    for (case, relmse, time, t_local) in matched {
         let own = relmse - e_ref;
         if own <= 0.0 {
             println!("{case}: relMSE {relmse:.2e} is within the reference's own noise");
             continue;
         }
         let spp_needed = c / own;
-        let pt_time = spp_needed * t1;
+        let pt_time = spp_needed * t_local;
         println!(
-            "{case}: own relMSE {own:.2e} ({relmse:.2e} against the reference); PT needs ~{spp_needed:.0} spp = {pt_time:.1} s; IC took {time:.1} s: {:.1}× faster",
+            "{case}: own relMSE {own:.2e} ({relmse:.2e} against the reference); PT needs ~{spp_needed:.0} spp = {pt_time:.1} s at {t_local:.3} s per spp timed beside it ({:.1} s at the fit's {t1:.3}); IC took {time:.1} s: {:.1}× faster",
+            spp_needed * t1,
             pt_time / time
         );
+        figures.push(Figure::new(&case, "pt_s_per_spp_beside", t_local, "s"));
         figures.push(Figure::new(&case, "ic_own_relmse", own, "relMSE"));
         figures.push(Figure::new(&case, "pt_spp_to_match", spp_needed, "spp"));
         figures.push(Figure::new(&case, "pt_time_to_match_s", pt_time, "s"));
