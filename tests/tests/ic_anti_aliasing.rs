@@ -117,3 +117,63 @@ fn the_estimate_bounds_the_sampling_error_and_the_frame_goes_on_to_its_target() 
     drop(gpu);
     finish(ctx);
 }
+
+/// Per pixel with the ray-traced G-buffer (`metal_spheres`: enough triangles for the plan to
+/// trace it; its stopped pixels skip their camera ray) and specular lobes, whose path-traced
+/// light is what keeps some pixels going: the mean count stays below the sub-frames shaded,
+/// the estimate meets the target, and the image is within the target of 64 sub-frames.
+#[test]
+fn per_pixel_anti_aliasing_with_a_traced_g_buffer_meets_its_target() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let path = root.join("assets/metal_spheres/metal_spheres.gltf");
+    let scene = Scene::load(&path, &LoadOptions::default()).unwrap().0;
+    assert!(scene.plan().traced_gbuffer, "{:?}", scene.plan());
+    let ctx = context();
+    let shaders = shaders();
+    let mut gpu = GpuScene::new(&ctx, &scene, None).unwrap();
+    let mut render = |target: f64, per_pixel: bool| -> (FrameOutput, IcStats) {
+        let settings = IcSettings {
+            width: 48,
+            height: 48,
+            params: IcParams::draft(),
+            sub_frames: 8,
+            direct_samples: 4,
+            anti_aliasing: Some(AntiAliasing {
+                target,
+                max_sub_frames: 64,
+                per_pixel,
+            }),
+            ..IcSettings::default()
+        };
+        render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {}).unwrap()
+    };
+    let (_, stats8) = render(1.0, true);
+    let est8 = stats8.aa_relmse_estimate.unwrap();
+    let (out64, stats64) = render(1e-12, false);
+    assert_eq!(stats64.sub_frames_shaded, 64);
+    let target = est8 / 3.0;
+    let (out, stats) = render(target, true);
+    let (n, est, mean) = (
+        stats.sub_frames_shaded,
+        stats.aa_relmse_estimate.unwrap(),
+        stats.mean_pixel_sub_frames,
+    );
+    let m = compare(&image(&out64), &image(&out)).unwrap();
+    eprintln!(
+        "estimate at 8: {est8:.3e}; target {target:.3e}: {n} sub-frames, {mean:.1} per pixel, \
+         estimate {est:.3e}, relMSE against 64: {:.3e}",
+        m.relmse
+    );
+    assert!(
+        n > 8 && est <= target,
+        "{n} sub-frames, {est} against {target}"
+    );
+    assert!(
+        mean > 8.0 && mean < 0.8 * f64::from(n),
+        "{mean} per pixel of {n}"
+    );
+    assert!(m.relmse <= target, "relMSE {} against {target}", m.relmse);
+    assert!(out.pixels.iter().flatten().all(|c| c.is_finite()));
+    drop(gpu);
+    finish(ctx);
+}
