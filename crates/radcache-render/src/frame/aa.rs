@@ -22,23 +22,13 @@ pub fn sampling_relmse(sums: &[[f32; 4]], squares: &[[f32; 4]]) -> f64 {
     if sums.is_empty() {
         return 0.0;
     }
-    let mut total = 0.0f64;
-    for (s, q) in sums.iter().zip(squares) {
-        let n = f64::from(s[3]);
-        if n < 2.0 {
-            continue;
-        }
-        for c in 0..3 {
-            let (sum, sq) = (f64::from(s[c]), f64::from(q[c]));
-            let mean = sum / n;
-            let variance = ((sq - sum * mean) / (n - 1.0)).max(0.0);
-            let term = variance / n / (mean * mean + REL_EPS);
-            if term.is_finite() {
-                total += term;
-            }
-        }
-    }
-    total / (3.0 * sums.len() as f64)
+    let total: f64 = sums
+        .iter()
+        .zip(squares)
+        .filter(|(s, _)| s[3] >= 2.0)
+        .map(|(s, q)| relative_variance(s, q) / f64::from(s[3]))
+        .sum();
+    total / sums.len() as f64
 }
 
 /// The sub-frames to shade next, from `done` with the estimate `estimate` against `target`:

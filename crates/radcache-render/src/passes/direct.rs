@@ -44,10 +44,14 @@ radcache_shared::gpu_struct! {
 }
 
 /// Paths per pixel and sub-frame that trace the specular lobe's indirect light (scenes with
-/// specular materials): a quarter of the direct samples, at least one. A path costs a few rays
-/// (a gather path's length), a direct sample one.
+/// specular materials): as many as the direct samples, at least one. A path costs a few rays
+/// (a gather path's length), a direct sample one, but the paths carry the noise: on
+/// `metal_spheres` (256², default preset) a quarter of the direct samples gave relMSE 1.083e-3
+/// in 10.2–10.7 s, as many 8.17e-4 in 10.0–10.4 s (the frame meets its anti-aliasing target at 8
+/// sub-frames instead of 17), twice as many 6.38e-4 in 8.4–12.5 s; on `glossy_room` (128²)
+/// 6.70e-4 and 6.39e-4 in the same 4.3–4.4 s (docs/materials.md §10).
 pub fn specular_paths(direct_samples: u32) -> u32 {
-    (direct_samples / 4).max(1)
+    direct_samples.max(1)
 }
 
 /// The direct-lighting pipeline and its ray counter.
