@@ -26,8 +26,9 @@ impl IcRenderer {
         run: &mut FrameRun<'_>,
     ) -> Result<()> {
         let result = self.anti_alias_batches(ctx, gpu, settings, aa, run);
-        self.gbuffer.set_active(None)?;
-        result
+        // The batches' own error, if any, is the one to report.
+        let reset = self.gbuffer.set_active(None);
+        result.and(reset)
     }
 
     fn anti_alias_batches(
