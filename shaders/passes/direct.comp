@@ -30,30 +30,84 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant) uniform Push { DirectPush pc; };
 
 layout(binding = B_DIRECT_RAY_COUNT, std430) buffer RayCount { uint ray_count; };
-// With pc.adaptive_shadows, two words a pixel (docs/cache-frame.md §8.2): 2i, what its
+// With pc.adaptive_shadows, three words a pixel (docs/cache-frame.md §8.2): 3i, what its
 // neighbourhood saw of the emitters in this frame's sub-frames so far (written at sub-frame 0,
-// raised to a penumbra by later ones); 2i + 1, what sub-frame 0 saw, frozen for the later
+// raised to a penumbra by later ones); 3i + 1, what sub-frame 0 saw, frozen for the later
 // sub-frames to compare with the neighbours': the emitters' word (bits 0–1, SHADOW_NONE where
 // the pixel was no surface) and the visibility of punctual lights 0 … REUSED_LIGHTS − 1 (bit
-// 2 + i set where light i's shadow ray was unoccluded).
+// 2 + i set where light i's shadow ray was unoccluded); 3i + 2, the distance from the camera
+// of sub-frame 0's sample (its float bits), which tells a later sample on another surface.
 layout(binding = B_DIRECT_SHADOWS, std430) buffer Shadows { uint shadows[]; };
+const uint SHADOW_WORDS = 3u;
 // What a pixel's neighbourhood saw of the emitters (the values of the first word).
 const uint SHADOW_HIDDEN = 0u;
 const uint SHADOW_LIT = 1u;
 const uint SHADOW_PENUMBRA = 2u;
 const uint SHADOW_NONE = 3u;
-const uint REUSED_LIGHTS = 30u;
+const uint REUSED_LIGHTS = 29u;
+// The punctual lights' bits of the frozen word, and its bit 31: sub-frame 0's samples of the
+// pixel's 3×3 neighbourhood did not all lie on the pixel's surface (no reuse at the pixel).
+const uint PUNCTUAL_BITS = ((1u << REUSED_LIGHTS) - 1u) << 2;
+const uint SHADOW_EDGE = 1u << 31;
 
 // After sub-frame 0 (pc.adaptive_shadows): which of sub-frame 0's answers this pixel's sample
-// may take without a ray. Every one of its 3×3 neighbours (inside the image) must have been a
-// surface and have seen the same: the same visibility of every reused punctual light
-// (`punctual`), and the emitters wholly visible or wholly hidden alike (`emitters`). A shadow
-// boundary at or next to the pixel therefore keeps its rays; what is reused is a pixel deep
-// inside light or shadow, whose jittered samples, within half a pixel of its centre, see what
-// nine centres around them saw (a shadow finer than the pixel grid can be missed).
-// The linear index of `pixel` (its word pair in `shadows`, its sample sequences' seed).
+// may take without a ray. Sub-frame 0's samples of the pixel and of its 3×3 neighbours (inside
+// the image) must all have lain on one surface (else SHADOW_EDGE), this sample must lie on it
+// too (`same_surface_as_first`), and every neighbour must have seen the same as the pixel: the
+// same visibility of every reused punctual light (`punctual`), and the emitters wholly visible
+// or wholly hidden alike (`emitters`). A shadow boundary at or next to the pixel therefore
+// keeps its rays, and so does a pixel that an object's edge crosses or passes next to (a rim
+// or a leaf one pixel wide, whose neighbours on other surfaces say nothing of its light, or a
+// grazing plane, whose neighbours lie farther apart than three footprints) and a sample that
+// the jitter moved onto another object; what is reused is a pixel deep inside light or shadow
+// on one surface, whose jittered samples, within half a pixel of its centre, see what nine
+// samples around them saw (a shadow finer than the pixel grid can be missed).
+// The linear index of `pixel` (its word triple in `shadows`, its sample sequences' seed).
 uint pixel_index(ivec2 pixel) {
     return uint(pixel.y) * frame.resolution.x + uint(pixel.x);
+}
+
+// Whether the point `position` with normal `normal` lies on the surface of sample `g` (a
+// neighbour's sample: normals within 25°, within one footprint of g's tangent plane and three
+// footprints of g).
+bool on_surface_of(GSample g, vec3 position, vec3 normal) {
+    vec3 d = position - g.position;
+    float reach = 3.0 * g.footprint;
+    return dot(normal, g.normal) >= 0.9 && abs(dot(d, g.normal)) <= g.footprint &&
+           dot(d, d) <= reach * reach;
+}
+
+// Sub-frame 0: whether the samples of the pixel's 3×3 neighbours inside the image are surfaces
+// on the surface of its own sample `g` (read from the G-buffer, not the workgroup's copy).
+bool neighbourhood_on_one_surface(GSample g, ivec2 pixel) {
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            ivec2 q = pixel + ivec2(dx, dy);
+            if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) ||
+                any(greaterThanEqual(q, ivec2(frame.resolution.xy)))) {
+                continue;
+            }
+            vec4 p = imageLoad(g_position, q);
+            if (!(p.w > 0.5) || !on_surface_of(g, p.xyz, imageLoad(g_normal, q).xyz)) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+// Whether sample `g` lies on the surface of the pixel's sub-frame-0 sample, `first_distance`
+// from the camera: two points of one plane within a pixel differ in distance by at most about
+// the pixel's footprint times the tangent of the view angle (a grazing plane's distance
+// changes fast across the pixel), so the test allows 1.5 of that, cosine floored at 0.1, plus
+// 0.1 % of the distance for the G-buffer's precision.
+bool same_surface_as_first(GSample g, float first_distance) {
+    vec3 to_camera = frame.camera_position.xyz - g.position;
+    float d = length(to_camera);
+    float cos_v = d > 0.0 ? abs(dot(g.normal, to_camera)) / d : 1.0;
+    float sin_v = sqrt(max(1.0 - cos_v * cos_v, 0.0));
+    float tol = 1.5 * g.footprint * sin_v / max(cos_v, 0.1) + 1.0e-3 * d;
+    return abs(d - first_distance) <= tol;
 }
 
 struct Reuse {
@@ -62,7 +116,7 @@ struct Reuse {
     bool emitters;
 };
 
-Reuse shadow_reuse(ivec2 pixel) {
+Reuse shadow_reuse(GSample g, ivec2 pixel) {
     Reuse r;
     r.frozen = SHADOW_NONE;
     r.punctual = false;
@@ -70,9 +124,11 @@ Reuse shadow_reuse(ivec2 pixel) {
     if (pc.adaptive_shadows == 0u || pc.sub_frame == 0u) {
         return r;
     }
-    uint own = shadows[2u * pixel_index(pixel) + 1u];
+    uint index = pixel_index(pixel);
+    uint own = shadows[SHADOW_WORDS * index + 1u];
     r.frozen = own;
-    if ((own & 3u) == SHADOW_NONE) {
+    float first_distance = uintBitsToFloat(shadows[SHADOW_WORDS * index + 2u]);
+    if ((own & 3u) == SHADOW_NONE || (own & SHADOW_EDGE) != 0u || !same_surface_as_first(g, first_distance)) {
         return r;
     }
     r.punctual = true;
@@ -83,9 +139,9 @@ Reuse shadow_reuse(ivec2 pixel) {
             if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(frame.resolution.xy)))) {
                 continue;
             }
-            uint n = shadows[2u * pixel_index(q) + 1u];
+            uint n = shadows[SHADOW_WORDS * pixel_index(q) + 1u];
             bool surface = (n & 3u) != SHADOW_NONE;
-            r.punctual = r.punctual && surface && (n >> 2) == (own >> 2);
+            r.punctual = r.punctual && surface && ((n ^ own) & PUNCTUAL_BITS) == 0u;
             r.emitters = r.emitters && surface && (n & 3u) == (own & 3u);
         }
     }
@@ -160,7 +216,7 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     vec3 origin = offset_ray_origin(s.position, s.geometric_normal);
     uint index = pixel_index(pixel);
     PixelLight light = no_light();
-    Reuse reuse = shadow_reuse(pixel);
+    Reuse reuse = shadow_reuse(g, pixel);
     uint samples = max(pc.samples, 1u);
     Rng rng = rng_init(index, 0xffffffffu, pc.seed);
     float shift_pick = rng_next(rng);
@@ -197,7 +253,7 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     // (`shadow_reuse`; docs/cache-frame.md §8.2). Sub-frame k's samples start at
     // k × n_emitters of the sequence either way.
     if (pc.adaptive_shadows != 0u && pc.sub_frame > 0u) {
-        light.seen = shadows[2u * index];
+        light.seen = shadows[SHADOW_WORDS * index];
     }
     uint n_shadow = light.seen == SHADOW_PENUMBRA ? n_emitters : (reuse.emitters ? 0u : 1u);
     light.reused = n_shadow == 0u;
@@ -267,13 +323,9 @@ shared vec4 s_position[64];  // w: 1 for a surface pixel
 shared vec3 s_normal[64];
 shared uint s_partial[64];  // 1 where the pixel is marked a penumbra (before dilation)
 
-// Whether workgroup pixel `j` lies on the same surface as `g`: normals within 25°, within one
-// pixel footprint of its tangent plane and three of its position.
+// Whether workgroup pixel `j` lies on the same surface as `g` (`on_surface_of`).
 bool same_surface(GSample g, uint j) {
-    vec3 d = s_position[j].xyz - g.position;
-    float reach = 3.0 * g.footprint;
-    return s_position[j].w != 0.0 && dot(s_normal[j], g.normal) >= 0.9 &&
-           abs(dot(d, g.normal)) <= g.footprint && dot(d, d) <= reach * reach;
+    return s_position[j].w != 0.0 && on_surface_of(g, s_position[j].xyz, s_normal[j]);
 }
 
 // The workgroup index of the neighbour at `offset` from this invocation, or 64 outside it.
@@ -382,9 +434,9 @@ void main() {
         if (inside) {
             uint index = pixel_index(pixel);
             if (pc.sub_frame == 0u) {
-                shadows[2u * index] = frozen_class;
+                shadows[SHADOW_WORDS * index] = frozen_class;
             } else if (mark) {
-                shadows[2u * index] = SHADOW_PENUMBRA;
+                shadows[SHADOW_WORDS * index] = SHADOW_PENUMBRA;
             }
         }
     }
@@ -393,7 +445,10 @@ void main() {
         // Read by later sub-frames only (other dispatches): no race with the neighbours' reads.
         // A pixel whose emitters are in its MIS (HAS_SPECULAR) has no class: none for reuse.
         bool classed = g.surface && light.closed_form;
-        shadows[2u * pixel_index(pixel) + 1u] = classed ? frozen_class | light.punctual_seen : SHADOW_NONE;
+        uint index = pixel_index(pixel);
+        uint edge = classed && !neighbourhood_on_one_surface(g, pixel) ? SHADOW_EDGE : 0u;
+        shadows[SHADOW_WORDS * index + 1u] = classed ? frozen_class | light.punctual_seen | edge : SHADOW_NONE;
+        shadows[SHADOW_WORDS * index + 2u] = floatBitsToUint(length(frame.camera_position.xyz - g.position));
     }
     if (!inside) {
         return;

@@ -3,7 +3,7 @@
 //! other pixels whose neighbourhood saw the emitters wholly visible or wholly hidden, a quarter
 //! of the samples in penumbrae; its estimate stays the fixed pass's in expectation and exact
 //! where there is no shadow; a point light's shadow is reused away from its boundary and traced
-//! along it.
+//! along it, and along an object thinner than a pixel that the first sub-frame missed.
 
 use glam::{DVec3, Quat, Vec3};
 use radcache_render::{DirectPass, EmitterLight, SkyLight};
@@ -219,4 +219,133 @@ fn adaptive_shadows_reuse_a_point_lights_visibility_away_from_its_boundary() {
     }
     drop((fixed, adaptive));
     gpu.end();
+}
+
+/// A wall facing away from a point light (hidden everywhere; the plane z = 0, y up to 1) and, in
+/// front of it, a bar lying at y = 0 over `z` (its top faces the light over the wall's top edge
+/// from z = 0.25 on, the wall shadows it nearer), seen from above at an angle.
+fn bar_scene(name: &str, z: [f32; 2]) -> Scene {
+    let mut b = GltfBuilder::new();
+    let mat = b.add_material(&MaterialDesc::diffuse("grey", [0.6, 0.6, 0.6]));
+    // plane_y rotated +90° about x: the plane z = 0 facing +z, y in [-2, 1].
+    let wall = b.add_mesh("wall", &[plane_y([-3.0, 3.0], [-1.0, 2.0], 0.0, mat)]);
+    let bar = b.add_mesh("bar", &[plane_y([-3.0, 3.0], z, 0.0, mat)]);
+    let light = b.add_light(&LightDesc {
+        name: None,
+        kind: LightKind::Point,
+        color: [1.0; 3],
+        intensity: 5.0,
+        range: None,
+    });
+    let q = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let roots = vec![
+        b.add_node(&NodeDesc {
+            mesh: Some(wall),
+            rotation: Some([q.x, q.y, q.z, q.w]),
+            ..NodeDesc::default()
+        }),
+        b.add_node(&NodeDesc {
+            mesh: Some(bar),
+            ..NodeDesc::default()
+        }),
+        camera_node(
+            &mut b,
+            Vec3::new(0.0, 1.0, 3.0),
+            Quat::from_rotation_x(-0.38),
+            0.7,
+        ),
+        b.add_node(&NodeDesc {
+            translation: Some([0.0, 3.0, -0.5]),
+            light: Some(light),
+            ..NodeDesc::default()
+        }),
+    ];
+    b.add_scene(name, &roots, None);
+    write_and_load(&b, &temp_dir(name), name)
+}
+
+/// Sub-frame 0 at a G-buffer jitter where no sample of `scene` (a `bar_scene`) is lit, then ten
+/// jitters: each later sub-frame's image must be the fixed pass's at every pixel (a punctual
+/// light has no randomness), some of the bar lit, while the wall away from it still reuses its
+/// answer (fewer rays than a quarter of the surface pixels).
+fn reuse_is_exact_after_a_dark_first_sub_frame(scene: &Scene) {
+    let (w, h) = (48, 36);
+    let gpu = Gpu::new(scene, None, (w, h));
+    let pass = |pixels| {
+        DirectPass::new(
+            &gpu.ctx,
+            &gpu.shaders,
+            &gpu.scene,
+            SkyLight::Direct,
+            EmitterLight::Analytic,
+        )
+        .unwrap()
+        .with_adaptive_shadows(&gpu.ctx, pixels)
+        .unwrap()
+    };
+    let (fixed, adaptive) = (pass(None), pass(Some(w * h)));
+    let (samples, seed) = (4, 9);
+    let jitters: Vec<[f32; 2]> = (0..10).map(|i| [0.0, -0.45 + 0.1 * i as f32]).collect();
+    let lit = |image: &[Px]| image.iter().filter(|d| d[0] > 0.0).count();
+    let first = jitters
+        .iter()
+        .copied()
+        .find(|&j| {
+            gpu.render(j, None);
+            lit(&gpu.direct(&fixed, samples, 0, seed).0) == 0
+        })
+        .expect("a sub-frame-0 jitter whose samples are all in shadow");
+    gpu.render(first, None);
+    let surfaces = gpu
+        .read_gbuffer()
+        .position
+        .iter()
+        .filter(|p| p[3] > 0.0)
+        .count() as u64;
+    assert!(surfaces > u64::from(w * h) / 2, "{surfaces} surface pixels");
+    gpu.direct(&adaptive, samples, 0, seed);
+    let mut bar_lit = 0;
+    for (k, &jitter) in jitters.iter().enumerate() {
+        gpu.render(jitter, None);
+        let k = k as u32 + 1;
+        let (expected, _) = gpu.direct(&fixed, samples, k, seed);
+        let (got, rays) = gpu.direct(&adaptive, samples, k, seed);
+        bar_lit += lit(&expected);
+        assert!(
+            rays * 4 < surfaces,
+            "jitter {jitter:?}: {rays} rays for {surfaces} surface pixels"
+        );
+        for (i, (a, e)) in got.iter().zip(&expected).enumerate() {
+            close(
+                "bar pixel",
+                i,
+                xyz(*a),
+                xyz(*e),
+                1e-6 * xyz(*e).max_element() + 1e-9,
+            );
+        }
+    }
+    assert!(
+        bar_lit >= w as usize,
+        "{bar_lit} lit bar samples over the jitters"
+    );
+    drop((fixed, adaptive));
+    gpu.end();
+}
+
+/// A lit bar a quarter of a pixel high that sub-frame 0's samples all missed: every pixel and
+/// neighbour saw the wall, hidden; a later sample on the bar lies on another surface than its
+/// pixel's first one (`same_surface_as_first`, docs/cache-frame.md §8.2) and casts its ray.
+#[test]
+fn adaptive_shadows_trace_a_sample_on_an_object_the_first_sub_frame_missed() {
+    reuse_is_exact_after_a_dark_first_sub_frame(&bar_scene("ic-passes-thin-bar", [0.48, 0.52]));
+}
+
+/// A bar about a pixel high whose far half the wall shadows: sub-frame 0's samples on the bar
+/// all fell in the shadow, like the wall around them, and a later sample on the lit half lies
+/// on the same plane; the bar's neighbours above and below lie on the wall, so its pixels are
+/// edges (SHADOW_EDGE) and reuse nothing.
+#[test]
+fn adaptive_shadows_reuse_nothing_where_the_neighbours_lie_on_other_surfaces() {
+    reuse_is_exact_after_a_dark_first_sub_frame(&bar_scene("ic-passes-bar-edge", [0.15, 0.35]));
 }

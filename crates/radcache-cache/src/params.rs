@@ -6,7 +6,7 @@
 //! | `weight_kind` | T&L | T&L | T&L | see [`crate::weight`] for why T&L is the default |
 //! | `error_control` | split sphere | split sphere | split sphere | §4.1; the Hessian rule (§10) is a measured alternative |
 //! | `accuracy` (Ward `a`) | 0.3 | 0.15 | 0.1 | §8.1; RADIANCE `rvu` 0.3, `rtrace` 0.1 |
-//! | `kappa` (T&L `κ`) | 0.75 | 0.5 | 1.5 | Mitsuba's κ = 1 with `qualityAdjustment` 0.5 after the overture; default measured (below, §8.2); larger κ = smaller zones |
+//! | `kappa` (T&L `κ`) | 0.75 | 0.75 | 1.5 | Mitsuba's κ = 1 with `qualityAdjustment` 0.5 after the overture; default measured (below, §8.2); larger κ = smaller zones |
 //! | `min_spacing_px` | 3 | 4 | 1.5 | validity radius floor in pixels; Mitsuba 3; 4 measured (below, §8.2) |
 //! | `max_spacing_px` | 32 | 20 | 15 | validity radius cap in pixels (§8.1); pbrt-v2 15 |
 //! | `strata_m × strata_n` | 8×24 | 16×48 | 24×72 | §2.2: interactive 192 rays, offline 768; high ≈ 1.7k (`N = 3M`) |
@@ -42,13 +42,23 @@
 //! the finest creation levels otherwise put one per pixel or two. `high` keeps 1.5 px for scenes
 //! with fine geometric detail.
 //!
-//! The default κ of 0.5 (§8.2; Mitsuba renders with κ = 1 × its `qualityAdjustment` 0.5 after the
-//! overture, which our coarse-to-fine creation at κ/0.7 plays the part of) was measured on the same
-//! frame: κ = 1 gave relMSE 2.14e-4 (own 1.07e-4, net of the reference's noise) in 7.3 s with 4,390
-//! records, κ = 0.75 2.16e-4 in 6.4 s, κ = 0.5 2.31e-4 in 4.8–4.9 s with 2,243 records: error ×
-//! time 7.8e-4, 6.9e-4 and 6.0e-4. Zones stay capped at R⁺ = 20 px, so the larger κ only widens
-//! zones where the irradiance is smooth. `draft` keeps 0.75: at 0.5 its frame is 15 % faster and
-//! 13 % worse (the same error × time), and its R⁺ of 32 px already makes its zones the widest.
+//! The default κ of 0.75 (§8.2; Mitsuba renders with κ = 1 × its `qualityAdjustment` 0.5 after
+//! the overture, which our coarse-to-fine creation at κ/0.7 plays the part of) was measured on
+//! 2026-12-05 against Mitsuba's 8192-spp references (`radcache render --accuracy 1/κ`, 256²,
+//! each timed on its second run): on the courtyard κ = 0.5 left the undersides of ledges and
+//! cornices 4 % too dark on average and up to 20 % in bands (zones as wide as the gradient
+//! limit `E/|∇E|` allows, over an irradiance that halves across them: the ground's sunlit and
+//! shaded patches seen from below); κ = 0.75 gave relMSE 8.13e-4 against 1.07e-3, block RMSE
+//! 2.39e-3 against 3.41e-3, FLIP 0.0278 against 0.0325, with 7,150 records against 5,284 (7.27
+//! M record rays against 5.83 M) and 10–25 % more time; κ = 1 relMSE 8.36e-4 and block RMSE
+//! 2.32e-3 with 8,505 records (8.17 M rays). Halving the gradient limit instead (R ≤
+//! E/(2|∇E|), κ = 0.5) mended the undersides with 10 % more records but gained less (9.20e-4,
+//! block 2.83e-3), and the Hessian rule at κ = 0.75 gave 8.40e-4 and 2.55e-3.
+//! On the Cornell box κ = 0.75 costs 8 % more time for 2 % less relMSE and 8 % less block RMSE
+//! (2.72 s against 2.54 s; 2.48e-4 against 2.53e-4; 1.26e-3 against 1.37e-3). The earlier
+//! default of 0.5 was chosen on the Cornell box alone (κ = 1 gave relMSE 2.14e-4 in 7.3 s, 0.75
+//! 2.16e-4 in 6.4 s, 0.5 2.31e-4 in 4.8 s, a frame three times slower than today's). `draft` keeps
+//! 0.75 too, its R⁺ of 32 px making its zones the widest.
 
 //!
 //! The default's fine strata (§2.8) were measured at 256² against the references (`radcache
@@ -138,7 +148,7 @@ impl IcParams {
             weight_kind: WeightKind::default(),
             error_control: ErrorControl::default(),
             accuracy: 0.15,
-            kappa: 0.5,
+            kappa: 0.75,
             min_spacing_px: 4.0,
             max_spacing_px: 20.0,
             strata_m: 16,

@@ -15,7 +15,7 @@ fn presets_are_valid_and_ordered() {
     assert_eq!(IcParams::preset(Preset::Default), n);
     assert_eq!(
         (n.strata_m, n.strata_n, n.accuracy, n.kappa),
-        (16, 48, 0.15, 0.5),
+        (16, 48, 0.15, 0.75),
         "§8.1 values; κ measured (§8.2)"
     );
     assert_eq!(
@@ -91,8 +91,8 @@ fn fine_strata_follow_the_level_spacing() {
 #[test]
 fn derived_quantities() {
     let p = IcParams::default();
-    assert_eq!(p.weight_param(), 0.5);
-    assert_eq!(p.validity_scale(), 1.0);
+    assert_eq!(p.weight_param(), 0.75);
+    assert!((p.validity_scale() - 0.5 / 0.75).abs() < 1e-6, "σ = 1/(2κ)");
     assert_eq!(p.coverage_threshold(), 0.5);
     assert_eq!(
         (

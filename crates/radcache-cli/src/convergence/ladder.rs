@@ -406,8 +406,8 @@ mod tests {
                 "draft",
                 "default",
                 "high",
-                "kappa=0.25",
-                "kappa=1",
+                "kappa=0.375",
+                "kappa=1.5",
                 "strata 4x12",
                 "strata 8x24"
             ]

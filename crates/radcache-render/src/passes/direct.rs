@@ -148,11 +148,13 @@ impl DirectPass {
 
     /// Makes a pass whose emitters' light is in closed form, or whose scene has punctual
     /// lights, spend its shadow rays where they are needed ([`crate::EmitterShadows::Adaptive`]),
-    /// for images of `pixels` pixels (8 bytes each): sub-frame 0 casts every pixel's rays (a
+    /// for images of `pixels` pixels (12 bytes each): sub-frame 0 casts every pixel's rays (a
     /// quarter of the samples toward the emitters, one per punctual light) and stores what its
     /// 3×3 neighbourhood saw of the emitters (lit, hidden, or a penumbra, dilated by the
-    /// neighbourhood) and what it saw of each punctual light; later sub-frames cast no ray
-    /// where every 3×3 neighbour saw the same as the pixel, one toward the emitters at other
+    /// neighbourhood), what it saw of each punctual light, whether its neighbours' samples lay on
+    /// its surface, and its sample's distance; later sub-frames cast no ray where every 3×3
+    /// neighbour, on the pixel's surface, saw the same as the pixel and the sample lies on the
+    /// surface of the pixel's first, one toward the emitters at other
     /// lit and hidden pixels, and mark the penumbrae their rays find (docs/cache-frame.md
     /// §8.2). Other passes are returned as they are, and so is every pass for `pixels` `None`
     /// (every ray always).
@@ -166,7 +168,7 @@ impl DirectPass {
                 ctx,
                 &BufferDesc {
                     name: "direct.shadows",
-                    size: u64::from(pixels.max(1)) * 8,
+                    size: u64::from(pixels.max(1)) * 12,
                     usage: vk::BufferUsageFlags::STORAGE_BUFFER,
                     location: MemoryLocation::GpuOnly,
                     alignment: 0,
