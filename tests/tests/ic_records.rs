@@ -230,7 +230,7 @@ fn furnace_records_match_the_analytic_irradiance() {
 
 #[test]
 fn invalid_irradiance_background_and_overflow_are_guarded() {
-    // Le = 1e36: every sample is finite (≈ 1e36) but their sum over 16×48 strata overflows.
+    // Le = 1e36: every sample is finite (≈ 1e36) but their sum over the 12×36 strata overflows.
     let mut f = fixture(&furnace_scene(1e36));
     let params = IcParams::default();
     let pass = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &params, SkyLight::Records).unwrap();
@@ -287,10 +287,10 @@ fn cornell_records_agree_with_an_independent_estimate() {
     let a = run(&mut f, &pass_a, &points, &requests, c, 11, 1, 0);
     let again = run(&mut f, &pass_a, &points, &requests, c, 11, 1, 0);
     let b = run(&mut f, &pass_b, &points, &requests, c, 12, 4, 2);
-    // The default's coarse levels gather 16×48 strata, its fine ones (spacing ≤ R⁻) 8×24.
+    // The default's coarse levels gather 12×36 strata, its fine ones (spacing ≤ R⁻) 8×24.
     let coarse = run(&mut f, &pass_b, &points, &requests, c, 13, 2, 2);
     assert_eq!(fine.fine_level(), 3);
-    assert_eq!(fine.strata_at(2, false), (16, 48));
+    assert_eq!(fine.strata_at(2, false), (12, 36));
     assert_eq!(fine.strata_at(4, false), (8, 24));
     assert_eq!(a.records, again.records, "not deterministic");
     // The test hook's stride is the larger strata's count.

@@ -205,7 +205,7 @@ fn pack_metallic_roughness(metallic: f32, roughness: f32) -> f32 {
 /// Records made for glossy lobes keep the preset's full strata at the fine levels, where other
 /// records take the fine strata (`IcParams::strata_at`; docs/irradiance-cache.md §2.8): on
 /// `glossy_room`, one surface point requested at the default preset's first fine level gathers
-/// 16×48 samples and is flagged glossy where its G-buffer says metal of roughness 0.8, and 8×24
+/// 12×36 samples and is flagged glossy where its G-buffer says metal of roughness 0.8, and 8×24
 /// unflagged where it says roughness 0.3 (below the records' threshold, so its lobe's light is
 /// path traced per pixel).
 #[test]
@@ -216,7 +216,7 @@ fn records_for_glossy_lobes_keep_the_full_strata_at_fine_levels() {
     let params = IcParams::default();
     let level = params.fine_level();
     assert!(level < params.levels, "the default preset has fine levels");
-    assert_eq!(params.strata_at(level, true), (16, 48));
+    assert_eq!(params.strata_at(level, true), (12, 36));
     assert_eq!(params.strata_at(level, false), (8, 24));
     let metal = scene
         .materials
@@ -262,7 +262,7 @@ fn records_for_glossy_lobes_keep_the_full_strata_at_fine_levels() {
             .count()
     };
     let glossy = |i: usize| out.records[i].info[3] & RECORD_FLAG_GLOSSY != 0;
-    assert_eq!((traced(0), glossy(0)), (16 * 48, true), "roughness 0.8");
+    assert_eq!((traced(0), glossy(0)), (12 * 36, true), "roughness 0.8");
     assert_eq!((traced(1), glossy(1)), (8 * 24, false), "roughness 0.3");
     drop((pass, radiance));
     end(f);

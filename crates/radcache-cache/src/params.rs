@@ -9,7 +9,7 @@
 //! | `kappa` (T&L `κ`) | 0.75 | 0.75 | 1.5 | Mitsuba's κ = 1 with `qualityAdjustment` 0.5 after the overture; default measured (below, §8.2); larger κ = smaller zones |
 //! | `min_spacing_px` | 3 | 4 | 1.5 | validity radius floor in pixels; Mitsuba 3; 4 measured (below, §8.2) |
 //! | `max_spacing_px` | 32 | 20 | 15 | validity radius cap in pixels (§8.1); pbrt-v2 15 |
-//! | `strata_m × strata_n` | 8×24 | 16×48 | 24×72 | §2.2: interactive 192 rays, offline 768; high ≈ 1.7k (`N = 3M`) |
+//! | `strata_m × strata_n` | 8×24 | 12×36 | 24×72 | §2.2: interactive 192 rays, offline 768; default 432 measured (below); high ≈ 1.7k (`N = 3M`) |
 //! | `fine_strata_m × fine_strata_n` | 8×24 | 8×24 | 24×72 | §2.8: irradiance records requested at a level no wider than `R⁻`; default measured (below) |
 //! | `hole_threshold` | 0.25 | 0.5 | 0.75 | Σw, in units of [`weight_unit`], below which a pixel is a hole (pbrt-v2 minWeight 0.5) |
 //! | `levels` | 5 | 6 | 6 | coarse-to-fine spacings `2^(levels−1) … 1` px (docs/cache-frame.md §3.3: 32, 16, 8, 4, 2, 1) |
@@ -33,7 +33,7 @@
 //!
 //! Draft trades accuracy for speed (4× fewer rays, bigger zones, fewer refreshes); high halves the
 //! ray noise (2.25× rays), shrinks zones and refreshes more often. On lavapipe (≈0.3 Mrays/s for
-//! incoherent gather rays, measured) the default's 768 rays per record is the dominant cost, so
+//! incoherent gather rays, measured) the default's 432 rays per record is the dominant cost, so
 //! `draft` is the preset for tests and previews.
 //!
 //! The default R⁻ of 4 px (§8.2) was measured on the Cornell box at 256² against its 2048-spp
@@ -60,6 +60,16 @@
 //! 2.16e-4 in 6.4 s, 0.5 2.31e-4 in 4.8 s, a frame three times slower than today's). `draft` keeps
 //! 0.75 too, its R⁺ of 32 px making its zones the widest.
 
+//!
+//! The default's 12×36 strata (432 rays; the course's offline 16×48 until 2026-12-05) were
+//! measured at equal wall time against Mitsuba 3 (`cargo xtask bench peer`, one run each, the
+//! ratios within each run): the relMSE ratio Mitsuba/radcache went from 11.1 to 14.4 on the
+//! Cornell box, 3.33 to 3.69 on the courtyard and 2.92 to 3.25 on `metal_spheres`; the 8×8-block
+//! RMSE ratio radcache/Mitsuba from 0.95 to 0.93 on the courtyard and 1.14 to 1.08 on
+//! `metal_spheres` (0.31 to 0.35 on the Cornell box); FLIP from 0.996 to 0.98 on the courtyard.
+//! On the Cornell box alone (`radcache render --seed 1|2`, 256²) 12×36 cut the record rays by
+//! 34 % and the frame by about 25 % for relMSE +6 % and block RMSE +9 %. Each record is noisier,
+//! but the frame is cheaper by more than its error grows (docs/cache-frame.md §7.1).
 //!
 //! The default's fine strata (§2.8) were measured at 256² against the references (`radcache
 //! render --seed S`, the Cornell box's seeds 1–3; the courtyard with the CLI's adaptive
@@ -151,8 +161,8 @@ impl IcParams {
             kappa: 0.75,
             min_spacing_px: 4.0,
             max_spacing_px: 20.0,
-            strata_m: 16,
-            strata_n: 48,
+            strata_m: 12,
+            strata_n: 36,
             fine_strata_m: 8,
             fine_strata_n: 24,
             hole_threshold: 0.5,

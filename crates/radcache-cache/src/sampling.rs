@@ -18,7 +18,8 @@ use glam::Vec3;
 
 /// Default strata for interactive quality, `M × N = 8 × 24` (§2.2).
 pub const STRATA_INTERACTIVE: (u32, u32) = (8, 24);
-/// Default strata for offline quality, `M × N = 16 × 48` (§2.2, §8.1).
+/// The course's strata for offline quality, `M × N = 16 × 48` (§2.2, §8.1; the default preset
+/// takes 12 × 36, measured: params.rs).
 pub const STRATA_DEFAULT: (u32, u32) = (16, 48);
 
 /// Index of stratum `(j, k)` in the `M × N` sample arrays: `j * N + k` (wrapping, like GLSL `uint`).

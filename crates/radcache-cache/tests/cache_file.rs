@@ -372,8 +372,10 @@ fn fine_strata_round_trip_and_older_files_read_as_uniform() {
     let file = CacheFile::load(&write("fine.rcache", &b), &id, 4).unwrap();
     assert_eq!(file.header.identity.params, id.params);
     let text = file.header.describe();
+    let (m, n) = (id.params.strata_m, id.params.strata_n);
+    let (fm, fn_) = (id.params.fine_strata_m, id.params.fine_strata_n);
     assert!(
-        text.contains("strata_m: 16") && text.contains("fine_strata_m: 8"),
+        text.contains(&format!("strata_m: {m}")) && text.contains(&format!("fine_strata_m: {fm}")),
         "{text}"
     );
     // The same header as version 2 with the high halves cleared, as version 2 wrote it.
@@ -382,15 +384,15 @@ fn fine_strata_round_trip_and_older_files_read_as_uniform() {
     clear_fine_strata(&mut v2);
     reseal_header(&mut v2);
     let uniform = IcParams {
-        fine_strata_m: 16,
-        fine_strata_n: 48,
+        fine_strata_m: m,
+        fine_strata_n: n,
         ..id.params
     };
     let (r, text) = refusal(&write("v2-fine.rcache", &v2), &id);
     assert!(matches!(r, Refusal::OtherParams(_)), "{text}");
     assert!(
-        text.contains("fine_strata_m 16 (this render: 8)")
-            && text.contains("fine_strata_n 48 (this render: 24)"),
+        text.contains(&format!("fine_strata_m {m} (this render: {fm})"))
+            && text.contains(&format!("fine_strata_n {n} (this render: {fn_})")),
         "{text}"
     );
     let old = CacheIdentity {

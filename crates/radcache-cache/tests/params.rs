@@ -15,7 +15,7 @@ fn presets_are_valid_and_ordered() {
     assert_eq!(IcParams::preset(Preset::Default), n);
     assert_eq!(
         (n.strata_m, n.strata_n, n.accuracy, n.kappa),
-        (16, 48, 0.15, 0.75),
+        (12, 36, 0.15, 0.75),
         "§8.1 values; κ measured (§8.2)"
     );
     assert_eq!(
@@ -56,11 +56,11 @@ fn fine_strata_follow_the_level_spacing() {
     assert_eq!(n.fine_level(), 3);
     for level in 0..6 {
         let fine = level >= 3;
-        let expected = if fine { (8, 24) } else { (16, 48) };
+        let expected = if fine { (8, 24) } else { (12, 36) };
         assert_eq!(n.strata_at(level, false), expected, "level {level}");
         assert_eq!(
             n.strata_at(level, true),
-            (16, 48),
+            (12, 36),
             "radiance, level {level}"
         );
     }
@@ -71,7 +71,7 @@ fn fine_strata_follow_the_level_spacing() {
         ..n
     };
     assert_eq!(sparse.fine_level(), 6);
-    assert_eq!(sparse.strata_at(5, false), (16, 48));
+    assert_eq!(sparse.strata_at(5, false), (12, 36));
     let wide = IcParams {
         min_spacing_px: 40.0,
         ..n

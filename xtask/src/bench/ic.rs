@@ -18,7 +18,8 @@
 //! scene's triangles, rays from random surface points, measured in the same run). Beside the
 //! defaults, the frame at 256² with the direct light of before the closed-form emitters and the
 //! sky through the records (`--emitters sampled --sky direct`; case suffix `_sampled_light`), and
-//! with adaptive anti-aliasing (suffix `_aa`; `_aa_12x36` with 12×36 strata), and splatting at
+//! with adaptive anti-aliasing (suffix `_aa`; `_aa_16x48` with the course's 16×48 strata, the
+//! default's before 2026-12-05), and splatting at
 //! every sub-frame instead of once per frame (suffixes `_splat_per_sub_frame` and
 //! `_aa_splat_per_sub_frame`), and, where the emitters are taken in closed form, with a quarter
 //! of the direct samples as shadow rays at every pixel instead of adaptive emitter shadows
@@ -73,8 +74,8 @@ enum Variant {
     SampledLight,
     /// Adaptive anti-aliasing with the preset's target.
     Aa,
-    /// Adaptive anti-aliasing and 12×36 strata.
-    AaStrata12x36,
+    /// Adaptive anti-aliasing and the course's 16×48 strata (the default's before 2026-12-05).
+    AaStrata16x48,
     /// A splat at every sub-frame (`--splat per-sub-frame`).
     SplatPerSubFrame,
     /// Adaptive anti-aliasing and a splat at every sub-frame.
@@ -94,7 +95,7 @@ impl Variant {
             Variant::Plain => "",
             Variant::SampledLight => "_sampled_light",
             Variant::Aa => "_aa",
-            Variant::AaStrata12x36 => "_aa_12x36",
+            Variant::AaStrata16x48 => "_aa_16x48",
             Variant::SplatPerSubFrame => "_splat_per_sub_frame",
             Variant::AaSplatPerSubFrame => "_aa_splat_per_sub_frame",
             Variant::FixedShadows => "_fixed_shadows",
@@ -152,7 +153,7 @@ pub fn run(args: &[&str]) -> Result<()> {
 
     // (size, preset, variant): every preset at the reference's size with 8 sub-frames, the
     // default at 512², the default at 256² with the direct light sampled as before, and with
-    // the CLI's adaptive anti-aliasing (AntiAliasing::preset; also with 12×36 strata).
+    // the CLI's adaptive anti-aliasing (AntiAliasing::preset; also with 16×48 strata).
     use Variant::*;
     let mut cases: Vec<(u32, Preset, Variant)> =
         bs.presets.iter().map(|&p| (256, p, Plain)).collect();
@@ -161,7 +162,7 @@ pub fn run(args: &[&str]) -> Result<()> {
     }
     cases.push((256, Preset::Default, SampledLight));
     cases.push((256, Preset::Default, Aa));
-    cases.push((256, Preset::Default, AaStrata12x36));
+    cases.push((256, Preset::Default, AaStrata16x48));
     cases.push((256, Preset::Default, SplatPerSubFrame));
     cases.push((256, Preset::Default, AaSplatPerSubFrame));
     if scene.plan().analytic_emitters {
@@ -208,9 +209,9 @@ pub fn run(args: &[&str]) -> Result<()> {
                 settings.sky = SkyLight::Direct;
             }
             Aa => settings.anti_aliasing = Some(AntiAliasing::preset(preset)),
-            AaStrata12x36 => {
+            AaStrata16x48 => {
                 settings.anti_aliasing = Some(AntiAliasing::preset(preset));
-                settings.params = settings.params.with_strata(12, 36);
+                settings.params = settings.params.with_strata(16, 48);
             }
             SplatPerSubFrame => settings.splat = SplatMode::PerSubFrame,
             AaSplatPerSubFrame => {

@@ -13,7 +13,7 @@ use radcache_render::{
 pub enum Quality {
     /// Fast previews (a = 0.3, 8×24 strata).
     Draft,
-    /// The default (a = 0.15, 16×48 strata, 8×24 where records are at least as dense as R⁻).
+    /// The default (a = 0.15, 12×36 strata, 8×24 where records are at least as dense as R⁻).
     Default,
     /// Offline quality (a = 0.1, 24×72 strata).
     High,

@@ -147,7 +147,7 @@ pub fn preset_name(preset: Preset) -> &'static str {
 /// The cache's points: the three presets; the accuracy of `weight` (Ward's `a`, or T&L's `κ`
 /// through `a = 1/κ`) at the default preset's value × 2, 1.5, 0.75 and 0.5 (`quick`: × 2 and
 /// 0.5); the strata 4×12, 8×24 and 24×72 (`quick`: 4×12 and 8×24) at the default preset
-/// otherwise. The default preset (16×48) is the centre of both sweeps. With `glossy` (the scene
+/// otherwise. The default preset (12×36) is the centre of both sweeps. With `glossy` (the scene
 /// has radiance records) the three presets again with per-pixel glossy paths
 /// ([`Ladder::GlossyPaths`]).
 pub fn ic_cases(weight: WeightKind, quick: bool, glossy: bool) -> Vec<IcCase> {
