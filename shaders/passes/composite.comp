@@ -55,6 +55,10 @@ layout(binding = B_COMPOSITE_GLOSSY_SUM, rgba32f) readonly uniform image2D gloss
 // acos(CENTRE_MATCH_COS) of the sample's (docs/cache-frame.md §6.5).
 const float CENTRE_MATCH_PLANE = 1.0;
 const float CENTRE_MATCH_COS = 0.9;
+// How far (in pixels) a sample none of whose four nearest centres matches looks for one that
+// does, and the cost added to a centre that does not match.
+const int FAR_MATCH = 3;
+const float NO_MATCH_COST = 1.0e3;
 
 float centre_cost(GSample g, vec3 c, vec3 n, out bool matches) {
     vec3 d = g.position - c;
@@ -113,8 +117,10 @@ bool centre_of(GSample g, ivec2 q, out float cost) {
 // The cached light of the sample g of `pixel` at `jitter` (pixels from its centre) from the
 // splat made at the centres: interpolated bilinearly at the sample's position between the four
 // nearest centres that match it and hold light (joint bilateral upsampling); where none does,
-// that of the closest centre of the 3×3 neighbourhood (`matched` false), or none where no
-// centre there is a surface.
+// that of the matching centre of least cost within FAR_MATCH pixels (a leaf seen through a gap
+// in the foliage has its nearest centres on other leaves, its own a few pixels away); where
+// none matches there either, that of the closest centre of the 3×3 neighbourhood (`matched`
+// false), or none where no centre there is a surface.
 CachedLight cached_light_from_centres(GSample g, ivec2 pixel, vec2 jitter, out bool matched) {
     vec2 pos = vec2(pixel) + jitter;
     ivec2 base = ivec2(floor(pos));
@@ -146,15 +152,23 @@ CachedLight cached_light_from_centres(GSample g, ivec2 pixel, vec2 jitter, out b
     }
     ivec2 best = ivec2(-1);
     float best_cost = 1.0e30;
-    for (int k = 0; k < 9; ++k) {
-        ivec2 q = pixel + ivec2(k % 3 - 1, k / 3 - 1);
+    const int side = 2 * FAR_MATCH + 1;
+    for (int k = 0; k < side * side; ++k) {
+        ivec2 o = ivec2(k % side - FAR_MATCH, k / side - FAR_MATCH);
         float cost;
-        centre_of(g, q, cost);
+        // A match that holds light, of any cost, beats every other centre; those count only
+        // within the 3×3 neighbourhood.
+        bool ok = centre_of(g, pixel + o, cost) && imageLoad(splat_sum, pixel + o).a > 0.0;
+        if (!ok && max(abs(o.x), abs(o.y)) > 1) {
+            continue;
+        }
+        cost += ok ? 0.0 : NO_MATCH_COST;
         if (cost < best_cost) {
             best_cost = cost;
-            best = q;
+            best = pixel + o;
         }
     }
+    matched = best_cost < NO_MATCH_COST;
     return best.x >= 0 ? cached_light_at(best) : sum;
 }
 
