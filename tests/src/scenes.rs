@@ -7,7 +7,8 @@ use glam::{Quat, Vec3};
 use radcache_render::{
     render_ic, render_path, Budget, FrameOutput, GpuScene, IcSettings, PathSettings,
 };
-use radcache_scene::writer::{BufferLayout, GltfBuilder, NodeDesc, PrimitiveDesc};
+use radcache_scene::light::LightKind;
+use radcache_scene::writer::{BufferLayout, GltfBuilder, LightDesc, NodeDesc, PrimitiveDesc};
 use radcache_scene::{LoadOptions, Scene};
 use radcache_vk::{Context, ShaderCompiler};
 
@@ -109,6 +110,23 @@ pub fn camera_node(b: &mut GltfBuilder, position: Vec3, rotation: Quat, yfov: f3
         translation: Some(position.to_array()),
         rotation: Some(rotation.normalize().to_array()),
         camera: Some(cam),
+        ..NodeDesc::default()
+    })
+}
+
+/// Adds a white point light of `intensity` (candela) and its node at `position`; returns the
+/// node index.
+pub fn point_light_node(b: &mut GltfBuilder, position: [f32; 3], intensity: f32) -> usize {
+    let light = b.add_light(&LightDesc {
+        name: None,
+        kind: LightKind::Point,
+        color: [1.0; 3],
+        intensity,
+        range: None,
+    });
+    b.add_node(&NodeDesc {
+        translation: Some(position),
+        light: Some(light),
         ..NodeDesc::default()
     })
 }

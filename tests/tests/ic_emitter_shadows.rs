@@ -7,12 +7,13 @@
 
 use glam::{DVec3, Quat, Vec3};
 use radcache_render::{DirectPass, EmitterLight, SkyLight};
-use radcache_scene::light::LightKind;
-use radcache_scene::writer::{GltfBuilder, LightDesc, MaterialDesc, NodeDesc};
+use radcache_scene::writer::{GltfBuilder, MaterialDesc, NodeDesc};
 use radcache_scene::Scene;
 use radcache_tests::direct_cpu::{agree, cpu_direct};
 use radcache_tests::ic_fixture::*;
-use radcache_tests::scenes::{camera_node, load, plane_y, temp_dir, write_and_load};
+use radcache_tests::scenes::{
+    camera_node, load, plane_y, point_light_node, temp_dir, write_and_load,
+};
 
 /// The mean of sub-frames `images` per pixel.
 fn mean_image(images: &[Vec<Px>]) -> Vec<DVec3> {
@@ -130,13 +131,6 @@ fn slab_scene() -> Scene {
     let floor = plane_y([-4.0, 4.0], [-3.0, 3.0], 0.0, mat);
     let slab = plane_y([-0.4, 0.4], [-0.4, 0.4], 0.6, mat);
     let mesh = b.add_mesh("floor+slab", &[floor, slab]);
-    let light = b.add_light(&LightDesc {
-        name: None,
-        kind: LightKind::Point,
-        color: [1.0; 3],
-        intensity: 5.0,
-        range: None,
-    });
     let roots = vec![
         b.add_node(&NodeDesc {
             mesh: Some(mesh),
@@ -148,11 +142,7 @@ fn slab_scene() -> Scene {
             Quat::from_rotation_x(-0.6),
             0.7,
         ),
-        b.add_node(&NodeDesc {
-            translation: Some([0.3, 1.8, 0.2]),
-            light: Some(light),
-            ..NodeDesc::default()
-        }),
+        point_light_node(&mut b, [0.3, 1.8, 0.2], 5.0),
     ];
     b.add_scene(name, &roots, None);
     write_and_load(&b, &temp_dir(name), name)
@@ -168,19 +158,7 @@ fn adaptive_shadows_reuse_a_point_lights_visibility_away_from_its_boundary() {
     let scene = slab_scene();
     let (w, h) = (48, 36);
     let gpu = Gpu::new(&scene, None, (w, h));
-    let pass = |pixels| {
-        DirectPass::new(
-            &gpu.ctx,
-            &gpu.shaders,
-            &gpu.scene,
-            SkyLight::Direct,
-            EmitterLight::Analytic,
-        )
-        .unwrap()
-        .with_adaptive_shadows(&gpu.ctx, pixels)
-        .unwrap()
-    };
-    let (fixed, adaptive) = (pass(None), pass(Some(w * h)));
+    let (fixed, adaptive) = (analytic_pass(&gpu, None), analytic_pass(&gpu, Some(w * h)));
     let (samples, seed) = (4, 9);
     gpu.render([0.0; 2], None);
     let g = gpu.read_gbuffer();
@@ -230,13 +208,6 @@ fn bar_scene(name: &str, z: [f32; 2]) -> Scene {
     // plane_y rotated +90° about x: the plane z = 0 facing +z, y in [-2, 1].
     let wall = b.add_mesh("wall", &[plane_y([-3.0, 3.0], [-1.0, 2.0], 0.0, mat)]);
     let bar = b.add_mesh("bar", &[plane_y([-3.0, 3.0], z, 0.0, mat)]);
-    let light = b.add_light(&LightDesc {
-        name: None,
-        kind: LightKind::Point,
-        color: [1.0; 3],
-        intensity: 5.0,
-        range: None,
-    });
     let q = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
     let roots = vec![
         b.add_node(&NodeDesc {
@@ -254,11 +225,7 @@ fn bar_scene(name: &str, z: [f32; 2]) -> Scene {
             Quat::from_rotation_x(-0.38),
             0.7,
         ),
-        b.add_node(&NodeDesc {
-            translation: Some([0.0, 3.0, -0.5]),
-            light: Some(light),
-            ..NodeDesc::default()
-        }),
+        point_light_node(&mut b, [0.0, 3.0, -0.5], 5.0),
     ];
     b.add_scene(name, &roots, None);
     write_and_load(&b, &temp_dir(name), name)
@@ -271,19 +238,7 @@ fn bar_scene(name: &str, z: [f32; 2]) -> Scene {
 fn reuse_is_exact_after_a_dark_first_sub_frame(scene: &Scene) {
     let (w, h) = (48, 36);
     let gpu = Gpu::new(scene, None, (w, h));
-    let pass = |pixels| {
-        DirectPass::new(
-            &gpu.ctx,
-            &gpu.shaders,
-            &gpu.scene,
-            SkyLight::Direct,
-            EmitterLight::Analytic,
-        )
-        .unwrap()
-        .with_adaptive_shadows(&gpu.ctx, pixels)
-        .unwrap()
-    };
-    let (fixed, adaptive) = (pass(None), pass(Some(w * h)));
+    let (fixed, adaptive) = (analytic_pass(&gpu, None), analytic_pass(&gpu, Some(w * h)));
     let (samples, seed) = (4, 9);
     let jitters: Vec<[f32; 2]> = (0..10).map(|i| [0.0, -0.45 + 0.1 * i as f32]).collect();
     let lit = |image: &[Px]| image.iter().filter(|d| d[0] > 0.0).count();

@@ -7,11 +7,12 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use radcache_cache::IcParams;
-use radcache_image::{compare, read_exr, Image};
-use radcache_render::{render_ic, GpuScene, IcSettings, SplatMode};
+use radcache_image::{compare, read_exr, Image, Metrics};
+use radcache_render::{render_ic, GpuScene, IcSettings, IcStats, SplatMode};
 use radcache_scene::writer::NodeDesc;
 use radcache_scene::{EnvOverride, LoadOptions, Scene};
 use radcache_tests::{context, finish, shaders};
+use radcache_vk::{Context, ShaderCompiler};
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("radcache-icframe-{}-{name}", std::process::id()));
@@ -91,6 +92,28 @@ fn cornell_matches_the_reference() {
     finish(ctx);
 }
 
+/// `scene` rendered with the cache at `settings` and compared with `reference` (printed with the
+/// splat mode and the frame's counts; no non-finite pixel).
+fn render_compared(
+    ctx: &Context,
+    shaders: &ShaderCompiler,
+    scene: &Scene,
+    gpu: &mut GpuScene,
+    settings: &IcSettings,
+    reference: &Image,
+) -> (Metrics, IcStats) {
+    let (out, stats) = render_ic(ctx, shaders, scene, gpu, settings, &mut |_| {}).unwrap();
+    let image = Image::from_pixels(out.width, out.height, out.pixels).unwrap();
+    let m = compare(reference, &image).unwrap();
+    let splat = settings.splat;
+    eprintln!(
+        "{splat:?}: {m}\nrecords {}, holes left {}, unmatched samples {}",
+        stats.records, stats.holes_left, stats.unmatched_samples
+    );
+    assert_eq!(m.nonfinite_candidate, 0, "{splat:?}");
+    (m, stats)
+}
+
 /// Splatting once per frame at the pixel centres (the default) against a splat at every
 /// sub-frame's own samples: the centres' cache covers every centre, few samples lack a matching
 /// centre, and the image is as close to the reference (measured: relMSE 2.42e-4 against
@@ -111,15 +134,7 @@ fn splatting_once_matches_splatting_every_sub_frame() {
             splat,
             ..IcSettings::default()
         };
-        let (out, stats) =
-            render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {}).unwrap();
-        let image = Image::from_pixels(out.width, out.height, out.pixels).unwrap();
-        let m = compare(&reference, &image).unwrap();
-        eprintln!(
-            "{splat:?}: {m}\nrecords {}, holes left {}, unmatched samples {}",
-            stats.records, stats.holes_left, stats.unmatched_samples
-        );
-        assert_eq!(m.nonfinite_candidate, 0, "{splat:?}");
+        let (m, stats) = render_compared(&ctx, &shaders, &scene, &mut gpu, &settings, &reference);
         assert_eq!(stats.holes_left, 0, "{splat:?}");
         (m, stats)
     };
@@ -155,9 +170,8 @@ fn splatting_once_matches_splatting_every_sub_frame() {
 /// 64², with gaps of about half a pixel, lit by a point light in front: foliage in miniature.
 fn fence_scene() -> Scene {
     use glam::{Quat, Vec3};
-    use radcache_scene::light::LightKind;
-    use radcache_scene::writer::{GltfBuilder, LightDesc, MaterialDesc, PrimitiveDesc};
-    use radcache_tests::scenes::{camera_node, plane_y, write_and_load};
+    use radcache_scene::writer::{GltfBuilder, MaterialDesc, PrimitiveDesc};
+    use radcache_tests::scenes::{camera_node, plane_y, point_light_node, write_and_load};
     let name = "fence";
     let mut b = GltfBuilder::new();
     let white = b.add_material(&MaterialDesc::diffuse("white", [0.7, 0.7, 0.7]));
@@ -191,13 +205,6 @@ fn fence_scene() -> Scene {
         prims.push(quad([a, c, c + 2.0 * lean, a + 2.0 * lean], Vec3::Z, red));
     }
     let mesh = b.add_mesh("fence", &prims);
-    let light = b.add_light(&LightDesc {
-        name: None,
-        kind: LightKind::Point,
-        color: [1.0; 3],
-        intensity: 20.0,
-        range: None,
-    });
     let roots = vec![
         b.add_node(&NodeDesc {
             mesh: Some(mesh),
@@ -209,11 +216,7 @@ fn fence_scene() -> Scene {
             Quat::from_rotation_x(-0.05),
             0.6,
         ),
-        b.add_node(&NodeDesc {
-            translation: Some([0.5, 2.5, 3.0]),
-            light: Some(light),
-            ..NodeDesc::default()
-        }),
+        point_light_node(&mut b, [0.5, 2.5, 3.0], 20.0),
     ];
     b.add_scene(name, &roots, None);
     write_and_load(&b, &temp_dir(name), name)
@@ -243,16 +246,7 @@ fn splatting_once_finds_the_wall_behind_a_fence() {
             splat,
             ..IcSettings::default()
         };
-        let (out, stats) =
-            render_ic(&ctx, &shaders, &scene, &mut gpu, &settings, &mut |_| {}).unwrap();
-        let image = Image::from_pixels(w, h, out.pixels).unwrap();
-        let m = compare(&reference, &image).unwrap();
-        eprintln!(
-            "{splat:?}: {m}\nrecords {}, unmatched samples {}",
-            stats.records, stats.unmatched_samples
-        );
-        assert_eq!(m.nonfinite_candidate, 0, "{splat:?}");
-        (m, stats)
+        render_compared(&ctx, &shaders, &scene, &mut gpu, &settings, &reference)
     };
     let (once, once_stats) = render(SplatMode::Once);
     let (every, _) = render(SplatMode::PerSubFrame);

@@ -31,10 +31,10 @@
 //! of its record rays and 48 % of all its rays; 8 frames 18 % and 1.54e-3; 20 frames about 2.6e-3
 //! (docs/temporal.md §5).
 //!
-//! Draft trades accuracy for speed (4× fewer rays, bigger zones, fewer refreshes); high halves the
-//! ray noise (2.25× rays), shrinks zones and refreshes more often. On lavapipe (≈0.3 Mrays/s for
-//! incoherent gather rays, measured) the default's 432 rays per record is the dominant cost, so
-//! `draft` is the preset for tests and previews.
+//! Draft trades accuracy for speed (2.25× fewer rays at the coarse levels, bigger zones, fewer
+//! refreshes); high halves the ray noise (4× rays), shrinks zones and refreshes more often. On
+//! lavapipe (≈0.3 Mrays/s for incoherent gather rays, measured) the default's 432 rays per record
+//! is the dominant cost, so `draft` is the preset for tests and previews.
 //!
 //! The default R⁻ of 4 px (§8.2) was measured on the Cornell box at 256² against its 2048-spp
 //! reference (`tests/refs/`): 2, 3 and 4 px gave the same relMSE (2.49e-4, 2.51e-4, 2.54e-4) with
