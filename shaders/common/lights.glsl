@@ -99,6 +99,15 @@ float emitter_area_pdf(float mean_luminance, bool two_sided) {
     return total > 0.0 ? mean_luminance * PI * (two_sided ? 2.0 : 1.0) / total : 0.0;
 }
 
+// The solid-angle pdf with which emitter sampling picks the point `t` along `dir` of an
+// emissive triangle of `material` with geometric normal `n` (the area pdf × t² / |cos|): what a
+// BSDF-sampled ray that hits an emitter weighs against in MIS.
+float emitter_hit_pdf(uint material, vec3 n, vec3 dir, float t) {
+    GpuMaterial m = materials[material];
+    float cos_l = abs(dot(n, dir));
+    return emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t / max(cos_l, 1e-8);
+}
+
 // The texture coordinates at barycentrics b (of corners 1 and 2) of emitter e: TEXCOORD_0, and
 // TEXCOORD_1 with HAS_TEXCOORD1; the material's references map them as at a ray hit.
 TexCoords emitter_texcoords(GpuEmitter e, vec2 b) {

@@ -293,10 +293,7 @@ void path_step(inout PathState st, inout Rng rng) {
         }
 #elif defined(HAS_EMITTERS)
         if (st.bsdf_pdf > 0.0) {
-            GpuMaterial m = materials[s.material];
-            float cos_l = abs(dot(s.geometric_normal, st.ray.dir));
-            float pdf_light =
-                emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t / max(cos_l, 1e-8);
+            float pdf_light = emitter_hit_pdf(s.material, s.geometric_normal, st.ray.dir, t);
             w = power_heuristic(st.bsdf_pdf, pdf_light);
         }
 #endif

@@ -146,10 +146,8 @@ vec3 one_sample(Surface s, vec3 origin, float u_pick, vec3 u3, vec2 u2) {
     }
     float pdf_light = 0.0;
 #ifdef MIS_EMITTERS
-    GpuMaterial m = materials[h.material];
     float t = rayQueryGetIntersectionTEXT(q, true);
-    float cos_l = abs(dot(h.geometric_normal, dir));
-    pdf_light = emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t / max(cos_l, 1e-8);
+    pdf_light = emitter_hit_pdf(h.material, h.geometric_normal, dir, t);
 #endif
     return le * cos_s / (C_EMITTER * pdf_light + C_BSDF * pdf_bsdf);
 #endif
@@ -253,10 +251,8 @@ vec3 one_sample_brdf(Surface s, Bsdf f, vec3 origin, Techniques c, float u_pick,
 #endif
     float pdf_light = 0.0;
 #ifdef MIS_EMITTERS
-    GpuMaterial m = materials[h.material];
     float t = rayQueryGetIntersectionTEXT(q, true);
-    float cos_l = abs(dot(h.geometric_normal, dir));
-    pdf_light = emitter_area_pdf(m.params.z, m.emission.w != 0.0) * t * t / max(cos_l, 1e-8);
+    pdf_light = emitter_hit_pdf(h.material, h.geometric_normal, dir, t);
 #endif
     return le * fc / (c.emitter * pdf_light + c.bsdf * bs.pdf);
 }
