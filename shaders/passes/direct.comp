@@ -465,5 +465,9 @@ void main() {
 #else
     imageStore(g_direct, pixel, vec4(g.albedo * INV_PI * e, 0.0));
 #endif
-    atomicAdd(ray_count, rays_traced);
+    // Most pixels of a later sub-frame trace no ray (adaptive shadows): they leave the shared
+    // counter alone.
+    if (rays_traced != 0u) {
+        atomicAdd(ray_count, rays_traced);
+    }
 }

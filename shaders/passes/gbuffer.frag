@@ -1,7 +1,8 @@
 // passes/gbuffer.frag — Rust: crates/radcache-render/src/passes/gbuffer.rs
 // G-buffer rasterization, fragment stage: the five attachments of shaders/common/gbuffer.glsl.
-// The geometric normal comes from the triangle's world-space corners (mirroring instances flip
-// it, as glTF's winding rule says); the normal map (HAS_NORMAL_MAPS) bends the shading normal as
+// The geometric normal and the material are the triangle's, from the vertex stage (flat
+// varyings: its world-space corners, flipped by mirroring instances as glTF's winding rule says);
+// the normal map (HAS_NORMAL_MAPS) bends the shading normal as
 // surface_at does; both normals are turned toward the camera, and the front
 // face (for the emission rule) is the side the camera sees. The pixel footprint is the pinhole
 // `pixel_footprint` of ircache_math.glsl (its cosine clamp keeps grazing surfaces bounded, where
@@ -26,6 +27,8 @@ layout(location = 3) flat in uint v_triangle;
 layout(location = 4) in vec3 v_tangent;
 layout(location = 5) flat in float v_tangent_w;
 #endif
+layout(location = 6) flat in vec3 v_geometric;
+layout(location = 7) flat in uint v_material;
 
 layout(location = 0) out vec4 o_position;
 layout(location = 1) out vec4 o_normal;
@@ -49,25 +52,13 @@ uint gbuffer_alpha_seed() {
 #endif
 
 void main() {
-    GpuInstance inst = instances[pc.instance];
-    uint material = tri_materials[inst.mesh.w + v_triangle];
+    uint material = v_material;
 #ifdef HAS_ALPHA
     if (!alpha_keep(material, v_uv, pc.instance, v_triangle, gbuffer_alpha_seed())) {
         discard;
     }
 #endif
-    uint first = inst.mesh.z + 3u * v_triangle;
-    vec3 p0 = vertices[indices[first] + inst.mesh.y].position_u.xyz;
-    vec3 p1 = vertices[indices[first + 1u] + inst.mesh.y].position_u.xyz;
-    vec3 p2 = vertices[indices[first + 2u] + inst.mesh.y].position_u.xyz;
-    vec3 e1 = (inst.world_from_object * vec4(p1 - p0, 0.0)).xyz;
-    vec3 e2 = (inst.world_from_object * vec4(p2 - p0, 0.0)).xyz;
-    vec3 ng = cross(e1, e2);
-    float len = length(ng);
-    ng = len > 0.0 ? ng / len : vec3(0.0, 0.0, 1.0);
-    if (inst.normal_to_world[3][3] < 0.0) {
-        ng = -ng;
-    }
+    vec3 ng = v_geometric;
     vec3 position = v_position;
     vec3 to_camera = frame.camera_position.xyz - position;
     bool front = dot(ng, to_camera) >= 0.0;

@@ -22,6 +22,11 @@ layout(location = 3) flat out uint v_triangle;
 layout(location = 4) out vec3 v_tangent;
 layout(location = 5) flat out float v_tangent_w;
 #endif
+// The triangle's unit geometric normal (world space, flipped by a mirroring instance as glTF's
+// winding rule says) and its material: the same at its three corners, so a flat varying hands
+// them to every fragment (read per fragment, the corners cost three gathers each).
+layout(location = 6) flat out vec3 v_geometric;
+layout(location = 7) flat out uint v_material;
 
 void main() {
     GpuInstance inst = instances[pc.instance];
@@ -32,6 +37,17 @@ void main() {
     v_normal = (inst.normal_to_world * vec4(v.normal_v.xyz, 0.0)).xyz;
     v_uv = vertex_texcoords(v, index);
     v_triangle = uint(gl_VertexIndex) / 3u;
+    uint first = inst.mesh.z + 3u * v_triangle;
+    vec3 p0 = vertices[indices[first] + inst.mesh.y].position_u.xyz;
+    vec3 p1 = vertices[indices[first + 1u] + inst.mesh.y].position_u.xyz;
+    vec3 p2 = vertices[indices[first + 2u] + inst.mesh.y].position_u.xyz;
+    vec3 e1 = (inst.world_from_object * vec4(p1 - p0, 0.0)).xyz;
+    vec3 e2 = (inst.world_from_object * vec4(p2 - p0, 0.0)).xyz;
+    vec3 ng = cross(e1, e2);
+    float len = length(ng);
+    ng = len > 0.0 ? ng / len : vec3(0.0, 0.0, 1.0);
+    v_geometric = inst.normal_to_world[3][3] < 0.0 ? -ng : ng;
+    v_material = tri_materials[inst.mesh.w + v_triangle];
 #ifdef HAS_NORMAL_MAPS
     vec4 t = world_tangent(inst, tangents[index]);
     v_tangent = t.xyz;
