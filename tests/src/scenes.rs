@@ -131,6 +131,32 @@ pub fn point_light_node(b: &mut GltfBuilder, position: [f32; 3], intensity: f32)
     })
 }
 
+/// The scene `name` of `b`'s meshes `(mesh, rotation)`, one node each, a camera node
+/// ([`camera_node`]: position, rotation, vertical field of view) and a white point light
+/// ([`point_light_node`]: position, intensity), written and loaded back.
+pub fn meshes_camera_light_scene(
+    mut b: GltfBuilder,
+    name: &str,
+    meshes: &[(usize, Quat)],
+    camera: (Vec3, Quat, f32),
+    light: ([f32; 3], f32),
+) -> Scene {
+    let mut roots: Vec<usize> = meshes
+        .iter()
+        .map(|&(mesh, q)| {
+            b.add_node(&NodeDesc {
+                mesh: Some(mesh),
+                rotation: (q != Quat::IDENTITY).then(|| q.to_array()),
+                ..NodeDesc::default()
+            })
+        })
+        .collect();
+    roots.push(camera_node(&mut b, camera.0, camera.1, camera.2));
+    roots.push(point_light_node(&mut b, light.0, light.1));
+    b.add_scene(name, &roots, None);
+    write_and_load(&b, &temp_dir(name), name)
+}
+
 /// Image-space position (pixels, x right, y down, origin at the top-left corner) of NDC point
 /// `(x, y)` with y up, for a `width × height` image.
 pub fn ndc_to_pixel(x: f32, y: f32, width: u32, height: u32) -> (f64, f64) {

@@ -7,13 +7,11 @@
 
 use glam::{DVec3, Quat, Vec3};
 use radcache_render::{DirectPass, EmitterLight, SkyLight};
-use radcache_scene::writer::{GltfBuilder, MaterialDesc, NodeDesc};
+use radcache_scene::writer::{GltfBuilder, MaterialDesc};
 use radcache_scene::Scene;
 use radcache_tests::direct_cpu::{agree, cpu_direct};
 use radcache_tests::ic_fixture::*;
-use radcache_tests::scenes::{
-    camera_node, load, plane_y, point_light_node, temp_dir, write_and_load,
-};
+use radcache_tests::scenes::{load, meshes_camera_light_scene, plane_y, temp_dir};
 
 /// The mean of sub-frames `images` per pixel.
 fn mean_image(images: &[Vec<Px>]) -> Vec<DVec3> {
@@ -131,21 +129,14 @@ fn slab_scene() -> Scene {
     let floor = plane_y([-4.0, 4.0], [-3.0, 3.0], 0.0, mat);
     let slab = plane_y([-0.4, 0.4], [-0.4, 0.4], 0.6, mat);
     let mesh = b.add_mesh("floor+slab", &[floor, slab]);
-    let roots = vec![
-        b.add_node(&NodeDesc {
-            mesh: Some(mesh),
-            ..NodeDesc::default()
-        }),
-        camera_node(
-            &mut b,
-            Vec3::new(0.0, 2.0, 3.0),
-            Quat::from_rotation_x(-0.6),
-            0.7,
-        ),
-        point_light_node(&mut b, [0.3, 1.8, 0.2], 5.0),
-    ];
-    b.add_scene(name, &roots, None);
-    write_and_load(&b, &temp_dir(name), name)
+    let camera = (Vec3::new(0.0, 2.0, 3.0), Quat::from_rotation_x(-0.6), 0.7);
+    meshes_camera_light_scene(
+        b,
+        name,
+        &[(mesh, Quat::IDENTITY)],
+        camera,
+        ([0.3, 1.8, 0.2], 5.0),
+    )
 }
 
 /// A point light's shadow with adaptive shadows: sub-frame 0 casts a ray at every lit-facing
@@ -209,26 +200,9 @@ fn bar_scene(name: &str, z: [f32; 2]) -> Scene {
     let wall = b.add_mesh("wall", &[plane_y([-3.0, 3.0], [-1.0, 2.0], 0.0, mat)]);
     let bar = b.add_mesh("bar", &[plane_y([-3.0, 3.0], z, 0.0, mat)]);
     let q = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
-    let roots = vec![
-        b.add_node(&NodeDesc {
-            mesh: Some(wall),
-            rotation: Some([q.x, q.y, q.z, q.w]),
-            ..NodeDesc::default()
-        }),
-        b.add_node(&NodeDesc {
-            mesh: Some(bar),
-            ..NodeDesc::default()
-        }),
-        camera_node(
-            &mut b,
-            Vec3::new(0.0, 1.0, 3.0),
-            Quat::from_rotation_x(-0.38),
-            0.7,
-        ),
-        point_light_node(&mut b, [0.0, 3.0, -0.5], 5.0),
-    ];
-    b.add_scene(name, &roots, None);
-    write_and_load(&b, &temp_dir(name), name)
+    let meshes = [(wall, q), (bar, Quat::IDENTITY)];
+    let camera = (Vec3::new(0.0, 1.0, 3.0), Quat::from_rotation_x(-0.38), 0.7);
+    meshes_camera_light_scene(b, name, &meshes, camera, ([0.0, 3.0, -0.5], 5.0))
 }
 
 /// Sub-frame 0 at a G-buffer jitter where no sample of `scene` (a `bar_scene`) is lit, then ten
