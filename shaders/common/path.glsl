@@ -18,6 +18,9 @@
 
 #include "random.glsl"
 #include "lights.glsl"
+#ifdef PATH_GRID
+#include "path_grid.glsl"
+#endif
 
 // Gathers (record.comp, PATH_CLOSED_FORM_EMITTERS) in a Lambertian scene whose few emitters have a
 // closed form take the emitters' light at each vertex as a control variate (direct_light).
@@ -239,6 +242,13 @@ struct PathState {
     bool count_first;     // count sources found by the first segment
     bool done;
     float first_t;        // distance to the first hit, IC_PATH_MISS on a miss
+#ifdef PATH_GRID
+    // The grid cell of the first hit, which this path's continuation from there is deposited
+    // into (PATH_GRID_NONE: none), and the path's radiance and throughput at that point.
+    uint grid_slot;
+    vec3 grid_base;
+    vec3 grid_scale;
+#endif
 };
 
 const float IC_PATH_MISS = 1.0e30;
@@ -254,6 +264,11 @@ PathState path_begin(Ray ray, float bsdf_pdf, bool count_first_segment, uint rr_
     st.count_first = count_first_segment;
     st.done = false;
     st.first_t = IC_PATH_MISS;
+#ifdef PATH_GRID
+    st.grid_slot = PATH_GRID_NONE;
+    st.grid_base = vec3(0.0);
+    st.grid_scale = vec3(0.0);
+#endif
     return st;
 }
 
@@ -316,6 +331,34 @@ void path_step(inout PathState st, inout Rng rng) {
 
     st.throughput *= albedo;
 #endif
+#ifdef PATH_GRID
+    // The radiance grid (common/path_grid.glsl): a Lambertian vertex whose cell is ready ends
+    // the path with the cell's mean continuation; the first hit's continuation is deposited into
+    // its cell. (A glossy vertex's continuation depends on the direction it was reached from.)
+#ifdef HAS_SPECULAR
+    bool lambertian = f.m.metallic == 0.0 && f.m.specular_factor == 0.0;
+#else
+    const bool lambertian = true;
+#endif
+    if (g_grid_epoch != 0u && lambertian) {
+        float edge;
+        uint slot = path_grid_slot(s.position, s.geometric_normal, edge);
+        if (slot != PATH_GRID_NONE) {
+            bool ready = path_grid_ready(slot);
+            if (ready && t >= PATH_GRID_MIN_SEGMENT * edge) {
+                st.radiance += st.throughput * path_grid_mean(slot);
+                st.done = true;
+                return;
+            }
+            // A ready cell's sums are final (its mean is being read).
+            if (st.depth == 0u && !ready) {
+                st.grid_slot = slot;
+                st.grid_base = st.radiance;
+                st.grid_scale = st.throughput;
+            }
+        }
+    }
+#endif
     uint depth = st.depth;
     st.depth++;
     if (depth >= st.rr_start) {
@@ -348,6 +391,17 @@ void path_step(inout PathState st, inout Rng rng) {
 vec3 path_radiance(PathState st) {
     return (any(isnan(st.radiance)) || any(isinf(st.radiance))) ? vec3(0.0) : st.radiance;
 }
+
+#ifdef PATH_GRID
+// Deposits a finished path's continuation from its first hit into that hit's cell: the light
+// it gathered past the first hit's next-event estimation, over the throughput there (the
+// albedo). A path whose throughput there has a zero channel deposits nothing.
+void path_grid_finish(PathState st) {
+    if (st.grid_slot != PATH_GRID_NONE && all(greaterThan(st.grid_scale, vec3(0.0)))) {
+        path_grid_deposit(st.grid_slot, (st.radiance - st.grid_base) / st.grid_scale);
+    }
+}
+#endif
 
 // Radiance arriving along `ray`. With `count_first_segment` false, light that arrives along the
 // first segment straight from a source (emission at the first hit, the environment on a miss) is

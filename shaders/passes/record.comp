@@ -55,10 +55,19 @@
 // by s, packed the same way as f16 pairs (radcache_shared::consts::RECORD_RADIANCE_VEC4S). A
 // non-finite coefficient is stored as 0, with zero gradients; a non-finite gradient as 0.
 //
+// Radiance grid (PATH_GRID, docs/cache-frame.md §4.1; common/path_grid.glsl): with a nonzero
+// grid_epoch, a gather path's vertex whose cell of the grid is ready (filled by earlier
+// dispatches of the frame) ends the path with the cell's mean continuation radiance, and a path
+// that continued from its first hit deposits what it found there into that hit's cell.
+//
 // Optional sample dump (tests): when the buffer bound at B_GBUFFER_END + 4 holds at least
 // (i + 1)·M·N vec4, request i writes (L_jk, r_jk) of its strata at i·M·N + j·N + k.
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#ifdef PATH_GRID
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+#endif
 
 #include "../common/path.glsl"
 #include "../common/gbuffer.glsl"
@@ -389,6 +398,9 @@ void main() {
     // The record serves a glossy lobe from the cache (RECORD_FLAG_GLOSSY).
     bool glossy = false;
     g_level_subframe = pc.level_subframe;
+#ifdef PATH_GRID
+    path_grid_begin(pc.grid_epoch);
+#endif
     if (pc.source == RECORD_SOURCE_RECORDS) {
         // Refresh in place: the surface point, normal and footprint are the record's own, and
         // so are its pixel, level and sub-frame, hence its seeds (creation_seed, passes/record.rs): under
@@ -485,6 +497,9 @@ void main() {
     while (i < count) {
         path_step(st, rng);
         if (st.done) {
+#ifdef PATH_GRID
+            path_grid_finish(st);
+#endif
             vec3 l = path_radiance(st);
 #ifdef IC_SKY_IN_RECORDS
             // The sky in the records (docs/cache-frame.md §8.3): a first segment that escapes

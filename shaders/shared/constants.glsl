@@ -32,6 +32,14 @@ const uint QUAD_VERTICES = 6u;
 const uint GRID_MAX_LIST = 4096u;
 const uint GPU_RECORD_WORDS = 44u;
 const uint GPU_RECORD_R_ORIG_WORD = 7u;
+const uint PATH_GRID_CELLS = 262144u;
+const uint PATH_GRID_PROBES = 8u;
+const uint PATH_GRID_READY = 16u;
+const float PATH_GRID_SCALE = 1048576.0;
+const float PATH_GRID_MAX_SAMPLE = 65536.0;
+const float PATH_GRID_CELL_PX = 16.0;
+const float PATH_GRID_MAX_CELL = 0.0625;
+const float PATH_GRID_MIN_SEGMENT = 2.0;
 
 const uint COUNTERS_RESET = 0u;
 const uint COUNTERS_BEGIN_LEVEL = 1u;

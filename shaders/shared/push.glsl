@@ -66,7 +66,8 @@ struct RecordPush {
     uint fine_level;
     uint fine_m;
     uint fine_n;
-};  // 48 bytes
+    uint grid_epoch;
+};  // 52 bytes
 
 struct SplatWeights {
     uint kind;

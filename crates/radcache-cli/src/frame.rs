@@ -182,6 +182,7 @@ pub fn ic_settings(ic: &IcArgs, size: (u32, u32), seed: u32) -> Result<IcSetting
         emitter_shadows: ic.emitter_shadows(),
         anti_aliasing: ic.anti_aliasing()?,
         splat: ic.splat_mode(),
+        path_grid: ic.path_grid_mode(),
         seed,
         ..defaults
     })

@@ -316,6 +316,11 @@ pass_bindings! {
         /// The records' radiance coefficients (`vec4[12 per record]`, written with
         /// `HAS_RADIANCE_CACHE` where large enough; docs/radiance-caching.md §6.1).
         RADIANCE: StorageBuffer,
+        /// The gather paths' radiance grid: per cell its key, ready epoch and count (`uvec4[]`,
+        /// read and written with `PATH_GRID`; docs/cache-frame.md §4.1).
+        PATH_GRID: StorageBuffer,
+        /// The grid cells' fixed-point sums (`int64_t[4 per cell]`).
+        PATH_GRID_SUMS: StorageBuffer,
     }
 }
 

@@ -115,6 +115,9 @@ pub struct ScenePlan {
     /// compile the full metallic-roughness BRDF (`HAS_SPECULAR`). False when every material is
     /// Lambertian ([`Material::is_lambertian`](crate::Material::is_lambertian)).
     pub specular: bool,
+    /// Some material is Lambertian: the records' gather paths share a radiance grid at the
+    /// vertices on such materials ([`Self::path_grid`]).
+    pub lambertian: bool,
     /// Materials whose specular lobe is rough enough for the radiance records
     /// (docs/radiance-caching.md §4): not Lambertian, roughness factor at or above
     /// `GLOSSY_ROUGHNESS_MIN` (a roughness texture can only lower it; pixels below the threshold
@@ -185,6 +188,7 @@ impl ScenePlan {
             .any(|m| (m.emissive_texture.is_some() || m.has_alpha()) && m.is_emissive());
         let count = emitters.triangles.len();
         let specular = scene.materials.iter().any(|m| !m.is_lambertian());
+        let lambertian = scene.materials.iter().any(|m| m.is_lambertian());
         let alpha = scene.materials.iter().any(|m| m.has_alpha());
         let glossy_materials = scene
             .materials
@@ -205,6 +209,7 @@ impl ScenePlan {
             analytic_emitters,
             closed_form_gathers,
             specular,
+            lambertian,
             alpha,
             normal_maps: scene.meshes.iter().any(|m| !m.tangents.is_empty()),
             uv_transform: scene.materials.iter().any(|m| m.has_uv_transform()),
@@ -227,6 +232,14 @@ impl ScenePlan {
                 time_range,
             },
         }
+    }
+
+    /// The gathers of new records may share a radiance grid (docs/cache-frame.md §4.1;
+    /// `PATH_GRID`): some material is Lambertian, and past a vertex on one the light a path
+    /// finds does not depend on the direction it came from (vertices on other materials neither
+    /// read nor fill the grid).
+    pub fn path_grid(&self) -> bool {
+        self.lambertian
     }
 
     /// The scene has emissive triangles.
@@ -319,6 +332,20 @@ impl fmt::Display for ScenePlan {
                 "metallic-roughness BRDF (specular lobes compiled in)"
             } else {
                 "lambertian only (no specular code compiled)"
+            }
+        )?;
+        writeln!(
+            f,
+            "  gather paths: {}",
+            match (self.path_grid(), self.specular) {
+                (true, false) => {
+                    "radiance grid (a path ends where its cell holds enough continuations)"
+                }
+                (true, true) => {
+                    "radiance grid at Lambertian vertices (a path ends where its cell holds \
+                     enough continuations)"
+                }
+                _ => "to their end (no Lambertian material: no radiance grid)",
             }
         )?;
         if self.specular {

@@ -432,6 +432,11 @@ fn damaged_helmet_needs_the_full_brdf_and_has_an_unused_occlusion_map() {
     assert!(plan
         .to_string()
         .contains("materials: metallic-roughness BRDF (specular lobes compiled in)"));
+    // Its one material is metallic: no vertex for the radiance grid.
+    assert!(!plan.path_grid());
+    assert!(plan
+        .to_string()
+        .contains("gather paths: to their end (no Lambertian material: no radiance grid)"));
     assert_eq!(s.material_notes.occlusion_textures, 1);
     assert!(s.material_notes.unsupported_extensions.is_empty());
     assert_eq!(
@@ -469,6 +474,8 @@ fn bundled_scenes_are_lambertian() {
         assert!(plan
             .to_string()
             .contains("materials: lambertian only (no specular code compiled)"));
+        assert!(plan.path_grid(), "{}", path.display());
+        assert!(plan.to_string().contains("gather paths: radiance grid"));
     }
     // The bundled scenes with specular materials.
     let spheres = files.iter().find(|p| p.ends_with("metal_spheres.gltf"));
@@ -480,6 +487,10 @@ fn bundled_scenes_are_lambertian() {
     let (s, _) = load(glossy.expect("glossy_room is bundled"));
     let plan = s.plan();
     assert!(plan.specular && plan.radiance_cache());
+    assert!(plan.path_grid(), "its walls are Lambertian");
+    assert!(plan
+        .to_string()
+        .contains("gather paths: radiance grid at Lambertian vertices"));
     // Gold 0.7, plastic 0.8 and the floor plate 0.65; the 0.4 sphere stays below the threshold.
     assert_eq!(plan.glossy_materials, 3);
     assert!(plan

@@ -185,9 +185,31 @@ gpu_consts! {
     /// Word of `GpuRecord.normal_rorig.w` (`R_orig`) within a record.
     pub const GPU_RECORD_R_ORIG_WORD: u32 =
         ((std::mem::offset_of!(crate::gpu::GpuRecord, normal_rorig) + 12) / 4) as u32;
+    /// Cells of the gather paths' radiance grid (docs/cache-frame.md §4.1; a power of two).
+    pub const PATH_GRID_CELLS: u32 = 1 << 18;
+    /// Slots a cell's key probes (linear probing) before the grid counts as full for it.
+    pub const PATH_GRID_PROBES: u32 = 8;
+    /// Continuations a cell gathers before the record dispatches after it take its mean.
+    pub const PATH_GRID_READY: u32 = 16;
+    /// Fixed-point steps per unit of radiance in the cells' 64-bit sums (order-independent, so
+    /// the records do not depend on the order in which the invocations add).
+    pub const PATH_GRID_SCALE: f32 = 1048576.0;
+    /// Largest radiance a continuation deposits (clamped): 2^24 of them cannot overflow a sum.
+    pub const PATH_GRID_MAX_SAMPLE: f32 = 65536.0;
+    /// A cell's edge in pixel footprints at its distance from the camera, before rounding up to
+    /// a power of two.
+    pub const PATH_GRID_CELL_PX: f32 = 16.0;
+    /// The largest cell edge, as a fraction of the scene's bounding-box diagonal (rounded down
+    /// to a power of two): at low resolutions the pixel rule would make cells as wide as a
+    /// room, and a cell that straddles a thin wall mixes the light of both sides.
+    pub const PATH_GRID_MAX_CELL: f32 = 1.0 / 16.0;
+    /// A vertex takes its cell's mean only when the segment that found it is at least this many
+    /// cell edges long (near a corner the light changes within a cell).
+    pub const PATH_GRID_MIN_SEGMENT: f32 = 2.0;
 }
 
 const _: () = assert!(GRID_SLOTS == GRID_LEVELS + 1);
+const _: () = assert!(PATH_GRID_CELLS.is_power_of_two());
 const _: () = assert!(RECORD_FLAG_GLOSSY <= RECORD_FLAGS_MASK);
 const _: () = assert!(RECORD_FLAGS_MASK == (1 << RECORD_INSTANCE_SHIFT) - 1);
 

@@ -117,7 +117,7 @@ pub(crate) fn query_caps(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Re
     // SAFETY: the chain only holds structs the device's API version / extensions define.
     unsafe { instance.get_physical_device_features2(pd, &mut core) };
     let c = core.features;
-    let flags: [(&'static str, u32); 14] = [
+    let flags: [(&'static str, u32); 16] = [
         ("bufferDeviceAddress", f12.buffer_device_address),
         ("scalarBlockLayout", f12.scalar_block_layout),
         ("runtimeDescriptorArray", f12.runtime_descriptor_array),
@@ -139,6 +139,8 @@ pub(crate) fn query_caps(instance: &ash::Instance, pd: vk::PhysicalDevice) -> Re
         ("accelerationStructure", fas.acceleration_structure),
         ("rayQuery", frq.ray_query),
         ("fragmentStoresAndAtomics", c.fragment_stores_and_atomics),
+        ("shaderInt64", c.shader_int64),
+        ("shaderBufferInt64Atomics", f12.shader_buffer_int64_atomics),
         ("drawIndirectFirstInstance", c.draw_indirect_first_instance),
         (
             "timestampComputeAndGraphics",
@@ -240,7 +242,8 @@ pub(crate) fn create_device(
         .scalar_block_layout(true)
         .runtime_descriptor_array(true)
         .descriptor_binding_partially_bound(true)
-        .shader_sampled_image_array_non_uniform_indexing(true);
+        .shader_sampled_image_array_non_uniform_indexing(true)
+        .shader_buffer_int64_atomics(true);
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
         .dynamic_rendering(true)
         .synchronization2(true)
@@ -249,9 +252,12 @@ pub(crate) fn create_device(
     let mut fas =
         vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
     let mut frq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
-    // drawIndirectFirstInstance: the splat pass's batch draw starts at a GPU-written instance.
+    // drawIndirectFirstInstance: the splat pass's batch draw starts at a GPU-written instance;
+    // shaderInt64 (and shaderBufferInt64Atomics above): the record pass's radiance grid sums in
+    // 64-bit fixed point (shaders/common/path_grid.glsl).
     let core = vk::PhysicalDeviceFeatures::default()
         .fragment_stores_and_atomics(true)
+        .shader_int64(true)
         .draw_indirect_first_instance(true);
     let mut f2 = vk::PhysicalDeviceFeatures2::default()
         .features(core)

@@ -28,6 +28,8 @@ pub const REQUIRED_FEATURES: &[&str] = &[
     "accelerationStructure",
     "rayQuery",
     "fragmentStoresAndAtomics",
+    "shaderInt64",
+    "shaderBufferInt64Atomics",
     "drawIndirectFirstInstance",
     "timestampComputeAndGraphics",
 ];

@@ -18,8 +18,8 @@
 //! scene's triangles, rays from random surface points, measured in the same run). Beside the
 //! defaults, the frame at 256² with the direct light of before the closed-form emitters and the
 //! sky through the records (`--emitters sampled --sky direct`; case suffix `_sampled_light`), and
-//! with adaptive anti-aliasing (suffix `_aa`; `_aa_16x48` with the course's 16×48 strata, the
-//! default's before 2026-12-05), and splatting at
+//! with adaptive anti-aliasing (suffix `_aa`; `_aa_no_path_grid` with full gather paths instead
+//! of the radiance grid, docs/cache-frame.md §4.1), and splatting at
 //! every sub-frame instead of once per frame (suffixes `_splat_per_sub_frame` and
 //! `_aa_splat_per_sub_frame`), and, where the emitters are taken in closed form, with a quarter
 //! of the direct samples as shadow rays at every pixel instead of adaptive emitter shadows
@@ -60,7 +60,7 @@ use radcache_cache::{IcParams, Preset};
 use radcache_image::{compare, read_exr, Image};
 use radcache_render::{
     render_ic, render_path, AntiAliasing, Budget, EmitterLight, EmitterShadows, GpuScene,
-    IcSettings, PathSettings, SkyLight, SplatMode,
+    IcSettings, PathGridMode, PathSettings, SkyLight, SplatMode,
 };
 use radcache_scene::{LoadOptions, Scene};
 
@@ -74,8 +74,8 @@ enum Variant {
     SampledLight,
     /// Adaptive anti-aliasing with the preset's target.
     Aa,
-    /// Adaptive anti-aliasing and the course's 16×48 strata (the default's before 2026-12-05).
-    AaStrata16x48,
+    /// Adaptive anti-aliasing and full gather paths (`--path-grid off`).
+    AaNoPathGrid,
     /// A splat at every sub-frame (`--splat per-sub-frame`).
     SplatPerSubFrame,
     /// Adaptive anti-aliasing and a splat at every sub-frame.
@@ -95,7 +95,7 @@ impl Variant {
             Variant::Plain => "",
             Variant::SampledLight => "_sampled_light",
             Variant::Aa => "_aa",
-            Variant::AaStrata16x48 => "_aa_16x48",
+            Variant::AaNoPathGrid => "_aa_no_path_grid",
             Variant::SplatPerSubFrame => "_splat_per_sub_frame",
             Variant::AaSplatPerSubFrame => "_aa_splat_per_sub_frame",
             Variant::FixedShadows => "_fixed_shadows",
@@ -147,13 +147,18 @@ pub fn run(args: &[&str]) -> Result<()> {
         sky: SkyLight::Direct,
         ..draft.clone()
     };
+    let no_grid = IcSettings {
+        path_grid: PathGridMode::Off,
+        ..draft.clone()
+    };
     bench.warm_up_ic(&scene, &mut gpu, draft)?;
     bench.warm_up_ic(&scene, &mut gpu, sampled_light)?;
+    bench.warm_up_ic(&scene, &mut gpu, no_grid)?;
     bench.warm_up_path(&scene, &mut gpu)?;
 
     // (size, preset, variant): every preset at the reference's size with 8 sub-frames, the
     // default at 512², the default at 256² with the direct light sampled as before, and with
-    // the CLI's adaptive anti-aliasing (AntiAliasing::preset; also with 16×48 strata).
+    // the CLI's adaptive anti-aliasing (AntiAliasing::preset; also with full gather paths).
     use Variant::*;
     let mut cases: Vec<(u32, Preset, Variant)> =
         bs.presets.iter().map(|&p| (256, p, Plain)).collect();
@@ -162,7 +167,7 @@ pub fn run(args: &[&str]) -> Result<()> {
     }
     cases.push((256, Preset::Default, SampledLight));
     cases.push((256, Preset::Default, Aa));
-    cases.push((256, Preset::Default, AaStrata16x48));
+    cases.push((256, Preset::Default, AaNoPathGrid));
     cases.push((256, Preset::Default, SplatPerSubFrame));
     cases.push((256, Preset::Default, AaSplatPerSubFrame));
     if scene.plan().analytic_emitters {
@@ -209,9 +214,9 @@ pub fn run(args: &[&str]) -> Result<()> {
                 settings.sky = SkyLight::Direct;
             }
             Aa => settings.anti_aliasing = Some(AntiAliasing::preset(preset)),
-            AaStrata16x48 => {
+            AaNoPathGrid => {
                 settings.anti_aliasing = Some(AntiAliasing::preset(preset));
-                settings.params = settings.params.with_strata(16, 48);
+                settings.path_grid = PathGridMode::Off;
             }
             SplatPerSubFrame => settings.splat = SplatMode::PerSubFrame,
             AaSplatPerSubFrame => {

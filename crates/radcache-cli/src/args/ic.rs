@@ -5,7 +5,8 @@ use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 use radcache_cache::{ErrorControl, IcParams, Preset, WeightKind};
 use radcache_render::{
-    AntiAliasing, EmitterLight, EmitterShadows, GlossyLight, GlossySpacing, SkyLight, SplatMode,
+    AntiAliasing, EmitterLight, EmitterShadows, GlossyLight, GlossySpacing, PathGridMode, SkyLight,
+    SplatMode,
 };
 
 /// Cache quality preset.
@@ -92,6 +93,16 @@ pub enum Splat {
     Once,
     /// At every sub-frame's own samples (one splat and one hole-filling pass per sub-frame).
     PerSubFrame,
+}
+
+/// Whether the gathers of new records share a radiance grid (docs/cache-frame.md §4.1).
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PathGridArg {
+    /// Where every material is Lambertian, a gather path ends at a vertex whose grid cell holds
+    /// enough continuations with their mean (default).
+    On,
+    /// Every gather path continues to its end.
+    Off,
 }
 
 /// What adaptive anti-aliasing's added sub-frames shade (docs/cache-frame.md §7.1, §7.2).
@@ -187,6 +198,9 @@ pub struct IcArgs {
     /// How often the records are splatted (`--method ic`).
     #[arg(long, value_enum, default_value_t = Splat::Once)]
     pub splat: Splat,
+    /// Whether the records' gather paths share a radiance grid (`--method ic`).
+    #[arg(long, value_enum, default_value_t = PathGridArg::On)]
+    pub path_grid: PathGridArg,
 }
 
 fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T)> {
@@ -263,6 +277,14 @@ impl IcArgs {
         match self.splat {
             Splat::Once => SplatMode::Once,
             Splat::PerSubFrame => SplatMode::PerSubFrame,
+        }
+    }
+
+    /// Whether the gathers share a radiance grid.
+    pub fn path_grid_mode(&self) -> PathGridMode {
+        match self.path_grid {
+            PathGridArg::On => PathGridMode::On,
+            PathGridArg::Off => PathGridMode::Off,
         }
     }
 

@@ -14,7 +14,7 @@ use radcache_vk::{Context, ShaderCompiler};
 use crate::error::{Error, Result};
 use crate::frame::path::{FrameOutput, Progress};
 use crate::frame::settings::{
-    EmitterShadows, GlossyLight, IcDebug, IcSettings, IcStats, SplatMode,
+    EmitterShadows, GlossyLight, IcDebug, IcSettings, IcStats, PathGridMode, SplatMode,
 };
 use crate::passes::composite::CompositePass;
 use crate::passes::direct::DirectPass;
@@ -140,7 +140,7 @@ impl IcRenderer {
             glossy_valid: true,
             holes: HolePass::new(ctx, shaders)?,
             neighbours: NeighbourPass::new(ctx, shaders)?,
-            records: RecordPass::with_glossy_spacing(
+            records: RecordPass::with_options(
                 ctx,
                 shaders,
                 gpu,
@@ -148,6 +148,13 @@ impl IcRenderer {
                 settings.sky,
                 radiance,
                 settings.glossy_spacing,
+                // Records kept over frames are refreshed by full paths, which must reproduce
+                // them (docs/temporal.md §3.5): made with the grid, they would not.
+                if temporal {
+                    PathGridMode::Off
+                } else {
+                    settings.path_grid
+                },
             )?,
             composite: CompositePass::with_options(
                 ctx,

@@ -72,6 +72,8 @@ pub struct IcSettings {
     /// How often the records are splatted: once per frame (the default) or at every
     /// sub-frame. Must be set when the renderer is created.
     pub splat: SplatMode,
+    /// Whether the gathers of new records share a radiance grid (docs/cache-frame.md §4.1).
+    pub path_grid: PathGridMode,
 }
 
 /// How often a frame rendered with the cache splats its records (docs/cache-frame.md §6.5).
@@ -87,6 +89,19 @@ pub enum SplatMode {
     /// At every sub-frame's own samples, and the cache phase fills the holes of every
     /// sub-frame: the exact per-sample interpolation, one splat per sub-frame.
     PerSubFrame,
+}
+
+/// Whether the gather paths of a frame's new records share a radiance grid
+/// (docs/cache-frame.md §4.1; `shaders/common/path_grid.glsl`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum PathGridMode {
+    /// Where the plan allows it (`ScenePlan::path_grid`: every material Lambertian), a gather
+    /// path's vertex whose grid cell already holds enough continuations ends there with their
+    /// mean, and the continuations from first hits fill the cells.
+    #[default]
+    On,
+    /// Every gather path continues to its end (Russian roulette).
+    Off,
 }
 
 /// Adaptive anti-aliasing of a frame rendered with the cache (docs/cache-frame.md §7.1): after
@@ -252,6 +267,7 @@ impl Default for IcSettings {
             glossy_spacing: GlossySpacing::Lobe,
             anti_aliasing: None,
             splat: SplatMode::Once,
+            path_grid: PathGridMode::On,
         }
     }
 }

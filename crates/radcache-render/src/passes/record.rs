@@ -30,11 +30,12 @@ use radcache_vk::{
 
 use crate::bindings::record as b;
 use crate::error::{Error, Result};
-use crate::frame::settings::{GlossySpacing, SkyLight};
+use crate::frame::settings::{GlossySpacing, PathGridMode, SkyLight};
 use crate::passes::gbuffer::GBuffer;
 use crate::scene::GpuScene;
-use radcache_shared::consts::{RecordSource, SEED_SUB_FRAME_MUL};
+use radcache_shared::consts::{RecordSource, PATH_GRID_CELLS, SEED_SUB_FRAME_MUL};
 use radcache_shared::gpu::IcCounters;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// The shader, relative to `shaders/`.
 pub const SHADER: &str = "passes/record.comp";
@@ -79,6 +80,9 @@ radcache_shared::gpu_struct! {
         pub fine_m: u32 => "uint",
         /// Fine N.
         pub fine_n: u32 => "uint",
+        /// The dispatch's epoch in the frame's radiance grid (`PATH_GRID`; 0: the grid is
+        /// neither read nor written; docs/cache-frame.md §4.1).
+        pub grid_epoch: u32 => "uint",
     }
 }
 
@@ -97,6 +101,16 @@ pub fn record_seed(pixel_index: u32, seed: u32) -> u32 {
     ircache_hash(pixel_index ^ ircache_hash(seed))
 }
 
+/// The gather paths' radiance grid of a frame (`shaders/common/path_grid.glsl`,
+/// docs/cache-frame.md §4.1): `PATH_GRID_CELLS` cells of a key, a ready epoch and a count
+/// (`uvec4`) and three 64-bit fixed-point sums (`int64_t[4]`), cleared by
+/// [`RecordPass::record_grid_reset`]; each dispatch of new records takes the next epoch.
+struct PathGrid {
+    keys: Buffer,
+    sums: Buffer,
+    epoch: AtomicU32,
+}
+
 /// The record pipeline, its parameters and its ray counter.
 pub struct RecordPass {
     pipeline: Pipeline,
@@ -106,6 +120,7 @@ pub struct RecordPass {
     no_radiance: Buffer,
     params: IcParams,
     radiance: bool,
+    grid: Option<PathGrid>,
 }
 
 impl std::fmt::Debug for RecordPass {
@@ -167,6 +182,25 @@ impl RecordPass {
         radiance: bool,
         spacing: GlossySpacing,
     ) -> Result<RecordPass> {
+        let grid = PathGridMode::Off;
+        Self::with_options(ctx, shaders, scene, params, sky, radiance, spacing, grid)
+    }
+
+    /// As [`RecordPass::with_glossy_spacing`]; with [`PathGridMode::On`] and a scene whose plan
+    /// allows it (`ScenePlan::path_grid`: every material Lambertian) the gathers of new records
+    /// share a radiance grid (`PATH_GRID`, docs/cache-frame.md §4.1), which
+    /// [`RecordPass::record_grid_reset`] clears at the start of each frame.
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_options(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        scene: &GpuScene,
+        params: &IcParams,
+        sky: SkyLight,
+        radiance: bool,
+        spacing: GlossySpacing,
+        grid: PathGridMode,
+    ) -> Result<RecordPass> {
         let strata = [
             (params.strata_m, params.strata_n),
             (params.fine_strata_m, params.fine_strata_n),
@@ -193,6 +227,10 @@ impl RecordPass {
             if spacing == GlossySpacing::Lobe {
                 defines.push(("GLOSSY_DENSITY", "1"));
             }
+        }
+        let grid = grid == PathGridMode::On && scene.plan().path_grid();
+        if grid {
+            defines.push(("PATH_GRID", "1"));
         }
         let spirv = shaders.compile(SHADER, &defines)?;
         let pipeline = Pipeline::compute(
@@ -222,7 +260,46 @@ impl RecordPass {
             no_radiance: buffer("records.no_radiance", MemoryLocation::GpuOnly)?,
             params: *params,
             radiance,
+            grid: if grid {
+                let cells = u64::from(PATH_GRID_CELLS);
+                let storage = |name, size| {
+                    Buffer::new(
+                        ctx,
+                        &BufferDesc {
+                            name,
+                            size,
+                            usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                                | vk::BufferUsageFlags::TRANSFER_DST,
+                            location: MemoryLocation::GpuOnly,
+                            alignment: 0,
+                        },
+                    )
+                };
+                Some(PathGrid {
+                    keys: storage("records.path_grid", cells * 16)?,
+                    sums: storage("records.path_grid_sums", cells * 32)?,
+                    epoch: AtomicU32::new(0),
+                })
+            } else {
+                None
+            },
         })
+    }
+
+    /// Whether the gathers share a radiance grid ([`RecordPass::with_options`]).
+    pub fn path_grid(&self) -> bool {
+        self.grid.is_some()
+    }
+
+    /// Clears the radiance grid (a frame's first step; nothing without one): the dispatches
+    /// after it fill the grid again from the first epoch on.
+    pub fn record_grid_reset(&self, rec: &mut Recorder) {
+        if let Some(g) = &self.grid {
+            rec.fill_buffer(&g.keys, 0, vk::WHOLE_SIZE, 0);
+            rec.fill_buffer(&g.sums, 0, vk::WHOLE_SIZE, 0);
+            rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
+            g.epoch.store(0, Ordering::Relaxed);
+        }
     }
 
     /// The parameters the pass was built with.
@@ -412,6 +489,11 @@ impl RecordPass {
             fine_level: p.fine_level(),
             fine_m: p.fine_strata_m,
             fine_n: p.fine_strata_n,
+            // New records only: a refresh must draw its record's own paths again.
+            grid_epoch: match (&self.grid, source) {
+                (Some(g), RecordSource::Pixels) => g.epoch.fetch_add(1, Ordering::Relaxed) + 1,
+                _ => 0,
+            },
         };
         for image in gbuffer.images() {
             rec.use_image(image, ImageUse::ComputeStorage);
@@ -427,6 +509,14 @@ impl RecordPass {
             (b::RAY_COUNT, Resource::Buffer(&self.rays)),
             (b::SAMPLES, Resource::Buffer(io.samples)),
             (b::RADIANCE, Resource::Buffer(io.radiance)),
+            (
+                b::PATH_GRID,
+                Resource::Buffer(self.grid.as_ref().map_or(&self.no_samples, |g| &g.keys)),
+            ),
+            (
+                b::PATH_GRID_SUMS,
+                Resource::Buffer(self.grid.as_ref().map_or(&self.no_samples, |g| &g.sums)),
+            ),
         ]);
         rec.pass("records", |rec| {
             rec.bind_pipeline(&self.pipeline);

@@ -132,6 +132,7 @@ impl IcRenderer {
         let temporal = settings.time_step_s > 0.0;
         let mut rec = ctx.begin("ic.setup")?;
         gpu.record_update(ctx, &mut rec)?;
+        self.records.record_grid_reset(&mut rec);
         if !self.has_records {
             self.state.record_reset(&mut rec)?;
         }
