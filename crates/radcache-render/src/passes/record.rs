@@ -13,13 +13,17 @@
 //! - `RECORDS`: `GpuRecord[]`;
 //! - `RAY_COUNT`: the ray count (`uint`, host-readable, [`RecordPass::rays`]);
 //! - `SAMPLES`: the optional sample dump, `vec4[]` of `(L_jk, r_jk)`
-//!   ([`RecordPass::record_with_samples`]).
+//!   ([`RecordPass::record_with_samples`]);
+//! - `RADIANCE`: the records' radiance coefficients (`HAS_RADIANCE_CACHE`);
+//! - `PATH_GRID`, `PATH_GRID_SUMS`: the frame's radiance grid (`PATH_GRID`, docs/cache-frame.md
+//!   §4.1), the pass's own buffers ([`RecordPass::with_options`]).
 //!
-//! Push constants ([`RecordPush`], 48 bytes): `M`, `N`, seed, level | sub-frame << 16, then
+//! Push constants ([`RecordPush`], 52 bytes): `M`, `N`, seed, level | sub-frame << 16, then
 //! `min_px`, `max_px` (R⁻/R⁺ as validity radii in pixel footprints), the validity scale
 //! (`IcParams::validity_scale`) and `r_eps` relative to the scene scale, then the source
 //! ([`RecordSource`]: pixel requests, or record indices evaluated again,
-//! [`RecordPass::record_refresh`]).
+//! [`RecordPass::record_refresh`]), the fine level and strata, and the dispatch's epoch in the
+//! radiance grid (0: not used).
 
 use radcache_cache::sampling::ircache_hash;
 use radcache_cache::{ErrorControl, IcParams};
@@ -167,29 +171,16 @@ impl RecordPass {
         sky: SkyLight,
         radiance: bool,
     ) -> Result<RecordPass> {
-        let spacing = GlossySpacing::Lobe;
-        Self::with_glossy_spacing(ctx, shaders, scene, params, sky, radiance, spacing)
-    }
-
-    /// As [`RecordPass::with_radiance`], the records for glossy lobes spaced by `spacing`
-    /// (docs/radiance-caching.md §9; `GLOSSY_DENSITY` with [`GlossySpacing::Lobe`]).
-    pub fn with_glossy_spacing(
-        ctx: &Context,
-        shaders: &ShaderCompiler,
-        scene: &GpuScene,
-        params: &IcParams,
-        sky: SkyLight,
-        radiance: bool,
-        spacing: GlossySpacing,
-    ) -> Result<RecordPass> {
-        let grid = PathGridMode::Off;
+        let (spacing, grid) = (GlossySpacing::Lobe, PathGridMode::Off);
         Self::with_options(ctx, shaders, scene, params, sky, radiance, spacing, grid)
     }
 
-    /// As [`RecordPass::with_glossy_spacing`]; with [`PathGridMode::On`] and a scene whose plan
-    /// allows it (`ScenePlan::path_grid`: every material Lambertian) the gathers of new records
-    /// share a radiance grid (`PATH_GRID`, docs/cache-frame.md §4.1), which
-    /// [`RecordPass::record_grid_reset`] clears at the start of each frame.
+    /// As [`RecordPass::with_radiance`], the records for glossy lobes spaced by `spacing`
+    /// (docs/radiance-caching.md §9; `GLOSSY_DENSITY` with [`GlossySpacing::Lobe`]); with
+    /// [`PathGridMode::On`] and a scene whose plan allows it (`ScenePlan::path_grid`: some
+    /// material is Lambertian) the gathers of new records share a radiance grid (`PATH_GRID`,
+    /// docs/cache-frame.md §4.1), which [`RecordPass::record_grid_reset`] clears at the start of
+    /// each frame.
     #[allow(clippy::too_many_arguments)]
     pub fn with_options(
         ctx: &Context,
@@ -240,44 +231,33 @@ impl RecordPass {
             &b::layout(),
             std::mem::size_of::<RecordPush>() as u32,
         )?;
-        let buffer = |name, location| {
-            Buffer::new(
-                ctx,
-                &BufferDesc {
-                    name,
-                    size: 16,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                    location,
-                    alignment: 0,
-                },
-            )
+        let buffer = |name, size, usage, location| {
+            let alignment = 0;
+            let desc = BufferDesc {
+                name,
+                size,
+                usage,
+                location,
+                alignment,
+            };
+            Buffer::new(ctx, &desc)
         };
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let (gpu, host) = (MemoryLocation::GpuOnly, MemoryLocation::GpuToCpu);
+        let cells = u64::from(PATH_GRID_CELLS);
+        let cleared = storage | vk::BufferUsageFlags::TRANSFER_DST;
         Ok(RecordPass {
             pipeline,
-            rays: buffer("records.ray_count", MemoryLocation::GpuToCpu)?,
+            rays: buffer("records.ray_count", 16, storage, host)?,
             // One vec4: too small for any request's strata, so nothing is dumped.
-            no_samples: buffer("records.no_samples", MemoryLocation::GpuOnly)?,
-            no_radiance: buffer("records.no_radiance", MemoryLocation::GpuOnly)?,
+            no_samples: buffer("records.no_samples", 16, storage, gpu)?,
+            no_radiance: buffer("records.no_radiance", 16, storage, gpu)?,
             params: *params,
             radiance,
             grid: if grid {
-                let cells = u64::from(PATH_GRID_CELLS);
-                let storage = |name, size| {
-                    Buffer::new(
-                        ctx,
-                        &BufferDesc {
-                            name,
-                            size,
-                            usage: vk::BufferUsageFlags::STORAGE_BUFFER
-                                | vk::BufferUsageFlags::TRANSFER_DST,
-                            location: MemoryLocation::GpuOnly,
-                            alignment: 0,
-                        },
-                    )
-                };
                 Some(PathGrid {
-                    keys: storage("records.path_grid", cells * 16)?,
-                    sums: storage("records.path_grid_sums", cells * 32)?,
+                    keys: buffer("records.path_grid", cells * 16, cleared, gpu)?,
+                    sums: buffer("records.path_grid_sums", cells * 32, cleared, gpu)?,
                     epoch: AtomicU32::new(0),
                 })
             } else {
