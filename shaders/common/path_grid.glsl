@@ -1,9 +1,10 @@
-// common/path_grid.glsl — Rust: crates/radcache-render/src/passes/record.rs (PathGrid)
+// common/path_grid.glsl — Rust: crates/radcache-render/src/passes/record/path_grid.rs
 // The gather paths' radiance grid (docs/cache-frame.md §4.1), compiled into the record pass with
-// the define PATH_GRID (diffuse scenes: the continuation from a Lambertian vertex does not depend
-// on the direction it was reached from). A cell is a world-space box, its edge a power of two
-// about PATH_GRID_CELL_PX pixel footprints at its distance from the camera, and one of the six
-// axis directions its vertices' geometric normals are nearest to. It holds the sum and the count
+// the define PATH_GRID (scenes with a Lambertian material; only Lambertian vertices read and fill
+// it: the continuation from one does not depend on the direction it was reached from). A cell is
+// a world-space box, its edge a power of two about PATH_GRID_CELL_PX pixel footprints at its
+// distance from the camera (at most PATH_GRID_MAX_CELL of the scene), and one of the six axis
+// directions its vertices' geometric normals are nearest to. It holds the sum and the count
 // of the continuation radiance `L_c` that paths leaving vertices in it brought back: the light a
 // path finds past a vertex's next-event estimation, which a cosine-sampled continuation
 // estimates as the vertex's indirect irradiance over π whatever the albedo (the albedo is in the

@@ -37,9 +37,11 @@ use crate::error::{Error, Result};
 use crate::frame::settings::{GlossySpacing, PathGridMode, SkyLight};
 use crate::passes::gbuffer::GBuffer;
 use crate::scene::GpuScene;
-use radcache_shared::consts::{RecordSource, PATH_GRID_CELLS, SEED_SUB_FRAME_MUL};
+use radcache_shared::consts::{RecordSource, SEED_SUB_FRAME_MUL};
 use radcache_shared::gpu::IcCounters;
-use std::sync::atomic::{AtomicU32, Ordering};
+
+mod path_grid;
+use path_grid::PathGrid;
 
 /// The shader, relative to `shaders/`.
 pub const SHADER: &str = "passes/record.comp";
@@ -103,16 +105,6 @@ pub fn creation_seed(seed: u32, sub_frame: u32) -> u32 {
 /// (docs/irradiance-cache.md §2.3).
 pub fn record_seed(pixel_index: u32, seed: u32) -> u32 {
     ircache_hash(pixel_index ^ ircache_hash(seed))
-}
-
-/// The gather paths' radiance grid of a frame (`shaders/common/path_grid.glsl`,
-/// docs/cache-frame.md §4.1): `PATH_GRID_CELLS` cells of a key, a ready epoch and a count
-/// (`uvec4`) and three 64-bit fixed-point sums (`int64_t[4]`), cleared by
-/// [`RecordPass::record_grid_reset`]; each dispatch of new records takes the next epoch.
-struct PathGrid {
-    keys: Buffer,
-    sums: Buffer,
-    epoch: AtomicU32,
 }
 
 /// The record pipeline, its parameters and its ray counter.
@@ -231,35 +223,28 @@ impl RecordPass {
             &b::layout(),
             std::mem::size_of::<RecordPush>() as u32,
         )?;
-        let buffer = |name, size, usage, location| {
-            let alignment = 0;
-            let desc = BufferDesc {
-                name,
-                size,
-                usage,
-                location,
-                alignment,
-            };
-            Buffer::new(ctx, &desc)
+        let buffer = |name, location| {
+            Buffer::new(
+                ctx,
+                &BufferDesc {
+                    name,
+                    size: 16,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                    location,
+                    alignment: 0,
+                },
+            )
         };
-        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let (gpu, host) = (MemoryLocation::GpuOnly, MemoryLocation::GpuToCpu);
-        let cells = u64::from(PATH_GRID_CELLS);
-        let cleared = storage | vk::BufferUsageFlags::TRANSFER_DST;
         Ok(RecordPass {
             pipeline,
-            rays: buffer("records.ray_count", 16, storage, host)?,
+            rays: buffer("records.ray_count", MemoryLocation::GpuToCpu)?,
             // One vec4: too small for any request's strata, so nothing is dumped.
-            no_samples: buffer("records.no_samples", 16, storage, gpu)?,
-            no_radiance: buffer("records.no_radiance", 16, storage, gpu)?,
+            no_samples: buffer("records.no_samples", MemoryLocation::GpuOnly)?,
+            no_radiance: buffer("records.no_radiance", MemoryLocation::GpuOnly)?,
             params: *params,
             radiance,
             grid: if grid {
-                Some(PathGrid {
-                    keys: buffer("records.path_grid", cells * 16, cleared, gpu)?,
-                    sums: buffer("records.path_grid_sums", cells * 32, cleared, gpu)?,
-                    epoch: AtomicU32::new(0),
-                })
+                Some(PathGrid::new(ctx)?)
             } else {
                 None
             },
@@ -275,10 +260,7 @@ impl RecordPass {
     /// after it fill the grid again from the first epoch on.
     pub fn record_grid_reset(&self, rec: &mut Recorder) {
         if let Some(g) = &self.grid {
-            rec.fill_buffer(&g.keys, 0, vk::WHOLE_SIZE, 0);
-            rec.fill_buffer(&g.sums, 0, vk::WHOLE_SIZE, 0);
-            rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
-            g.epoch.store(0, Ordering::Relaxed);
+            g.record_reset(rec);
         }
     }
 
@@ -471,7 +453,7 @@ impl RecordPass {
             fine_n: p.fine_strata_n,
             // New records only: a refresh must draw its record's own paths again.
             grid_epoch: match (&self.grid, source) {
-                (Some(g), RecordSource::Pixels) => g.epoch.fetch_add(1, Ordering::Relaxed) + 1,
+                (Some(g), RecordSource::Pixels) => g.next_epoch(),
                 _ => 0,
             },
         };
