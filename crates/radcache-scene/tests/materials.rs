@@ -1,6 +1,7 @@
 //! Materials: KHR_materials_ior and KHR_materials_specular, the specification's default material,
 //! extensions radcache does not implement (named once, with a count), occlusion textures, a
-//! missing texture file, and which scenes need the full BRDF (`ScenePlan::specular`).
+//! missing texture file, and which scenes need the full BRDF (`ScenePlan::specular`; the bundled
+//! scenes' materials in `plan.rs`).
 
 mod common;
 
@@ -8,7 +9,6 @@ use std::path::PathBuf;
 
 use common::{load, shared_model, temp_dir, triangle_scene, warnings_of, write};
 use glam::{Vec3, Vec4};
-use radcache_scene::assets::write_bundled_assets;
 use radcache_scene::writer::{write_files, GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
 use radcache_scene::{Error, LoadOptions, Scene, WarningKind, IOR_INFINITE};
 use serde_json::{json, Value};
@@ -449,60 +449,6 @@ fn damaged_helmet_needs_the_full_brdf_and_has_an_unused_occlusion_map() {
         warnings_of(&w, WarningKind::MaterialExtensionIgnored),
         (0, 0)
     );
-}
-
-#[test]
-fn bundled_scenes_are_lambertian() {
-    let files = write_bundled_assets(&temp_dir("lambert")).unwrap();
-    assert!(files.len() >= 5);
-    let specular =
-        |p: &std::path::Path| p.ends_with("metal_spheres.gltf") || p.ends_with("glossy_room.gltf");
-    for path in files
-        .iter()
-        .filter(|p| p.extension().is_some_and(|e| e == "gltf") && !specular(p))
-    {
-        let (s, _) = load(path);
-        for m in &s.materials {
-            assert!(m.is_lambertian(), "{}: {m:?}", path.display());
-            assert_eq!(
-                (m.metallic, m.roughness, m.specular_factor),
-                (0.0, 1.0, 0.0)
-            );
-        }
-        let plan = s.plan();
-        assert!(!plan.specular, "{}", path.display());
-        assert!(plan
-            .to_string()
-            .contains("materials: lambertian only (no specular code compiled)"));
-        assert!(plan.path_grid(), "{}", path.display());
-        assert!(plan.to_string().contains("gather paths: radiance grid"));
-    }
-    // The bundled scenes with specular materials.
-    let spheres = files.iter().find(|p| p.ends_with("metal_spheres.gltf"));
-    let (s, _) = load(spheres.expect("metal_spheres is bundled"));
-    assert!(s.plan().specular);
-    assert_eq!(s.materials.iter().filter(|m| m.metallic == 1.0).count(), 2);
-    assert_eq!(s.plan().glossy_materials, 1, "the 0.6 sphere");
-    let glossy = files.iter().find(|p| p.ends_with("glossy_room.gltf"));
-    let (s, _) = load(glossy.expect("glossy_room is bundled"));
-    let plan = s.plan();
-    assert!(plan.specular && plan.radiance_cache());
-    assert!(plan.path_grid(), "its walls are Lambertian");
-    assert!(plan
-        .to_string()
-        .contains("gather paths: radiance grid at Lambertian vertices"));
-    // Gold 0.7, plastic 0.8 and the floor plate 0.65; the 0.4 sphere stays below the threshold.
-    assert_eq!(plan.glossy_materials, 3);
-    assert!(plan
-        .to_string()
-        .contains("glossy lobes: radiance records for roughness ≥ 0.6 (3 materials"));
-    // Cornell box, as bundled in the repository.
-    let cornell =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/cornell/cornell.gltf");
-    let (s, w) = load(&cornell);
-    assert!(w.is_empty(), "{w:?}");
-    assert!(s.materials.iter().all(|m| m.is_lambertian()));
-    assert!(!s.plan().specular);
 }
 
 #[test]

@@ -1,10 +1,14 @@
 //! The scene plan's animation classification (none / camera only / lights only / geometry), its
-//! time range, and its `Display` text.
+//! time range, and its `Display` text; the bundled scenes' materials and what the plan compiles
+//! for them (specular code, radiance records, the gathers' radiance grid).
 
 mod common;
 
+use std::path::PathBuf;
+
 use common::{close3, load, temp_dir, triangle_scene};
 use glam::Vec3;
+use radcache_scene::assets::write_bundled_assets;
 use radcache_scene::writer::{ChannelDesc, LightDesc, NodeDesc};
 use radcache_scene::{AnimationKind, EnvironmentKind, Interpolation, LightKind, Property, Scene};
 
@@ -137,4 +141,58 @@ fn animated_camera_and_plan_text() {
             "summary lacks {needle:?}:\n{summary}"
         );
     }
+}
+
+#[test]
+fn bundled_scenes_are_lambertian() {
+    let files = write_bundled_assets(&temp_dir("lambert")).unwrap();
+    assert!(files.len() >= 5);
+    let specular =
+        |p: &std::path::Path| p.ends_with("metal_spheres.gltf") || p.ends_with("glossy_room.gltf");
+    for path in files
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "gltf") && !specular(p))
+    {
+        let (s, _) = load(path);
+        for m in &s.materials {
+            assert!(m.is_lambertian(), "{}: {m:?}", path.display());
+            assert_eq!(
+                (m.metallic, m.roughness, m.specular_factor),
+                (0.0, 1.0, 0.0)
+            );
+        }
+        let plan = s.plan();
+        assert!(!plan.specular, "{}", path.display());
+        assert!(plan
+            .to_string()
+            .contains("materials: lambertian only (no specular code compiled)"));
+        assert!(plan.path_grid(), "{}", path.display());
+        assert!(plan.to_string().contains("gather paths: radiance grid"));
+    }
+    // The bundled scenes with specular materials.
+    let spheres = files.iter().find(|p| p.ends_with("metal_spheres.gltf"));
+    let (s, _) = load(spheres.expect("metal_spheres is bundled"));
+    assert!(s.plan().specular);
+    assert_eq!(s.materials.iter().filter(|m| m.metallic == 1.0).count(), 2);
+    assert_eq!(s.plan().glossy_materials, 1, "the 0.6 sphere");
+    let glossy = files.iter().find(|p| p.ends_with("glossy_room.gltf"));
+    let (s, _) = load(glossy.expect("glossy_room is bundled"));
+    let plan = s.plan();
+    assert!(plan.specular && plan.radiance_cache());
+    assert!(plan.path_grid(), "its walls are Lambertian");
+    assert!(plan
+        .to_string()
+        .contains("gather paths: radiance grid at Lambertian vertices"));
+    // Gold 0.7, plastic 0.8 and the floor plate 0.65; the 0.4 sphere stays below the threshold.
+    assert_eq!(plan.glossy_materials, 3);
+    assert!(plan
+        .to_string()
+        .contains("glossy lobes: radiance records for roughness ≥ 0.6 (3 materials"));
+    // Cornell box, as bundled in the repository.
+    let cornell =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/cornell/cornell.gltf");
+    let (s, w) = load(&cornell);
+    assert!(w.is_empty(), "{w:?}");
+    assert!(s.materials.iter().all(|m| m.is_lambertian()));
+    assert!(!s.plan().specular);
 }
