@@ -5,9 +5,10 @@
 // albedo/π × the estimate (emission itself is in the G-buffer's emission image). With
 // HAS_SPECULAR (a scene with non-Lambertian materials) the estimate weighs each sample with the
 // full BRDF (one_sample_brdf), and the specular lobe's indirect light is added, path traced
-// (specular_indirect); the written value is that reflected radiance. A pixel that per-pixel
-// adaptive anti-aliasing has stopped (G-buffer position w = −1, docs/cache-frame.md §7.2) is
-// no surface here: it traces nothing, and the composite skips it.
+// (specular_path) and pooled over the neighbourhood (specular_pooled); the written value is that
+// reflected radiance. A pixel that per-pixel adaptive anti-aliasing has stopped (G-buffer
+// position w = −1, docs/cache-frame.md §7.2) is no surface here: it traces nothing, and the
+// composite skips it.
 //
 // Sample g of a pixel (g = sub_frame · count + k; sub-frames continue the sequence) draws its random
 // numbers from Kronecker sequences (Roberts 2018, the R_d sequences: point g is fract(shift + g·α),
@@ -151,7 +152,7 @@ Reuse shadow_reuse(GSample g, ivec2 pixel) {
 #ifdef HAS_RADIANCE_CACHE
 // Radiance records for glossy lobes (docs/radiance-caching.md §6.2): where pc.radiance_cache is
 // set and the pixel's roughness is at least GLOSSY_ROUGHNESS_MIN, the specular lobe's indirect
-// light comes from the records (passes/splat_glossy.frag) instead of specular_indirect's paths,
+// light comes from the records (passes/splat_glossy.frag) instead of specular_path's paths,
 // and this pass writes the pixel's glossy world weights for that splat.
 #define GLOSSY_TABLE_BINDING B_DIRECT_GLOSSY_TABLE
 #include "../common/glossy.glsl"
@@ -189,6 +190,7 @@ struct PixelLight {
     bool reused;  // no emitter sample: sub-frame 0's answer stands (`Reuse`)
     uint punctual_seen;  // the traced punctual lights' visibility bits (`punctual_visible`)
     bool closed_form;  // the emitters' light in closed form (false: in the MIS, HAS_SPECULAR)
+    bool specular_paths;  // the specular lobe's indirect light by paths (HAS_SPECULAR)
 };
 
 // A pixel's light before anything is added (also a pixel without a surface).
@@ -202,10 +204,12 @@ PixelLight no_light() {
     light.reused = false;
     light.punctual_seen = 0u;
     light.closed_form = true;
+    light.specular_paths = false;
     return light;
 }
 
-PixelLight pixel_light(GSample g, ivec2 pixel) {
+// The surface of sample `g` as the light functions take it.
+Surface sample_surface(GSample g) {
     Surface s;
     s.position = g.position;
     s.geometric_normal = g.geometric;
@@ -213,6 +217,11 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     s.uv = TexCoords(0.0);
     s.material = g.material;
     s.front_face = true;
+    return s;
+}
+
+PixelLight pixel_light(GSample g, ivec2 pixel) {
+    Surface s = sample_surface(g);
     vec3 origin = offset_ray_origin(s.position, s.geometric_normal);
     uint index = pixel_index(pixel);
     PixelLight light = no_light();
@@ -292,28 +301,35 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     }
 #endif
 #ifdef HAS_SPECULAR
-    vec3 spec = vec3(0.0);
-    uint paths = max(pc.specular_paths, 1u);
+    // The specular lobe's indirect light: paths pooled over the neighbourhood (specular_pooled),
+    // where the lobe has light of its own and the radiance records do not take it.
+    light.specular_paths = f.m.metallic > 0.0 || f.m.specular_factor > 0.0;
 #ifdef HAS_RADIANCE_CACHE
     if (pc.radiance_cache != 0u && f.m.roughness >= GLOSSY_ROUGHNESS_MIN) {
         write_glossy_weights(index, f, normalize(frame.camera_position.xyz - g.position));
-        paths = 0u;
+        light.specular_paths = false;
     }
 #endif
-    for (uint k = 0u; k < paths; ++k) {
-        Rng spec_rng = rng_init(index, pc.sub_frame * paths + k, pc.seed ^ 0x5bd1e995u);
-        vec3 e = specular_indirect(s, f, origin, spec_rng);
-        if (!any(isnan(e)) && !any(isinf(e))) {
-            spec += e;
-        }
-    }
     light.rest = (n > 0u ? sum / float(n) : vec3(0.0)) +
-                 punctual_brdf(s, f, origin, reuse, light.punctual_seen) + spec / float(max(paths, 1u));
+                 punctual_brdf(s, f, origin, reuse, light.punctual_seen);
 #else
     light.rest = (n > 0u ? sum / float(n) : vec3(0.0)) + punctual(s, origin, reuse, light.punctual_seen);
 #endif
     return light;
 }
+
+// The workgroup index of the neighbour at `offset` from this invocation, or 64 outside it.
+uint neighbour_index(ivec2 offset) {
+    ivec2 q = ivec2(gl_LocalInvocationID.xy) + offset;
+    if (any(lessThan(q, ivec2(0))) || any(greaterThan(q, ivec2(7)))) {
+        return 64u;
+    }
+    return uint(q.y * 8 + q.x);
+}
+
+#ifdef HAS_SPECULAR
+#include "direct_specular.glsl"
+#endif
 
 #ifdef HAS_ANALYTIC_EMITTERS
 // The workgroup's pixels' sample sums, positions and normals, for the ratio's neighbourhood.
@@ -326,15 +342,6 @@ shared uint s_partial[64];  // 1 where the pixel is marked a penumbra (before di
 // Whether workgroup pixel `j` lies on the same surface as `g` (`on_surface_of`).
 bool same_surface(GSample g, uint j) {
     return s_position[j].w != 0.0 && on_surface_of(g, s_position[j].xyz, s_normal[j]);
-}
-
-// The workgroup index of the neighbour at `offset` from this invocation, or 64 outside it.
-uint neighbour_index(ivec2 offset) {
-    ivec2 q = ivec2(gl_LocalInvocationID.xy) + offset;
-    if (any(lessThan(q, ivec2(0))) || any(greaterThan(q, ivec2(7)))) {
-        return 64u;
-    }
-    return uint(q.y * 8 + q.x);
 }
 
 // The pixel's and its same-surface 3×3 neighbours' sample sums (within its 8×8 workgroup): the
@@ -368,6 +375,10 @@ void main() {
     if (g.surface) {
         light = pixel_light(g, pixel);
     }
+#ifdef HAS_SPECULAR
+    // Every invocation of the workgroup reaches the barriers inside (no early return above).
+    light.rest += specular_pooled(g, inside ? pixel_index(pixel) : 0u, light.specular_paths);
+#endif
     // Sub-frame 0's emitter word for the frozen copy (HIDDEN for all without analytic emitters).
     uint frozen_class = SHADOW_HIDDEN;
     vec3 e = light.rest;

@@ -275,32 +275,37 @@ vec3 punctual_brdf(Surface s, Bsdf f, vec3 origin, Reuse reuse, inout uint seen)
     return sum;
 }
 
-// The specular lobe's indirect light (path traced per pixel, unbiased; pc.specular_paths paths per
-// sub-frame, passes/direct.rs `specular_paths`): one direction
-// from the GGX visible normals, weighted by the specular lobe's f·cos/pdf, and the path that
-// continues from it with nothing counted on its first segment (the light straight from a source,
-// a constant sky in the records included, is one_sample_brdf's). The diffuse lobe's indirect
-// light is the cache's (passes/composite.comp).
-vec3 specular_indirect(Surface s, Bsdf f, vec3 origin, inout Rng rng) {
+// One path of the specular lobe's indirect light (path traced per pixel, unbiased; pc.specular_paths
+// paths per sub-frame, passes/direct.rs `specular_paths`): a direction from the GGX visible
+// normals, written to `sample_dir` (world, xyz) with its density (w; 0 where the draw left the
+// lobe or the surface: a sample worth 0), and the radiance `radiance` the path that continues
+// from it brings back, with nothing counted on its first segment (the light straight from a
+// source, a constant sky in the records included, is one_sample_brdf's). `specular_pooled` weighs
+// it by the lobe's f·cos/pdf. The diffuse lobe's indirect light is the cache's
+// (passes/composite.comp).
+void specular_path(Surface s, Bsdf f, vec3 origin, inout Rng rng, out vec4 sample_dir,
+                   out vec3 radiance) {
+    sample_dir = vec4(0.0);
+    radiance = vec3(0.0);
     float alpha = alpha_from_roughness(f.m.roughness);
     vec2 u = rng_next2(rng);
     vec3 l = brdf_normalize_or_z(brdf_reflect(f.v, sample_ggx_vndf(alpha, f.v, u.x, u.y)));
     float pdf = ggx_reflection_pdf(alpha, f.v, l);
     if (l.z < COS_MIN || !(pdf > 0.0)) {
-        return vec3(0.0);
+        return;
     }
-    vec3 weight = brdf_eval_lobes(f.m, f.v, l).specular * (l.z / pdf);
     Ray ray;
     ray.origin = origin;
     ray.dir = bsdf_world(f, l);
-    if (all(equal(weight, vec3(0.0))) || dot(ray.dir, s.geometric_normal) <= 0.0) {
-        return vec3(0.0);
+    if (dot(ray.dir, s.geometric_normal) <= 0.0) {
+        return;
     }
     PathState st = path_begin(ray, 0.0, false, 2u);
     while (!st.done) {
         path_step(st, rng);
     }
-    return weight * path_radiance(st);
+    sample_dir = vec4(ray.dir, pdf);
+    radiance = path_radiance(st);
 }
 #endif
 

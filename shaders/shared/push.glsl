@@ -17,7 +17,7 @@ struct DirectPush {
     uint specular_paths;
     uint radiance_cache;
     uint adaptive_shadows;
-    uint pad1;
+    uint specular_pool;
     uint pad2;
 };  // 32 bytes
 

@@ -183,6 +183,7 @@ pub fn ic_settings(ic: &IcArgs, size: (u32, u32), seed: u32) -> Result<IcSetting
         anti_aliasing: ic.anti_aliasing()?,
         splat: ic.splat_mode(),
         path_grid: ic.path_grid_mode(),
+        specular_paths: ic.specular_paths(),
         seed,
         ..defaults
     })

@@ -26,7 +26,7 @@ pub use frame::ic::{render_ic, IcRenderer};
 pub use frame::path::{render_path, Budget, FrameOutput, PathSettings, Progress};
 pub use frame::settings::{
     sub_frame_jitter, AntiAliasing, EmitterLight, EmitterShadows, GlossyLight, GlossySpacing,
-    IcDebug, IcSettings, IcStats, PathGridMode, SkyLight, SplatMode,
+    IcDebug, IcSettings, IcStats, PathGridMode, SkyLight, SpecularPaths, SplatMode,
 };
 pub use passes::aov::{render_aovs, AovPass, Aovs};
 pub use passes::composite::{CentreSamples, CompositePass};

@@ -353,7 +353,8 @@ impl fmt::Display for ScenePlan {
                 writeln!(
                     f,
                     "  glossy lobes: radiance records for roughness ≥ {GLOSSY_ROUGHNESS_MIN} \
-                     ({} material{}; sharper lobes path traced per pixel)",
+                     ({} material{}; sharper lobes path traced per pixel, the paths pooled over \
+                     each pixel's 3×3 neighbourhood)",
                     self.glossy_materials,
                     if self.glossy_materials == 1 { "" } else { "s" }
                 )?;
@@ -361,7 +362,8 @@ impl fmt::Display for ScenePlan {
                 writeln!(
                     f,
                     "  glossy lobes: none at roughness ≥ {GLOSSY_ROUGHNESS_MIN} (specular light \
-                     path traced per pixel; no radiance records)"
+                     path traced per pixel, the paths pooled over each pixel's 3×3 neighbourhood; \
+                     no radiance records)"
                 )?;
             }
         }

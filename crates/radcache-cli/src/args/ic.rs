@@ -6,7 +6,7 @@ use clap::{Args, ValueEnum};
 use radcache_cache::{ErrorControl, IcParams, Preset, WeightKind};
 use radcache_render::{
     AntiAliasing, EmitterLight, EmitterShadows, GlossyLight, GlossySpacing, PathGridMode, SkyLight,
-    SplatMode,
+    SpecularPaths, SplatMode,
 };
 
 /// Cache quality preset.
@@ -105,6 +105,15 @@ pub enum PathGridArg {
     Off,
 }
 
+/// Whose paths a pixel's specular lobe takes its indirect light from (docs/materials.md §10).
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpecularPathsArg {
+    /// Its own and those of its 3×3 neighbours whose lobes overlap its own (default).
+    Pooled,
+    /// Its own alone.
+    PerPixel,
+}
+
 /// What adaptive anti-aliasing's added sub-frames shade (docs/cache-frame.md §7.1, §7.2).
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AaScope {
@@ -201,6 +210,9 @@ pub struct IcArgs {
     /// Whether the records' gather paths share a radiance grid (`--method ic`).
     #[arg(long, value_enum, default_value_t = PathGridArg::On)]
     pub path_grid: PathGridArg,
+    /// Whose paths a pixel's specular lobe takes its indirect light from (`--method ic`).
+    #[arg(long, value_enum, default_value_t = SpecularPathsArg::Pooled)]
+    pub specular_paths: SpecularPathsArg,
 }
 
 fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T)> {
@@ -285,6 +297,14 @@ impl IcArgs {
         match self.path_grid {
             PathGridArg::On => PathGridMode::On,
             PathGridArg::Off => PathGridMode::Off,
+        }
+    }
+
+    /// Whose paths the specular lobes take.
+    pub fn specular_paths(&self) -> SpecularPaths {
+        match self.specular_paths {
+            SpecularPathsArg::Pooled => SpecularPaths::Pooled,
+            SpecularPathsArg::PerPixel => SpecularPaths::PerPixel,
         }
     }
 

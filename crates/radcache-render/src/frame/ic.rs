@@ -14,7 +14,8 @@ use radcache_vk::{Context, ShaderCompiler};
 use crate::error::{Error, Result};
 use crate::frame::path::{FrameOutput, Progress};
 use crate::frame::settings::{
-    EmitterShadows, GlossyLight, IcDebug, IcSettings, IcStats, PathGridMode, SplatMode,
+    EmitterShadows, GlossyLight, IcDebug, IcSettings, IcStats, PathGridMode, SpecularPaths,
+    SplatMode,
 };
 use crate::passes::composite::CompositePass;
 use crate::passes::direct::DirectPass;
@@ -134,7 +135,8 @@ impl IcRenderer {
                     EmitterShadows::Adaptive => Some(w * h),
                     EmitterShadows::Fixed => None,
                 },
-            )?,
+            )?
+            .with_specular_pool(settings.specular_paths == SpecularPaths::Pooled),
             splat: SplatPass::new(ctx, shaders, w, h)?,
             glossy,
             glossy_valid: true,

@@ -74,6 +74,24 @@ pub struct IcSettings {
     pub splat: SplatMode,
     /// Whether the gathers of new records share a radiance grid (docs/cache-frame.md §4.1).
     pub path_grid: PathGridMode,
+    /// Whose paths a pixel's specular lobe takes its indirect light from (docs/materials.md
+    /// §10). Must be set when the renderer is created.
+    pub specular_paths: SpecularPaths,
+}
+
+/// Whose paths estimate a pixel's specular indirect light (scenes with specular materials;
+/// docs/materials.md §10).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum SpecularPaths {
+    /// The pixel's own and those of the pixels of its 3×3 neighbourhood (within its 8×8
+    /// workgroup) on its surface, of its material, whose lobes point within twice the lobe's
+    /// width of its own: each weighed by the pixel's BRDF over the density it was drawn from.
+    /// Unbiased but for the radiance being seen from a point a pixel away; up to nine times the
+    /// paths per pixel for the rays of one.
+    #[default]
+    Pooled,
+    /// The pixel's own paths alone.
+    PerPixel,
 }
 
 /// How often a frame rendered with the cache splats its records (docs/cache-frame.md §6.5).
@@ -268,6 +286,7 @@ impl Default for IcSettings {
             anti_aliasing: None,
             splat: SplatMode::Once,
             path_grid: PathGridMode::On,
+            specular_paths: SpecularPaths::Pooled,
         }
     }
 }

@@ -36,8 +36,9 @@ radcache_shared::gpu_struct! {
         /// lights' shadow rays are left out there likewise
         /// ([`DirectPass::with_adaptive_shadows`]; docs/cache-frame.md §8.2).
         pub adaptive_shadows: u32 => "uint",
-        /// Padding.
-        pub pad1: u32 => "uint",
+        /// 1: a pixel's specular paths are pooled with those of its 3×3 neighbours whose lobes
+        /// overlap its own ([`DirectPass::with_specular_pool`]; docs/materials.md §10).
+        pub specular_pool: u32 => "uint",
         /// Padding.
         pub pad2: u32 => "uint",
     }
@@ -68,6 +69,8 @@ pub struct DirectPass {
     /// sub-frames so far, and what sub-frame 0 saw of them and of the punctual lights
     /// ([`DirectPass::with_adaptive_shadows`]).
     shadows: Option<Buffer>,
+    /// The specular paths are pooled over the neighbourhood ([`DirectPass::with_specular_pool`]).
+    specular_pool: bool,
 }
 
 impl std::fmt::Debug for DirectPass {
@@ -143,7 +146,19 @@ impl DirectPass {
             analytic: analytic.is_some(),
             punctual: scene.plan().has_punctual_lights(),
             shadows: None,
+            specular_pool: true,
         })
+    }
+
+    /// Whether a pixel's specular lobe takes its indirect light from its own paths alone
+    /// (`false`) or from those of the pixels of its 3×3 neighbourhood (within its 8×8 workgroup)
+    /// whose lobes overlap its own (`true`, the default; [`crate::SpecularPaths`]): each
+    /// neighbour's paths, weighed by this pixel's BRDF over the neighbour's density, are an
+    /// unbiased estimate of this pixel's integral but for the radiance being seen from a point a
+    /// pixel away (docs/materials.md §10).
+    pub fn with_specular_pool(mut self, pool: bool) -> DirectPass {
+        self.specular_pool = pool;
+        self
     }
 
     /// Makes a pass whose emitters' light is in closed form, or whose scene has punctual
@@ -238,7 +253,7 @@ impl DirectPass {
             specular_paths: specular_paths(samples),
             radiance_cache: u32::from(glossy.is_some()),
             adaptive_shadows: u32::from(shadows.is_some()),
-            pad1: 0,
+            specular_pool: u32::from(self.specular_pool),
             pad2: 0,
         };
         rec.pass("direct", |rec| {
