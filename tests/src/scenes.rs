@@ -75,6 +75,35 @@ pub fn plane_y(x: [f32; 2], z: [f32; 2], y: f32, material: usize) -> PrimitiveDe
     )
 }
 
+/// A vertical rectangle `[y0, y1] × [z0, z1]` at `x`, with vertex normals `(normal_x, 0, 0)`
+/// (±1: the side it faces), e.g. a coloured panel a hair in front of a side wall.
+pub fn plane_x(y: [f32; 2], z: [f32; 2], x: f32, normal_x: f32, material: usize) -> PrimitiveDesc {
+    PrimitiveDesc::triangles(
+        vec![
+            [x, y[0], z[0]],
+            [x, y[0], z[1]],
+            [x, y[1], z[1]],
+            [x, y[1], z[0]],
+        ],
+        Some(vec![[normal_x, 0.0, 0.0]; 4]),
+        vec![0, 1, 2, 0, 2, 3],
+        Some(material),
+    )
+}
+
+/// The materials of a closed test room lit from under its ceiling: Lambertian white (0.75) and
+/// red (0.7, 0.15, 0.1), and a double-sided emitter of radiance 12 (indices in that order).
+pub fn lit_room_materials(b: &mut GltfBuilder) -> [usize; 3] {
+    use radcache_scene::writer::MaterialDesc;
+    let white = b.add_material(&MaterialDesc::diffuse("white", [0.75, 0.75, 0.75]));
+    let red = b.add_material(&MaterialDesc::diffuse("red", [0.7, 0.15, 0.1]));
+    let light = b.add_material(&MaterialDesc {
+        double_sided: true,
+        ..MaterialDesc::emitter("light", [0.0; 3], [12.0; 3])
+    });
+    [white, red, light]
+}
+
 /// An axis-aligned cube of half-size `half` centred at the origin, faces outward (flat normals,
 /// counter-clockwise seen from outside).
 pub fn cube(half: f32, material: usize) -> PrimitiveDesc {

@@ -20,7 +20,8 @@ use radcache_render::{render_ic, FrameOutput, GpuScene, IcSettings};
 use radcache_scene::writer::{GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
 use radcache_scene::Scene;
 use radcache_tests::scenes::{
-    camera_node, pixel_to_ndc, plane_y, render, temp_dir, write_and_load,
+    camera_node, lit_room_materials, pixel_to_ndc, plane_x, plane_y, render, temp_dir,
+    write_and_load,
 };
 use radcache_tests::{context, finish, shaders};
 
@@ -341,12 +342,7 @@ fn a_mirror_reflects_two_emitters_with_schlick_fresnel() {
 fn spheres_room(tag: &str) -> Scene {
     use radcache_tests::geometry::{room, uv_sphere};
     let mut b = GltfBuilder::new();
-    let white = b.add_material(&MaterialDesc::diffuse("white", [0.75, 0.75, 0.75]));
-    let red = b.add_material(&MaterialDesc::diffuse("red", [0.7, 0.15, 0.1]));
-    let light = b.add_material(&MaterialDesc {
-        double_sided: true,
-        ..MaterialDesc::emitter("light", [0.0; 3], [12.0; 3])
-    });
+    let [white, red, light] = lit_room_materials(&mut b);
     let gold = b.add_material(&MaterialDesc::metal_rough(
         "gold",
         [0.95, 0.7, 0.35],
@@ -376,17 +372,7 @@ fn spheres_room(tag: &str) -> Scene {
     let mut prims = vec![
         tri(&walls, white, None),
         // A red panel on the left wall, a hair in front of it.
-        PrimitiveDesc::triangles(
-            vec![
-                [-0.999, -1.0, -1.0],
-                [-0.999, -1.0, 1.0],
-                [-0.999, 1.0, 1.0],
-                [-0.999, 1.0, -1.0],
-            ],
-            Some(vec![[1.0, 0.0, 0.0]; 4]),
-            vec![0, 1, 2, 0, 2, 3],
-            Some(red),
-        ),
+        plane_x([-1.0, 1.0], [-1.0, 1.0], -0.999, 1.0, red),
         plane_y([-0.3, 0.3], [-0.3, 0.3], 0.99, light),
     ];
     let mut sphere = |centre: Vec3, r: f32, material: usize| {

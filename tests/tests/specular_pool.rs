@@ -18,20 +18,17 @@ use radcache_render::{render_ic, FrameOutput, GpuScene, IcSettings, SpecularPath
 use radcache_scene::writer::{GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
 use radcache_scene::Scene;
 use radcache_tests::geometry::room;
-use radcache_tests::scenes::{camera_node, plane_y, render, temp_dir, write_and_load};
+use radcache_tests::scenes::{
+    camera_node, lit_room_materials, plane_x, plane_y, render, temp_dir, write_and_load,
+};
 use radcache_tests::{context, finish, shaders};
 
 /// The room (2 × 2 × 2, white), a red and a green panel on the side walls, a square emitter under
 /// the ceiling and a rough white metal plate on the floor, seen from the back wall looking down.
 fn plate_room(tag: &str) -> Scene {
     let mut b = GltfBuilder::new();
-    let white = b.add_material(&MaterialDesc::diffuse("white", [0.75, 0.75, 0.75]));
-    let red = b.add_material(&MaterialDesc::diffuse("red", [0.7, 0.15, 0.1]));
+    let [white, red, light] = lit_room_materials(&mut b);
     let green = b.add_material(&MaterialDesc::diffuse("green", [0.1, 0.6, 0.15]));
-    let light = b.add_material(&MaterialDesc {
-        double_sided: true,
-        ..MaterialDesc::emitter("light", [0.0; 3], [12.0; 3])
-    });
     let metal = b.add_material(&MaterialDesc::metal_rough(
         "metal",
         [0.9, 0.9, 0.9],
@@ -39,19 +36,6 @@ fn plate_room(tag: &str) -> Scene {
         0.5,
     ));
     let walls = room(Vec3::splat(-1.0), Vec3::splat(1.0));
-    let panel = |x: f32, normal: f32, material: usize| {
-        PrimitiveDesc::triangles(
-            vec![
-                [x, -1.0, -1.0],
-                [x, -1.0, 1.0],
-                [x, 1.0, 1.0],
-                [x, 1.0, -1.0],
-            ],
-            Some(vec![[normal, 0.0, 0.0]; 4]),
-            vec![0, 1, 2, 0, 2, 3],
-            Some(material),
-        )
-    };
     let prims = vec![
         PrimitiveDesc::triangles(
             walls.positions.iter().map(|p| p.to_array()).collect(),
@@ -59,8 +43,8 @@ fn plate_room(tag: &str) -> Scene {
             walls.indices.clone(),
             Some(white),
         ),
-        panel(-0.999, 1.0, red),
-        panel(0.999, -1.0, green),
+        plane_x([-1.0, 1.0], [-1.0, 1.0], -0.999, 1.0, red),
+        plane_x([-1.0, 1.0], [-1.0, 1.0], 0.999, -1.0, green),
         plane_y([-0.3, 0.3], [-0.3, 0.3], 0.99, light),
         plane_y([-0.999, 0.999], [-0.999, 0.999], -0.999, metal),
     ];
