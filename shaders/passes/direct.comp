@@ -347,18 +347,29 @@ bool same_surface(GSample g, uint j) {
 // The pixel's and its same-surface 3×3 neighbours' sample sums (within its 8×8 workgroup): the
 // visible fraction of the emitters' light at the pixel is Σ sum_visible / Σ sum_all over them
 // (docs/cache-frame.md §8.2).
+// A neighbour without samples adds nothing, so the surface test is made only where one has
+// some: after sub-frame 0 most of a frame casts no emitter ray (the shadow reuse), and there the
+// loop is skipped.
 void neighbourhood_sums(GSample g, PixelLight light, out vec3 all_sum, out vec3 visible) {
     all_sum = light.sum_all;
     visible = light.sum_visible;
-    for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-            uint j = neighbour_index(ivec2(dx, dy));
-            if ((dx == 0 && dy == 0) || j == 64u || !same_surface(g, j)) {
-                continue;
-            }
-            all_sum += s_sum_all[j];
-            visible += s_sum_visible[j];
+    uint with_samples = 0u;
+    for (int k = 0; k < 9; ++k) {
+        uint j = neighbour_index(ivec2(k % 3 - 1, k / 3 - 1));
+        if (k != 4 && j != 64u && any(greaterThan(s_sum_all[j], vec3(0.0)))) {
+            with_samples |= 1u << uint(k);
         }
+    }
+    if (with_samples == 0u) {
+        return;
+    }
+    for (int k = 0; k < 9; ++k) {
+        uint j = neighbour_index(ivec2(k % 3 - 1, k / 3 - 1));
+        if ((with_samples & (1u << uint(k))) == 0u || !same_surface(g, j)) {
+            continue;
+        }
+        all_sum += s_sum_all[j];
+        visible += s_sum_visible[j];
     }
 }
 #endif
@@ -433,12 +444,18 @@ void main() {
         bool mark = own == SHADOW_PENUMBRA || (pc.sub_frame > 0u && g.surface && own != light.seen);
         s_partial[lid] = mark ? 1u : 0u;
         barrier();
-        for (int dy = -1; dy <= 1 && g.surface && !mark; ++dy) {
-            for (int dx = -1; dx <= 1; ++dx) {
-                uint j = neighbour_index(ivec2(dx, dy));
-                if (j != 64u && s_partial[j] != 0u && same_surface(g, j)) {
-                    mark = true;
-                }
+        // The surface test only toward marked neighbours (few: penumbrae and what changed).
+        uint marked = 0u;
+        for (int k = 0; k < 9; ++k) {
+            uint j = neighbour_index(ivec2(k % 3 - 1, k / 3 - 1));
+            if (j != 64u && s_partial[j] != 0u) {
+                marked |= 1u << uint(k);
+            }
+        }
+        for (int k = 0; k < 9 && marked != 0u && g.surface && !mark; ++k) {
+            uint j = neighbour_index(ivec2(k % 3 - 1, k / 3 - 1));
+            if ((marked & (1u << uint(k))) != 0u && same_surface(g, j)) {
+                mark = true;
             }
         }
         frozen_class = mark ? SHADOW_PENUMBRA : own;
