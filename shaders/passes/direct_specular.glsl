@@ -1,7 +1,8 @@
 // passes/direct_specular.glsl — included by passes/direct.comp (Rust:
 // crates/radcache-render/src/passes/direct.rs), with HAS_SPECULAR: the specular lobe's indirect
 // light, its paths (direct_light.glsl's specular_path) pooled over the pixel's neighbourhood.
-// Needs the pass's push constants (pc), neighbour_index, on_surface_of and sample_surface.
+// Needs the pass's push constants (pc), neighbour_index (direct_neighbourhood.glsl), on_surface_of
+// and sample_surface.
 #ifndef RADCACHE_DIRECT_SPECULAR_GLSL
 #define RADCACHE_DIRECT_SPECULAR_GLSL
 
