@@ -16,7 +16,11 @@
 // that are final. The sums are 64-bit fixed point (PATH_GRID_SCALE steps per unit), whose
 // addition is exact and commutative: the records do not depend on the order of the invocations.
 // Keys go to the first free slot of PATH_GRID_PROBES by linear probing; a key that finds none is
-// served by full paths.
+// served by full paths. A lookup looks through all its probes for its key before it inserts, so
+// a key has one cell, found whatever order the invocations run in, also where the grid's
+// ageing freed slots (docs/temporal.md §3.8). The host clears the grid at the start of a frame, or, where it is kept
+// over frames with the records (docs/temporal.md §3.8), one slice of it; epochs then go on
+// counting, so cells made ready in earlier frames are read.
 #ifndef RADCACHE_PATH_GRID_GLSL
 #define RADCACHE_PATH_GRID_GLSL
 
@@ -65,6 +69,16 @@ uint path_grid_slot(vec3 p, vec3 ng, out float edge) {
     uint h = pcg_hash(uint(c.x) ^ pcg_hash(uint(c.y) ^ pcg_hash(uint(c.z)
              ^ pcg_hash(uint(level + 128) | ((2u * axis + side) << 8u)))));
     uint tag = pcg_hash(h ^ 0x5bd1e995u) | 1u;
+    // The key's cell, wherever among its probes it was inserted: where the grid is kept over
+    // frames, the slot of an aged-out key before it may be free again, and a key that stopped
+    // there would insert a second, empty cell for itself in one order of the invocations and
+    // read its old one in another.
+    for (uint i = 0u; i < PATH_GRID_PROBES; ++i) {
+        uint slot = (h + i) & (PATH_GRID_CELLS - 1u);
+        if (grid_keys[slot].x == tag) {
+            return slot;
+        }
+    }
     for (uint i = 0u; i < PATH_GRID_PROBES; ++i) {
         uint slot = (h + i) & (PATH_GRID_CELLS - 1u);
         uint k = grid_keys[slot].x;

@@ -57,7 +57,8 @@
 //
 // Radiance grid (PATH_GRID, docs/cache-frame.md §4.1; common/path_grid.glsl): with a nonzero
 // grid_epoch, a gather path's vertex whose cell of the grid is ready (filled by earlier
-// dispatches of the frame) ends the path with the cell's mean continuation radiance, and a path
+// dispatches: of the frame, or of earlier frames where the grid is kept with the records,
+// docs/temporal.md §3.8) ends the path with the cell's mean continuation radiance, and a path
 // that continued from its first hit deposits what it found there into that hit's cell.
 //
 // Optional sample dump (tests): when the buffer bound at B_GBUFFER_END + 4 holds at least

@@ -16,7 +16,7 @@
 //! | `creation_strictness` | 0.7 | 0.7 | 0.7 | docs/cache-frame.md §3.2: create at `a·0.7` (Ward) or `κ/0.7` (T&L) |
 //! | `front_tolerance_px` | 0.5 | 0.5 | 0.5 | §5.4: in-front tolerance `0.5·s(p)` |
 //! | `temporal_accuracy` (`a_t`) | 0.1 | 0.05 | 0.02 | docs/temporal.md §3.3 |
-//! | `max_age_frames` (`Δt_max`) | 5 | 30 | 15 | docs/temporal.md §3.3; draft measured (below) |
+//! | `max_age_frames` (`Δt_max`) | 8 | 30 | 15 | docs/temporal.md §3.3; draft measured (below) |
 //!
 //! Draft's `Δt_max` of 20 frames was measured with `cargo xtask bench temporal` (animated scene,
 //! 60 frames at 256²): 60 frames gave 9.3 % of a per-frame rebuild's record rays but 3.9× its
@@ -29,7 +29,11 @@
 //! each evaluation and are listed the frame before their lifespan ends (2026-12-05), 5 frames
 //! give the per-frame rebuild's error (own relMSE 1.45e-3 against 1.46e-3, less flicker) with 26 %
 //! of its record rays and 48 % of all its rays; 8 frames 18 % and 1.54e-3; 20 frames about 2.6e-3
-//! (docs/temporal.md §5).
+//! (docs/temporal.md §5). Since kept records gather through the radiance grid kept over frames
+//! (2026-12-06, docs/temporal.md §3.8), their error is below the rebuild's and draft's `Δt_max`
+//! is 8: `cargo xtask bench temporal --max-age 5|8` gave own relMSE 8.93e-4 and 9.55e-4 against
+//! the rebuild's 1.139e-3, with 16.9 % and 11.4 % of its record rays, and kept frames of 53.2 %
+//! and 49.5 % of its time.
 //!
 //! Draft trades accuracy for speed (2.25× fewer rays at the coarse levels, bigger zones, fewer
 //! refreshes); high halves the ray noise (4× rays), shrinks zones and refreshes more often. On
@@ -186,7 +190,7 @@ impl IcParams {
                 hole_threshold: 0.25,
                 levels: 5,
                 temporal_accuracy: 0.1,
-                max_age_frames: 5.0,
+                max_age_frames: 8.0,
                 ..base
             },
             Preset::High => Self {

@@ -441,6 +441,14 @@ impl fmt::Display for ScenePlan {
             "records kept with lifespans (moving geometry or lights: records follow their \
              instances, are extrapolated in time and refreshed in place when they expire)"
         };
-        writeln!(f, "  cache across frames: {cache}")
+        writeln!(f, "  cache across frames: {cache}")?;
+        if !self.keeps_records() && self.path_grid() {
+            writeln!(
+                f,
+                "  radiance grid across frames: kept with the records, each cell at most the \
+                 records' longest life old"
+            )?;
+        }
+        Ok(())
     }
 }

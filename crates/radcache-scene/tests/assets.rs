@@ -266,6 +266,10 @@ fn animated_scene() {
         text.contains("cache across frames: records kept with lifespans"),
         "{text}"
     );
+    assert!(
+        text.contains("radiance grid across frames: kept with the records"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -285,6 +289,7 @@ fn cornell_fly_through_moves_only_the_camera() {
     let plan = s.plan();
     assert_eq!(plan.animation.kind, AnimationKind::CameraOnly);
     assert!(plan.keeps_records());
+    assert!(!s.to_string().contains("radiance grid across frames"));
     // The same room under another camera: the same content (a cache file of one serves the
     // other); the animated room is other content.
     assert_eq!(s.content_hash(), cornell.content_hash());

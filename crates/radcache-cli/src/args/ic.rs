@@ -168,7 +168,7 @@ pub struct IcArgs {
     #[arg(long, value_name = "A_T")]
     pub temporal_accuracy: Option<f32>,
     /// The longest life of a record kept across frames with moving geometry or lights, in
-    /// frames (`Δt_max`); default 5 (draft), 30 (default), 15 (high); docs/temporal.md §3.3.
+    /// frames (`Δt_max`); default 8 (draft), 30 (default), 15 (high); docs/temporal.md §3.3.
     #[arg(long, value_name = "FRAMES")]
     pub max_age: Option<f32>,
     /// Jittered sub-frames of the cache (anti-aliasing); default 8.

@@ -14,8 +14,7 @@ use radcache_vk::{Context, ShaderCompiler};
 use crate::error::{Error, Result};
 use crate::frame::path::{FrameOutput, Progress};
 use crate::frame::settings::{
-    EmitterShadows, GlossyLight, IcDebug, IcSettings, IcStats, PathGridMode, SpecularPaths,
-    SplatMode,
+    EmitterShadows, GlossyLight, IcDebug, IcSettings, IcStats, SpecularPaths, SplatMode,
 };
 use crate::passes::composite::CompositePass;
 use crate::passes::direct::DirectPass;
@@ -150,13 +149,7 @@ impl IcRenderer {
                 settings.sky,
                 radiance,
                 settings.glossy_spacing,
-                // Records kept over frames are refreshed by full paths, which must reproduce
-                // them (docs/temporal.md §3.5): made with the grid, they would not.
-                if temporal {
-                    PathGridMode::Off
-                } else {
-                    settings.path_grid
-                },
+                settings.path_grid,
             )?,
             composite: CompositePass::with_options(
                 ctx,

@@ -264,6 +264,16 @@ impl RecordPass {
         }
     }
 
+    /// Ages the radiance grid kept over frames (the first step of frame `frame` of a renderer
+    /// that keeps records with lifespans; nothing without a grid): clears the slice of it that
+    /// makes every cell at most `life` frames old (docs/temporal.md §3.8). The other cells stay,
+    /// ready ones included, and this frame's gathers and refreshes read them.
+    pub fn record_grid_age(&self, rec: &mut Recorder, frame: u32, life: u32) {
+        if let Some(g) = &self.grid {
+            g.record_age(rec, frame, life);
+        }
+    }
+
     /// The parameters the pass was built with.
     pub fn params(&self) -> &IcParams {
         &self.params
@@ -451,11 +461,8 @@ impl RecordPass {
             fine_level: p.fine_level(),
             fine_m: p.fine_strata_m,
             fine_n: p.fine_strata_n,
-            // New records only: a refresh must draw its record's own paths again.
-            grid_epoch: match (&self.grid, source) {
-                (Some(g), RecordSource::Pixels) => g.next_epoch(),
-                _ => 0,
-            },
+            // New records and refreshes alike (docs/temporal.md §3.8).
+            grid_epoch: self.grid.as_ref().map_or(0, |g| g.next_epoch()),
         };
         for image in gbuffer.images() {
             rec.use_image(image, ImageUse::ComputeStorage);

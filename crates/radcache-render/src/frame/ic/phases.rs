@@ -132,7 +132,15 @@ impl IcRenderer {
         let temporal = settings.time_step_s > 0.0;
         let mut rec = ctx.begin("ic.setup")?;
         gpu.record_update(ctx, &mut rec)?;
-        self.records.record_grid_reset(&mut rec);
+        // Records kept with lifespans keep the radiance grid too: the frame ages it by a slice,
+        // so that no cell is older than a record may be (`Δt_max`, docs/temporal.md §3.8).
+        let lifespans = self.temporal.as_ref().is_some_and(|t| t.lifespans());
+        if temporal && lifespans && self.has_records {
+            let life = self.params.max_age_frames.round().max(1.0) as u32;
+            self.records.record_grid_age(&mut rec, now, life);
+        } else {
+            self.records.record_grid_reset(&mut rec);
+        }
         if !self.has_records {
             self.state.record_reset(&mut rec)?;
         }

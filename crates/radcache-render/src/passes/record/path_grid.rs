@@ -1,14 +1,22 @@
-//! The gather paths' radiance grid of a frame (`shaders/common/path_grid.glsl`,
-//! docs/cache-frame.md §4.1): `PATH_GRID_CELLS` cells of a key, a ready epoch and a count
-//! (`uvec4`) and three 64-bit fixed-point sums (`int64_t[4]`), cleared at the start of each
-//! frame; each dispatch of new records takes the next epoch.
+//! The gather paths' radiance grid (`shaders/common/path_grid.glsl`, docs/cache-frame.md §4.1):
+//! `PATH_GRID_CELLS` cells of a key, a ready epoch and a count (`uvec4`) and three 64-bit
+//! fixed-point sums (`int64_t[4]`). A frame whose records are not kept over time clears it at its
+//! start; a renderer that keeps records with lifespans (temporal caching) keeps it over frames
+//! and clears a slice of it per frame instead ([`PathGrid::record_age`], docs/temporal.md §3.8).
+//! Each dispatch that uses it takes the next epoch; epochs keep counting across frames until a
+//! whole reset.
 
+use std::ops::Range;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use radcache_shared::consts::PATH_GRID_CELLS;
 use radcache_vk::{vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Recorder};
 
 use crate::error::Result;
+
+/// Bytes per cell of the key buffer (`uvec4`) and of the sums (`int64_t[4]`).
+const KEY_BYTES: u64 = 16;
+const SUM_BYTES: u64 = 32;
 
 /// The grid's buffers and the epoch of the next dispatch.
 pub(super) struct PathGrid {
@@ -32,8 +40,8 @@ impl PathGrid {
             Buffer::new(ctx, &desc)
         };
         Ok(PathGrid {
-            keys: buffer("records.path_grid", cells * 16)?,
-            sums: buffer("records.path_grid_sums", cells * 32)?,
+            keys: buffer("records.path_grid", cells * KEY_BYTES)?,
+            sums: buffer("records.path_grid_sums", cells * SUM_BYTES)?,
             epoch: AtomicU32::new(0),
         })
     }
@@ -46,9 +54,53 @@ impl PathGrid {
         self.epoch.store(0, Ordering::Relaxed);
     }
 
-    /// The epoch of the next dispatch of new records (from 1; 0 tells the shader the grid is
-    /// off).
+    /// Clears the slice of the grid that frame `frame` ages out ([`aged_slots`]): with the grid
+    /// kept over frames, no cell is older than `life` frames. Epochs go on counting, so a cell
+    /// that became ready in an earlier frame is read by every dispatch of this one.
+    pub(super) fn record_age(&self, rec: &mut Recorder, frame: u32, life: u32) {
+        let slots = aged_slots(frame, life);
+        let (first, count) = (u64::from(slots.start), u64::from(slots.len() as u32));
+        rec.fill_buffer(&self.keys, first * KEY_BYTES, count * KEY_BYTES, 0);
+        rec.fill_buffer(&self.sums, first * SUM_BYTES, count * SUM_BYTES, 0);
+        rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
+    }
+
+    /// The epoch of the next dispatch (from 1; 0 tells the shader the grid is off).
     pub(super) fn next_epoch(&self) -> u32 {
         self.epoch.fetch_add(1, Ordering::Relaxed) + 1
+    }
+}
+
+/// The slots frame `frame` clears when the grid lives over frames: slice `frame mod life` of
+/// `life` equal slices of the table. Every slot is cleared once in any `life` consecutive
+/// frames, so a cell holds no continuation older than that. A cleared slot is free for any key;
+/// a key inserted past it earlier is still found, since a lookup looks through all its probes
+/// before it inserts (`path_grid_slot`).
+pub(super) fn aged_slots(frame: u32, life: u32) -> Range<u32> {
+    let (n, life) = (
+        u64::from(PATH_GRID_CELLS),
+        u64::from(life.clamp(1, PATH_GRID_CELLS)),
+    );
+    let part = u64::from(frame) % life;
+    (part * n / life) as u32..((part + 1) * n / life) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_slot_is_cleared_once_within_its_life() {
+        for life in [1, 2, 5, 7, 30] {
+            let mut cleared = vec![0u32; PATH_GRID_CELLS as usize];
+            // One life of frames, from an arbitrary frame number.
+            for frame in 1000..1000 + life {
+                for s in aged_slots(frame, life) {
+                    cleared[s as usize] += 1;
+                }
+            }
+            assert!(cleared.iter().all(|&c| c == 1), "life {life}");
+        }
+        assert_eq!(aged_slots(3, 1), 0..PATH_GRID_CELLS);
     }
 }
