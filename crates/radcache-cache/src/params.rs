@@ -32,7 +32,7 @@
 //! (docs/temporal.md §5). Since kept records gather through the radiance grid kept over frames
 //! (2026-12-06, docs/temporal.md §3.8), their error is below the rebuild's and draft's `Δt_max`
 //! is 8: `cargo xtask bench temporal --max-age 5|8` gave own relMSE 8.93e-4 and 9.55e-4 against
-//! the rebuild's 1.139e-3, with 16.9 % and 11.4 % of its record rays, and kept frames of 53.2 %
+//! the rebuild's 1.139e-3, with 16.9 % and 11.4 % of its record rays, and kept frames of 52.8 %
 //! and 49.5 % of its time.
 //!
 //! Draft trades accuracy for speed (2.25× fewer rays at the coarse levels, bigger zones, fewer

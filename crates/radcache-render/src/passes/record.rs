@@ -170,9 +170,8 @@ impl RecordPass {
     /// As [`RecordPass::with_radiance`], the records for glossy lobes spaced by `spacing`
     /// (docs/radiance-caching.md §9; `GLOSSY_DENSITY` with [`GlossySpacing::Lobe`]); with
     /// [`PathGridMode::On`] and a scene whose plan allows it (`ScenePlan::path_grid`: some
-    /// material is Lambertian) the gathers of new records share a radiance grid (`PATH_GRID`,
-    /// docs/cache-frame.md §4.1), which [`RecordPass::record_grid_reset`] clears at the start of
-    /// each frame.
+    /// material is Lambertian) the gathers share a radiance grid (`PATH_GRID`, docs/cache-frame.md
+    /// §4.1), which [`RecordPass::record_grid_frame`] readies at the start of each frame.
     #[allow(clippy::too_many_arguments)]
     pub fn with_options(
         ctx: &Context,
@@ -256,21 +255,15 @@ impl RecordPass {
         self.grid.is_some()
     }
 
-    /// Clears the radiance grid (a frame's first step; nothing without one): the dispatches
-    /// after it fill the grid again from the first epoch on.
-    pub fn record_grid_reset(&self, rec: &mut Recorder) {
-        if let Some(g) = &self.grid {
-            g.record_reset(rec);
-        }
-    }
-
-    /// Ages the radiance grid kept over frames (the first step of frame `frame` of a renderer
-    /// that keeps records with lifespans; nothing without a grid): clears the slice of it that
-    /// makes every cell at most `life` frames old (docs/temporal.md §3.8). The other cells stay,
-    /// ready ones included, and this frame's gathers and refreshes read them.
-    pub fn record_grid_age(&self, rec: &mut Recorder, frame: u32, life: u32) {
-        if let Some(g) = &self.grid {
-            g.record_age(rec, frame, life);
+    /// Readies the radiance grid for a frame (its first step; nothing without a grid): clears it,
+    /// or with `age = Some((frame, life))` (a renderer that keeps records with lifespans,
+    /// docs/temporal.md §3.8) clears only the slice that keeps every cell at most `life` frames
+    /// old; the other cells, ready ones included, serve this frame's gathers and refreshes.
+    pub fn record_grid_frame(&self, rec: &mut Recorder, age: Option<(u32, u32)>) {
+        match (&self.grid, age) {
+            (Some(g), Some((frame, life))) => g.record_age(rec, frame, life),
+            (Some(g), None) => g.record_reset(rec),
+            (None, _) => {}
         }
     }
 

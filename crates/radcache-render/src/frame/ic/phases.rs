@@ -135,12 +135,9 @@ impl IcRenderer {
         // Records kept with lifespans keep the radiance grid too: the frame ages it by a slice,
         // so that no cell is older than a record may be (`Δt_max`, docs/temporal.md §3.8).
         let lifespans = self.temporal.as_ref().is_some_and(|t| t.lifespans());
-        if temporal && lifespans && self.has_records {
-            let life = self.params.max_age_frames.round().max(1.0) as u32;
-            self.records.record_grid_age(&mut rec, now, life);
-        } else {
-            self.records.record_grid_reset(&mut rec);
-        }
+        let life = self.params.max_age_frames.round().max(1.0) as u32;
+        let age = (temporal && lifespans && self.has_records).then_some((now, life));
+        self.records.record_grid_frame(&mut rec, age);
         if !self.has_records {
             self.state.record_reset(&mut rec)?;
         }
