@@ -7,7 +7,7 @@
 //! whole reset.
 
 use std::ops::Range;
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use radcache_shared::consts::PATH_GRID_CELLS;
 use radcache_vk::{vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Recorder};
@@ -18,11 +18,13 @@ use crate::error::Result;
 const KEY_BYTES: u64 = 16;
 const SUM_BYTES: u64 = 32;
 
-/// The grid's buffers and the epoch of the next dispatch.
+/// The grid's buffers, the epoch of the next dispatch, and whether a whole clear has been
+/// recorded since they were allocated (their memory is undefined until then).
 pub(super) struct PathGrid {
     pub(super) keys: Buffer,
     pub(super) sums: Buffer,
     epoch: AtomicU32,
+    cleared: AtomicBool,
 }
 
 impl PathGrid {
@@ -43,6 +45,7 @@ impl PathGrid {
             keys: buffer("records.path_grid", cells * KEY_BYTES)?,
             sums: buffer("records.path_grid_sums", cells * SUM_BYTES)?,
             epoch: AtomicU32::new(0),
+            cleared: AtomicBool::new(false),
         })
     }
 
@@ -52,12 +55,19 @@ impl PathGrid {
         rec.fill_buffer(&self.sums, 0, vk::WHOLE_SIZE, 0);
         rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
         self.epoch.store(0, Ordering::Relaxed);
+        self.cleared.store(true, Ordering::Relaxed);
     }
 
     /// Clears the slice of the grid that frame `frame` ages out ([`aged_slots`]): with the grid
     /// kept over frames, no cell is older than `life` frames. Epochs go on counting, so a cell
-    /// that became ready in an earlier frame is read by every dispatch of this one.
+    /// that became ready in an earlier frame is read by every dispatch of this one. A grid never
+    /// cleared yet (a renderer whose first frame starts from records imported from a cache file)
+    /// is cleared whole.
     pub(super) fn record_age(&self, rec: &mut Recorder, frame: u32, life: u32) {
+        if !self.cleared.load(Ordering::Relaxed) {
+            self.record_reset(rec);
+            return;
+        }
         let slots = aged_slots(frame, life);
         let (first, count) = (u64::from(slots.start), u64::from(slots.len() as u32));
         rec.fill_buffer(&self.keys, first * KEY_BYTES, count * KEY_BYTES, 0);
