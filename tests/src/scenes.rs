@@ -186,6 +186,28 @@ pub fn meshes_camera_light_scene(
     write_and_load(&b, &temp_dir(name), name)
 }
 
+/// The scene `name` of one node `node` holding `b`'s mesh `mesh` and a camera node
+/// ([`camera_node`]: position, rotation, vertical field of view), with the scene's `extras`
+/// (an environment, say), written and loaded back.
+pub fn mesh_camera_scene(
+    mut b: GltfBuilder,
+    name: &str,
+    (node, mesh): (&str, usize),
+    camera: (Vec3, Quat, f32),
+    extras: Option<serde_json::Value>,
+) -> Scene {
+    let roots = vec![
+        b.add_node(&NodeDesc {
+            name: Some(node.into()),
+            mesh: Some(mesh),
+            ..NodeDesc::default()
+        }),
+        camera_node(&mut b, camera.0, camera.1, camera.2),
+    ];
+    b.add_scene(name, &roots, extras);
+    write_and_load(&b, &temp_dir(name), name)
+}
+
 /// Image-space position (pixels, x right, y down, origin at the top-left corner) of NDC point
 /// `(x, y)` with y up, for a `width × height` image.
 pub fn ndc_to_pixel(x: f32, y: f32, width: u32, height: u32) -> (f64, f64) {

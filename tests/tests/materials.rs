@@ -20,8 +20,8 @@ use radcache_render::{render_ic, FrameOutput, GpuScene, IcSettings};
 use radcache_scene::writer::{GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
 use radcache_scene::Scene;
 use radcache_tests::scenes::{
-    camera_node, lit_room_materials, pixel_to_ndc, plane_x, plane_y, render, temp_dir,
-    write_and_load,
+    camera_node, lit_room_materials, mesh_camera_scene, pixel_to_ndc, plane_x, plane_y, render,
+    temp_dir, write_and_load,
 };
 use radcache_tests::{context, finish, shaders};
 
@@ -64,22 +64,13 @@ fn sky_plane(tag: &str, mat: &MaterialDesc, pitch: f32, yfov: f32) -> Scene {
     let mut b = GltfBuilder::new();
     let m = b.add_material(mat);
     let mesh = b.add_mesh("plane", &[plane_y([-40.0, 40.0], [-40.0, 40.0], 0.0, m)]);
-    let roots = vec![
-        b.add_node(&NodeDesc {
-            name: Some("plane".into()),
-            mesh: Some(mesh),
-            ..NodeDesc::default()
-        }),
-        camera_node(
-            &mut b,
-            Vec3::new(0.0, 1.5, 3.0),
-            Quat::from_rotation_x(-pitch),
-            yfov,
-        ),
-    ];
+    let camera = (
+        Vec3::new(0.0, 1.5, 3.0),
+        Quat::from_rotation_x(-pitch),
+        yfov,
+    );
     let extras = serde_json::json!({"environment": {"radiance": [1.0, 1.0, 1.0]}});
-    b.add_scene(tag, &roots, Some(extras));
-    write_and_load(&b, &temp_dir(tag), tag)
+    mesh_camera_scene(b, tag, ("plane", mesh), camera, Some(extras))
 }
 
 /// `n·v` of the camera ray through the centre of pixel (px, py) on the plane y = 0 (normal +Y).

@@ -15,12 +15,10 @@ use glam::{Quat, Vec3};
 use radcache_cache::IcParams;
 use radcache_image::{compare, Image};
 use radcache_render::{render_ic, FrameOutput, GpuScene, IcSettings, SpecularPaths};
-use radcache_scene::writer::{GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
+use radcache_scene::writer::{GltfBuilder, MaterialDesc, PrimitiveDesc};
 use radcache_scene::Scene;
 use radcache_tests::geometry::room;
-use radcache_tests::scenes::{
-    camera_node, lit_room_materials, plane_x, plane_y, render, temp_dir, write_and_load,
-};
+use radcache_tests::scenes::{lit_room_materials, mesh_camera_scene, plane_x, plane_y, render};
 use radcache_tests::{context, finish, shaders};
 
 /// The room (2 × 2 × 2, white), a red and a green panel on the side walls, a square emitter under
@@ -49,21 +47,8 @@ fn plate_room(tag: &str) -> Scene {
         plane_y([-0.999, 0.999], [-0.999, 0.999], -0.999, metal),
     ];
     let mesh = b.add_mesh("room", &prims);
-    let roots = vec![
-        b.add_node(&NodeDesc {
-            name: Some("room".into()),
-            mesh: Some(mesh),
-            ..NodeDesc::default()
-        }),
-        camera_node(
-            &mut b,
-            Vec3::new(0.0, 0.3, 0.99),
-            Quat::from_rotation_x(-0.7),
-            1.0,
-        ),
-    ];
-    b.add_scene(tag, &roots, None);
-    write_and_load(&b, &temp_dir(tag), tag)
+    let camera = (Vec3::new(0.0, 0.3, 0.99), Quat::from_rotation_x(-0.7), 1.0);
+    mesh_camera_scene(b, tag, ("room", mesh), camera, None)
 }
 
 fn image(o: &FrameOutput) -> Image {
