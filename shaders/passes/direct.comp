@@ -8,7 +8,9 @@
 // (specular_path) and pooled over the neighbourhood (specular_pooled); the written value is that
 // reflected radiance. A pixel that per-pixel adaptive anti-aliasing has stopped (G-buffer
 // position w = −1, docs/cache-frame.md §7.2) is no surface here: it traces nothing, and the
-// composite skips it.
+// composite skips it. With DIRECT_COMPOSITE and pc.composite (the later sub-frames of a frame
+// splatted once, docs/cache-frame.md §6.5) the pass adds the sample to the frame's accumulators
+// itself (composite_sample.glsl, as passes/composite.comp would) instead of writing the image.
 //
 // Sample g of a pixel (g = sub_frame · count + k; sub-frames continue the sequence) draws its random
 // numbers from Kronecker sequences (Roberts 2018, the R_d sequences: point g is fract(shift + g·α),
@@ -31,15 +33,23 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant) uniform Push { DirectPush pc; };
 
 layout(binding = B_DIRECT_RAY_COUNT, std430) buffer RayCount { uint ray_count; };
-// With pc.adaptive_shadows, three words a pixel (docs/cache-frame.md §8.2): 3i, what its
-// neighbourhood saw of the emitters in this frame's sub-frames so far (written at sub-frame 0,
-// raised to a penumbra by later ones); 3i + 1, what sub-frame 0 saw, frozen for the later
-// sub-frames to compare with the neighbours': the emitters' word (bits 0–1, SHADOW_NONE where
-// the pixel was no surface) and the visibility of punctual lights 0 … REUSED_LIGHTS − 1 (bit
-// 2 + i set where light i's shadow ray was unoccluded); 3i + 2, the distance from the camera
-// of sub-frame 0's sample (its float bits), which tells a later sample on another surface.
+// With pc.adaptive_shadows, SHADOW_WORDS words a pixel (docs/cache-frame.md §8.2), from
+// i = SHADOW_WORDS × the pixel's index: i, what its neighbourhood saw of the emitters in this
+// frame's sub-frames so far (written at sub-frame 0, raised to a penumbra by later ones); i + 1,
+// what sub-frame 0 saw, frozen for the later sub-frames to compare with the neighbours': the
+// emitters' word (bits 0–1, SHADOW_NONE where the pixel was no surface) and the visibility of
+// punctual lights 0 … REUSED_LIGHTS − 1 (bit 2 + i set where light i's shadow ray was
+// unoccluded); i + 2, the distance from the camera of sub-frame 0's sample (its float bits),
+// which tells a later sample on another surface; with HAS_ANALYTIC_EMITTERS, i + 3, sub-frame
+// 0's shading normal (octahedral, packSnorm2x16), and i + 4 … i + 6, the emitters' unshadowed
+// irradiance there (float bits), taken again by later samples on that surface
+// (`first_unshadowed`).
 layout(binding = B_DIRECT_SHADOWS, std430) buffer Shadows { uint shadows[]; };
+#ifdef HAS_ANALYTIC_EMITTERS
+const uint SHADOW_WORDS = 7u;
+#else
 const uint SHADOW_WORDS = 3u;
+#endif
 // What a pixel's neighbourhood saw of the emitters (the values of the first word).
 const uint SHADOW_HIDDEN = 0u;
 const uint SHADOW_LIT = 1u;
@@ -115,6 +125,7 @@ struct Reuse {
     uint frozen;  // the pixel's sub-frame-0 word
     bool punctual;
     bool emitters;
+    bool on_first;  // after sub-frame 0: the sample lies on the surface of sub-frame 0's
 };
 
 Reuse shadow_reuse(GSample g, ivec2 pixel) {
@@ -122,6 +133,7 @@ Reuse shadow_reuse(GSample g, ivec2 pixel) {
     r.frozen = SHADOW_NONE;
     r.punctual = false;
     r.emitters = false;
+    r.on_first = false;
     if (pc.adaptive_shadows == 0u || pc.sub_frame == 0u) {
         return r;
     }
@@ -129,7 +141,8 @@ Reuse shadow_reuse(GSample g, ivec2 pixel) {
     uint own = shadows[SHADOW_WORDS * index + 1u];
     r.frozen = own;
     float first_distance = uintBitsToFloat(shadows[SHADOW_WORDS * index + 2u]);
-    if ((own & 3u) == SHADOW_NONE || (own & SHADOW_EDGE) != 0u || !same_surface_as_first(g, first_distance)) {
+    r.on_first = (own & 3u) != SHADOW_NONE && same_surface_as_first(g, first_distance);
+    if (!r.on_first || (own & SHADOW_EDGE) != 0u) {
         return r;
     }
     r.punctual = true;
@@ -220,6 +233,51 @@ Surface sample_surface(GSample g) {
     return s;
 }
 
+#ifdef HAS_ANALYTIC_EMITTERS
+// The octahedral map of unit vector n to the square [−1, 1]² (and back), for the stored normal.
+vec2 octahedral(vec3 n) {
+    n /= abs(n.x) + abs(n.y) + abs(n.z);
+    vec2 sign_xy = vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    return n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * sign_xy;
+}
+
+vec3 from_octahedral(vec2 e) {
+    vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+    float t = max(-n.z, 0.0);
+    n.xy += vec2(n.x >= 0.0 ? -t : t, n.y >= 0.0 ? -t : t);
+    return normalize(n);
+}
+
+// Normals closer than this (cosine; about 0.6°) share sub-frame 0's unshadowed irradiance.
+const float FIRST_NORMAL_COS = 0.99995;
+
+// The emitters' unshadowed irradiance at sample `g`: after sub-frame 0, where the sample lies
+// on the surface of sub-frame 0's (`reuse.on_first`) with its normal within FIRST_NORMAL_COS,
+// the irradiance sub-frame 0 computed there (a later sample is within the same pixel, and the
+// irradiance, smooth at the scale of the emitters' distance, changes across a pixel only by a
+// linear term that the jittered sub-frames average out; docs/cache-frame.md §8.2); else the
+// closed form, which sub-frame 0 stores for them.
+vec3 first_unshadowed(GSample g, uint index, vec3 origin, Reuse reuse) {
+    uint base = SHADOW_WORDS * index;
+    if (pc.adaptive_shadows != 0u && reuse.on_first) {
+        vec3 n = from_octahedral(unpackSnorm2x16(shadows[base + 3u]));
+        if (dot(n, g.normal) >= FIRST_NORMAL_COS) {
+            return vec3(uintBitsToFloat(shadows[base + 4u]), uintBitsToFloat(shadows[base + 5u]),
+                        uintBitsToFloat(shadows[base + 6u]));
+        }
+    }
+    vec3 e = analytic_emitter_irradiance(origin, g.normal);
+    if (pc.adaptive_shadows != 0u && pc.sub_frame == 0u) {
+        // Read by later sub-frames only (other dispatches).
+        shadows[base + 3u] = packSnorm2x16(octahedral(g.normal));
+        shadows[base + 4u] = floatBitsToUint(e.r);
+        shadows[base + 5u] = floatBitsToUint(e.g);
+        shadows[base + 6u] = floatBitsToUint(e.b);
+    }
+    return e;
+}
+#endif
+
 PixelLight pixel_light(GSample g, ivec2 pixel) {
     Surface s = sample_surface(g);
     vec3 origin = offset_ray_origin(s.position, s.geometric_normal);
@@ -266,7 +324,7 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     }
     uint n_shadow = light.seen == SHADOW_PENUMBRA ? n_emitters : (reuse.emitters ? 0u : 1u);
     light.reused = n_shadow == 0u;
-    light.unshadowed = closed_form ? analytic_emitter_irradiance(origin, s.shading_normal) : vec3(0.0);
+    light.unshadowed = closed_form ? first_unshadowed(g, index, origin, reuse) : vec3(0.0);
 #ifdef HAS_SPECULAR
     // Reflected radiance: the irradiance times the diffuse lobe, base colour / π.
     light.unshadowed *= f.m.base_colour * INV_PI;
@@ -319,6 +377,19 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
 }
 
 #include "direct_neighbourhood.glsl"
+
+#ifdef DIRECT_COMPOSITE
+// With pc.composite (docs/cache-frame.md §6.5): the sub-frame's composite against the frame's
+// centre samples, here rather than in a pass of its own, which would load the G-buffer and the
+// direct image again (passes/composite.comp; the composite's resources at the pass's bindings).
+#define COMPOSITE_B_SPLAT_SUM B_DIRECT_COMPOSITE_SPLAT_SUM
+#define COMPOSITE_B_ACCUM B_DIRECT_COMPOSITE_ACCUM
+#define COMPOSITE_B_NONFINITE B_DIRECT_COMPOSITE_NONFINITE
+#define COMPOSITE_B_EMISSION_ACCUM B_DIRECT_COMPOSITE_EMISSION_ACCUM
+#define COMPOSITE_B_CENTRE B_DIRECT_COMPOSITE_CENTRE
+#define COMPOSITE_B_GLOSSY_SUM B_DIRECT_COMPOSITE_GLOSSY_SUM
+#include "composite_sample.glsl"
+#endif
 
 void main() {
     ivec2 pixel = ivec2(interleaved_pixel());
@@ -427,17 +498,25 @@ void main() {
     if (!inside) {
         return;
     }
-    if (!g.surface) {
-        imageStore(g_direct, pixel, vec4(0.0));
-        return;
-    }
-    if (any(isnan(e)) || any(isinf(e))) {
-        e = vec3(0.0);
-    }
+    vec3 value = vec3(0.0);
+    if (g.surface && !any(isnan(e)) && !any(isinf(e))) {
 #ifdef HAS_SPECULAR
-    imageStore(g_direct, pixel, vec4(e, 0.0));
+        value = e;
 #else
-    imageStore(g_direct, pixel, vec4(g.albedo * INV_PI * e, 0.0));
+        value = g.albedo * INV_PI * e;
+#endif
+    }
+#ifdef DIRECT_COMPOSITE
+    if (pc.composite != 0u) {
+        if (!g.stopped) {
+            composite_sample(pixel, pixel_index(pixel), g, value,
+                             CompositeArgs(pc.jitter, 0u, pc.radiance_cache, 2u));
+        }
+    } else {
+        imageStore(g_direct, pixel, vec4(value, 0.0));
+    }
+#else
+    imageStore(g_direct, pixel, vec4(value, 0.0));
 #endif
     // Most pixels of a later sub-frame trace no ray (adaptive shadows): they leave the shared
     // counter alone.

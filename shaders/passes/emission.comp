@@ -36,7 +36,9 @@ void main() {
     }
     uint index = uint(pixel.y * size.x + pixel.x);
     vec4 own = emission_accum[index];
-    float subframes = max(own.a, 1.0);
+    // The sub-frames that shaded the pixel: the frame accumulator's count (the emission sums
+    // hold rgb alone, passes/composite.comp).
+    float subframes = max(accum[index].a, 1.0);
     bool near_emitter = false;
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {

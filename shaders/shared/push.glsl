@@ -18,8 +18,11 @@ struct DirectPush {
     uint radiance_cache;
     uint adaptive_shadows;
     uint specular_pool;
-    uint pad2;
-};  // 32 bytes
+    uint composite;
+    vec2 jitter;
+    uint pad3;
+    uint pad4;
+};  // 48 bytes
 
 struct GBufferPush {
     uint instance;

@@ -202,7 +202,8 @@ pass_bindings! {
     pub mod composite("COMPOSITE", base = GBUFFER_END, prefix = [SCENE, GBUFFER]) {
         /// Σw·Ẽ (rgb), Σw (a): the splat target.
         SPLAT_SUM: StorageImage,
-        /// The frame accumulator (`vec4[]`: Σ radiance, sub-frames).
+        /// The frame accumulator (`vec4[]`: Σ radiance, sub-frames; with `IC_AA_MOMENTS`,
+        /// adaptive anti-aliasing, followed by Σ radiance² per pixel).
         ACCUM: StorageBuffer,
         /// Non-finite values dropped (`uint`).
         NONFINITE: StorageBuffer,
@@ -214,9 +215,6 @@ pass_bindings! {
         SPLAT_COUNT: StorageImage,
         /// Σw·L_glossy (rgb), Σw (a): the glossy splat's target (read with `HAS_RADIANCE_CACHE`).
         GLOSSY_SUM: StorageImage,
-        /// Σ radiance² (rgb) per pixel (`vec4[]`, written with `IC_AA_MOMENTS`: adaptive
-        /// anti-aliasing).
-        ACCUM_SQ: StorageBuffer,
         /// Each pixel's centre sample (`vec4[2 per pixel]`: position, normal and footprint),
         /// for splatting once per frame (docs/cache-frame.md §6.5).
         CENTRE: StorageBuffer,
@@ -233,11 +231,42 @@ pass_bindings! {
         GLOSSY_WEIGHTS: StorageBuffer,
         /// The glossy lobe's SH table (`float[]`, read with `HAS_RADIANCE_CACHE`).
         GLOSSY_TABLE: StorageBuffer,
-        /// Adaptive shadows (docs/cache-frame.md §8.2), two `uint` a pixel: what its
-        /// neighbourhood saw of the emitters (hidden, lit or a penumbra) in the frame so far, and
-        /// sub-frame 0's answers frozen (the emitters' and the punctual lights' visibility).
+        /// Adaptive shadows (docs/cache-frame.md §8.2), three `uint` a pixel (seven with
+        /// emitters in closed form): what its neighbourhood saw of the emitters (hidden, lit or
+        /// a penumbra) in the frame so far, sub-frame 0's answers frozen (the emitters' and the
+        /// punctual lights' visibility), its sample's distance (and normal and the emitters'
+        /// unshadowed irradiance there).
         SHADOWS: StorageBuffer,
     }
+}
+
+pass_bindings! {
+    /// `passes/direct.comp` made to composite (`DIRECT_COMPOSITE`): after the direct pass's
+    /// table ([`direct_composite_layout`]), the composite's resources (`composite`'s bindings
+    /// of the same names) but the debug AOVs' (a frame with them composites in its own pass):
+    /// the push descriptors of a pipeline are at most 32 (Vulkan's least `maxPushDescriptors`,
+    /// lavapipe's), and the scene, the G-buffer and the direct pass take 26.
+    pub mod direct_composite("DIRECT_COMPOSITE", base = direct::SHADOWS + 1, prefix = []) {
+        /// The splat target.
+        SPLAT_SUM: StorageImage,
+        /// The frame accumulator.
+        ACCUM: StorageBuffer,
+        /// Non-finite values dropped, samples no centre matched.
+        NONFINITE: StorageBuffer,
+        /// The emission accumulator.
+        EMISSION_ACCUM: StorageBuffer,
+        /// The glossy splat's target.
+        GLOSSY_SUM: StorageImage,
+        /// The pixels' centre samples.
+        CENTRE: StorageBuffer,
+    }
+}
+
+/// The whole table of `passes/direct.comp` made to composite: the direct pass's, then
+/// [`direct_composite`]'s own bindings.
+pub fn direct_composite_layout() -> Vec<BindingLayout> {
+    let own = direct_composite::OWN.iter().map(|b| b.layout());
+    direct::layout().into_iter().chain(own).collect()
 }
 
 pass_bindings! {
@@ -410,6 +439,7 @@ pub fn generated_glsl() -> String {
         aov::glsl(),
         composite::glsl(),
         direct::glsl(),
+        direct_composite::glsl(),
         emission::glsl(),
         holes::glsl(),
         ic_counters::glsl(),
@@ -449,6 +479,7 @@ mod tests {
         for table in [
             composite::layout(),
             direct::layout(),
+            direct_composite_layout(),
             holes::layout(),
             record::layout(),
             splat::layout(),
@@ -467,6 +498,11 @@ mod tests {
                 numbers.len(),
                 n,
                 "a binding number is used twice: {table:?}"
+            );
+            // Push descriptors: Vulkan guarantees 32 a pipeline (lavapipe gives no more).
+            assert!(
+                n <= 32,
+                "{n} bindings, more than 32 push descriptors: {table:?}"
             );
         }
         assert_eq!(composite::SPLAT_SUM, GBUFFER_END);

@@ -30,7 +30,7 @@ pub use frame::settings::{
 };
 pub use passes::aov::{render_aovs, AovPass, Aovs};
 pub use passes::composite::{CentreSamples, CompositePass};
-pub use passes::direct::DirectPass;
+pub use passes::direct::{CompositeSubFrame, CompositeTargets, DirectPass};
 pub use passes::emission::EmissionPass;
 pub use passes::gbuffer::{GBuffer, GBufferPass, DEPTH_FORMAT, GBUFFER_BINDINGS, GBUFFER_FORMAT};
 pub use passes::holes::{HolePass, HoleSelection};

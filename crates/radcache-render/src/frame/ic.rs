@@ -120,14 +120,27 @@ impl IcRenderer {
             params,
             gbuffer: GBuffer::new(ctx, w, h)?,
             gbuffer_pass: GBufferPass::new(ctx, shaders, gpu)?,
-            direct: DirectPass::with_radiance(
-                ctx,
-                shaders,
-                gpu,
-                settings.sky,
-                settings.emitters,
-                radiance,
-            )?
+            // Splatting once, the later sub-frames' composite is the direct pass's.
+            direct: if settings.splat == SplatMode::Once {
+                DirectPass::with_composite(
+                    ctx,
+                    shaders,
+                    gpu,
+                    settings.sky,
+                    settings.emitters,
+                    radiance,
+                    settings.anti_aliasing.is_some(),
+                )?
+            } else {
+                DirectPass::with_radiance(
+                    ctx,
+                    shaders,
+                    gpu,
+                    settings.sky,
+                    settings.emitters,
+                    radiance,
+                )?
+            }
             .with_adaptive_shadows(
                 ctx,
                 match settings.emitter_shadows {

@@ -57,14 +57,23 @@ pub enum CentreSamples {
     Match,
 }
 
+/// The buffers of a [`CompositePass`] that a direct pass made to composite binds
+/// ([`crate::passes::direct::CompositeTargets`]).
+pub(crate) struct CompositeResources<'a> {
+    pub accum: &'a Buffer,
+    pub nonfinite: &'a Buffer,
+    pub emission_accum: &'a Buffer,
+    pub centre: &'a Buffer,
+}
+
 /// The composite pipeline and the frame accumulator.
 pub struct CompositePass {
     pipeline: Pipeline,
     pub(crate) accum: Buffer,
     pub(crate) emission_accum: Buffer,
     debug_accum: Buffer,
-    /// Σ radiance² per pixel (16 bytes a pixel with moments, one vec4 otherwise).
-    accum_sq: Buffer,
+    /// With moments the accumulator holds a second vec4 array after the first: Σ radiance²
+    /// per pixel.
     moments: bool,
     /// The centre samples (32 bytes a pixel when the pass was made for them, one vec4
     /// otherwise).
@@ -141,14 +150,13 @@ impl CompositePass {
         let pixels = u64::from(width) * u64::from(height);
         Ok(CompositePass {
             pipeline,
-            accum: buffer("composite.accum", pixels * 16, MemoryLocation::GpuOnly)?,
-            emission_accum: buffer("composite.emission", pixels * 16, MemoryLocation::GpuOnly)?,
-            debug_accum: buffer("composite.debug", pixels * 32, MemoryLocation::GpuOnly)?,
-            accum_sq: buffer(
-                "composite.accum_sq",
-                if moments { pixels * 16 } else { 16 },
+            accum: buffer(
+                "composite.accum",
+                pixels * 16 * if moments { 2 } else { 1 },
                 MemoryLocation::GpuOnly,
             )?,
+            emission_accum: buffer("composite.emission", pixels * 16, MemoryLocation::GpuOnly)?,
+            debug_accum: buffer("composite.debug", pixels * 32, MemoryLocation::GpuOnly)?,
             moments,
             centre: buffer(
                 "composite.centre",
@@ -166,7 +174,6 @@ impl CompositePass {
         rec.fill_buffer(&self.accum, 0, vk::WHOLE_SIZE, 0);
         rec.fill_buffer(&self.emission_accum, 0, vk::WHOLE_SIZE, 0);
         rec.fill_buffer(&self.debug_accum, 0, vk::WHOLE_SIZE, 0);
-        rec.fill_buffer(&self.accum_sq, 0, vk::WHOLE_SIZE, 0);
         rec.fill_buffer(&self.nonfinite, 0, vk::WHOLE_SIZE, 0);
         rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
     }
@@ -200,8 +207,7 @@ impl CompositePass {
         centre: CentreSamples,
         debug: bool,
     ) -> Result<()> {
-        let pixels = u64::from(self.width) * u64::from(self.height);
-        if centre != CentreSamples::Own && self.centre.size() < pixels * 32 {
+        if centre != CentreSamples::Own && !self.has_centres() {
             return Err(crate::error::Error::Invalid(
                 "the composite pass was made without centre samples".into(),
             ));
@@ -224,7 +230,6 @@ impl CompositePass {
             (b::DEBUG_ACCUM, Resource::Buffer(&self.debug_accum)),
             (b::SPLAT_COUNT, Resource::StorageImage(&splat.count)),
             (b::GLOSSY_SUM, Resource::StorageImage(glossy_sum)),
-            (b::ACCUM_SQ, Resource::Buffer(&self.accum_sq)),
             (b::CENTRE, Resource::Buffer(&self.centre)),
         ]);
         let push = CompositePush {
@@ -282,6 +287,21 @@ impl CompositePass {
         Ok((indirect, weight, count))
     }
 
+    /// The buffers a direct pass made to composite binds.
+    pub(crate) fn resources(&self) -> CompositeResources<'_> {
+        CompositeResources {
+            accum: &self.accum,
+            nonfinite: &self.nonfinite,
+            emission_accum: &self.emission_accum,
+            centre: &self.centre,
+        }
+    }
+
+    /// Whether the pass holds the centre samples ([`CentreSamples`]: made with `centres`).
+    pub fn has_centres(&self) -> bool {
+        self.centre.size() >= u64::from(self.width) * u64::from(self.height) * 32
+    }
+
     /// Width and height of the accumulator.
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)
@@ -303,8 +323,8 @@ impl CompositePass {
             return Ok(None);
         }
         let n = (self.width * self.height) as usize;
-        let sums: Vec<[f32; 4]> = ctx.read_buffer(&self.accum, n)?;
-        let squares: Vec<[f32; 4]> = ctx.read_buffer(&self.accum_sq, n)?;
+        let mut sums: Vec<[f32; 4]> = ctx.read_buffer(&self.accum, 2 * n)?;
+        let squares = sums.split_off(n);
         Ok(Some((sums, squares)))
     }
 

@@ -1,17 +1,25 @@
 //! Direct lighting of the cache's frame (`shaders/passes/direct.comp`): next-event estimation with
 //! MIS per surface pixel, compiled with the plan's defines (only the scene's light sources; a
 //! constant environment only where the sky does not go through the records, [`SkyLight`]).
+//!
+//! Made to composite ([`DirectPass::with_composite`], `DIRECT_COMPOSITE`), the pass can also add
+//! a sub-frame's samples to the frame's accumulators itself, against the centre samples of a
+//! splat made once per frame ([`crate::CentreSamples::Match`]), instead of writing the direct
+//! image for [`CompositePass`]: the composite's own pass would load the G-buffer and that image
+//! again, which on lavapipe was half of its time (docs/cache-frame.md §6.5).
 
 use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
-    vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
-    ShaderCompiler,
+    vk, Access, Buffer, BufferDesc, Context, ImageUse, MemoryLocation, Pipeline, Recorder,
+    Resource, ShaderCompiler,
 };
 
-use crate::bindings::direct as b;
+use crate::bindings::{direct as b, direct_composite as c, direct_composite_layout};
 use crate::error::{Error, Result};
 use crate::frame::settings::{EmitterLight, SkyLight};
+use crate::passes::composite::CompositePass;
 use crate::passes::gbuffer::GBuffer;
+use crate::passes::splat::SplatPass;
 use crate::passes::splat_glossy::GlossySplatPass;
 use crate::scene::GpuScene;
 
@@ -39,9 +47,36 @@ radcache_shared::gpu_struct! {
         /// 1: a pixel's specular paths are pooled with those of its 3×3 neighbours whose lobes
         /// overlap its own ([`DirectPass::with_specular_pool`]; docs/materials.md §10).
         pub specular_pool: u32 => "uint",
+        /// 1: the samples go to the frame's accumulators against the stored centre samples
+        /// instead of the direct image (a pass made to composite, [`DirectPass::with_composite`]).
+        pub composite: u32 => "uint",
+        /// The sub-frame's jitter (read where `composite` is set).
+        pub jitter: [f32; 2] => "vec2",
         /// Padding.
-        pub pad2: u32 => "uint",
+        pub pad3: u32 => "uint",
+        /// Padding.
+        pub pad4: u32 => "uint",
     }
+}
+
+/// What a pass made to composite reads and writes beside the direct pass's own resources: the
+/// composite's accumulators and centre samples, the splat's targets (and the glossy splat's).
+#[derive(Clone, Copy, Debug)]
+pub struct CompositeTargets<'a> {
+    /// The accumulators and the centre samples.
+    pub composite: &'a CompositePass,
+    /// The splat made at the centre samples.
+    pub splat: &'a SplatPass,
+    /// The glossy splat, where the frame has one.
+    pub glossy: Option<&'a GlossySplatPass>,
+}
+
+/// A sub-frame composited by the direct pass (never one with the debug AOVs, whose
+/// accumulators the pass does not bind): its jitter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CompositeSubFrame {
+    /// The sub-frame's sample within its pixel, from the pixel's centre.
+    pub jitter: [f32; 2],
 }
 
 /// Paths per pixel and sub-frame that trace the specular lobe's indirect light (scenes with
@@ -71,6 +106,8 @@ pub struct DirectPass {
     shadows: Option<Buffer>,
     /// The specular paths are pooled over the neighbourhood ([`DirectPass::with_specular_pool`]).
     specular_pool: bool,
+    /// Made to composite ([`DirectPass::with_composite`]).
+    composites: bool,
 }
 
 impl std::fmt::Debug for DirectPass {
@@ -104,6 +141,36 @@ impl DirectPass {
         emitters: EmitterLight,
         radiance: bool,
     ) -> Result<DirectPass> {
+        Self::build(ctx, shaders, scene, sky, emitters, radiance, None)
+    }
+
+    /// As [`DirectPass::with_radiance`], made to composite: every recording binds the
+    /// composite's resources ([`DirectPass::record_composited`]), and a sub-frame composited
+    /// against the centre samples adds its samples to the frame's accumulators itself instead
+    /// of writing the direct image. `moments` as the composite pass's (`IC_AA_MOMENTS`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_composite(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        scene: &GpuScene,
+        sky: SkyLight,
+        emitters: EmitterLight,
+        radiance: bool,
+        moments: bool,
+    ) -> Result<DirectPass> {
+        Self::build(ctx, shaders, scene, sky, emitters, radiance, Some(moments))
+    }
+
+    /// The pass; `composite` made to composite, with the composite's moments or not.
+    fn build(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        scene: &GpuScene,
+        sky: SkyLight,
+        emitters: EmitterLight,
+        radiance: bool,
+        composite: Option<bool>,
+    ) -> Result<DirectPass> {
         let mut defines = scene.defines();
         defines.extend(sky.define(scene.has_constant_environment()));
         let analytic = emitters.define(scene.plan().analytic_emitters);
@@ -111,12 +178,22 @@ impl DirectPass {
         if radiance {
             defines.push(("HAS_RADIANCE_CACHE", "1"));
         }
+        if let Some(moments) = composite {
+            defines.push(("DIRECT_COMPOSITE", "1"));
+            if moments {
+                defines.push(("IC_AA_MOMENTS", "1"));
+            }
+        }
         let spirv = shaders.compile("passes/direct.comp", &defines)?;
+        let layout = match composite {
+            Some(_) => direct_composite_layout(),
+            None => b::layout(),
+        };
         let pipeline = Pipeline::compute(
             ctx,
             "direct",
             &spirv,
-            &b::layout(),
+            &layout,
             std::mem::size_of::<DirectPush>() as u32,
         )?;
         let rays = Buffer::new(
@@ -147,6 +224,7 @@ impl DirectPass {
             punctual: scene.plan().has_punctual_lights(),
             shadows: None,
             specular_pool: true,
+            composites: composite.is_some(),
         })
     }
 
@@ -163,16 +241,18 @@ impl DirectPass {
 
     /// Makes a pass whose emitters' light is in closed form, or whose scene has punctual
     /// lights, spend its shadow rays where they are needed ([`crate::EmitterShadows::Adaptive`]),
-    /// for images of `pixels` pixels (12 bytes each): sub-frame 0 casts every pixel's rays (a
-    /// quarter of the samples toward the emitters, one per punctual light) and stores what its
-    /// 3×3 neighbourhood saw of the emitters (lit, hidden, or a penumbra, dilated by the
-    /// neighbourhood), what it saw of each punctual light, whether its neighbours' samples lay on
-    /// its surface, and its sample's distance; later sub-frames cast no ray where every 3×3
-    /// neighbour, on the pixel's surface, saw the same as the pixel and the sample lies on the
-    /// surface of the pixel's first, one toward the emitters at other
-    /// lit and hidden pixels, and mark the penumbrae their rays find (docs/cache-frame.md
-    /// §8.2). Other passes are returned as they are, and so is every pass for `pixels` `None`
-    /// (every ray always).
+    /// for images of `pixels` pixels (12 bytes each, 28 with emitters in closed form): sub-frame
+    /// 0 casts every pixel's rays (a quarter of the samples toward the emitters, one per
+    /// punctual light) and stores what its 3×3 neighbourhood saw of the emitters (lit, hidden,
+    /// or a penumbra, dilated by the neighbourhood), what it saw of each punctual light, whether
+    /// its neighbours' samples lay on its surface, its sample's distance and, with emitters in
+    /// closed form, its normal and the emitters' unshadowed irradiance; later sub-frames cast no
+    /// ray where every 3×3 neighbour, on the pixel's surface, saw the same as the pixel and the
+    /// sample lies on the surface of the pixel's first, one toward the emitters at other lit and
+    /// hidden pixels, mark the penumbrae their rays find, and take the stored irradiance where
+    /// the sample lies on the first one's surface with its normal (docs/cache-frame.md §8.2).
+    /// Other passes are returned as they are, and so is every pass for `pixels` `None` (every
+    /// ray always).
     pub fn with_adaptive_shadows(
         mut self,
         ctx: &Context,
@@ -183,7 +263,7 @@ impl DirectPass {
                 ctx,
                 &BufferDesc {
                     name: "direct.shadows",
-                    size: u64::from(pixels.max(1)) * 12,
+                    size: u64::from(pixels.max(1)) * if self.analytic { 28 } else { 12 },
                     usage: vk::BufferUsageFlags::STORAGE_BUFFER,
                     location: MemoryLocation::GpuOnly,
                     alignment: 0,
@@ -222,8 +302,74 @@ impl DirectPass {
         seed: u32,
         glossy: Option<&GlossySplatPass>,
     ) -> Result<()> {
+        if self.composites {
+            return Err(Error::Invalid(
+                "the direct pass made to composite records with the composite's resources".into(),
+            ));
+        }
+        self.record_inner(
+            rec,
+            scene,
+            gbuffer,
+            [samples, sub_frame, seed],
+            glossy,
+            None,
+        )
+    }
+
+    /// As [`DirectPass::record_glossy`] for a pass made to composite, the glossy splat taken
+    /// from `targets`: with `sub_frame_composite` the sub-frame's samples go to the frame's
+    /// accumulators against the centre samples stored by [`CompositePass`] at sub-frame 0
+    /// ([`crate::CentreSamples::Match`]), as the composite pass would add them, and the direct
+    /// image is left as it is; without it the pass writes the direct image as any other.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_composited(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        samples: u32,
+        sub_frame: u32,
+        seed: u32,
+        targets: CompositeTargets<'_>,
+        sub_frame_composite: Option<CompositeSubFrame>,
+    ) -> Result<()> {
+        if !self.composites {
+            return Err(Error::Invalid(
+                "the direct pass was made without the composite".into(),
+            ));
+        }
+        let composite = (targets, sub_frame_composite);
+        let sequence = [samples, sub_frame, seed];
+        self.record_inner(
+            rec,
+            scene,
+            gbuffer,
+            sequence,
+            targets.glossy,
+            Some(composite),
+        )
+    }
+
+    /// Records the pass: `[samples, sub_frame, seed]`, and for a pass made to composite its
+    /// resources and what this sub-frame composites.
+    fn record_inner(
+        &self,
+        rec: &mut Recorder,
+        scene: &GpuScene,
+        gbuffer: &GBuffer,
+        [samples, sub_frame, seed]: [u32; 3],
+        glossy: Option<&GlossySplatPass>,
+        composite: Option<(CompositeTargets<'_>, Option<CompositeSubFrame>)>,
+    ) -> Result<()> {
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
-        rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
+        // The composite's resources were last written by other passes (the splat's targets by
+        // rasterization) as well.
+        let before = match composite {
+            Some(_) => Access::ALL_WRITES,
+            None => Access::TRANSFER_WRITE,
+        };
+        rec.barrier(before, Access::COMPUTE_READ_WRITE);
         let mut bindings = scene.bindings();
         bindings.extend(gbuffer.bindings());
         bindings.push((b::RAY_COUNT, Resource::Buffer(&self.rays)));
@@ -234,11 +380,12 @@ impl DirectPass {
         bindings.push((b::GLOSSY_TABLE, Resource::Buffer(table)));
         let (w, h) = (gbuffer.width, gbuffer.height);
         let shadows = self.shadows.as_ref();
+        let per_pixel = if self.analytic { 28 } else { 12 };
         if let Some(buffer) = shadows {
-            if buffer.size() < u64::from(w) * u64::from(h) * 8 {
+            if buffer.size() < u64::from(w) * u64::from(h) * per_pixel {
                 return Err(Error::Invalid(format!(
                     "the direct pass's shadow marks hold {} pixels, the G-buffer has {w}x{h}",
-                    buffer.size() / 8
+                    buffer.size() / per_pixel
                 )));
             }
         }
@@ -246,6 +393,14 @@ impl DirectPass {
             b::SHADOWS,
             Resource::Buffer(shadows.unwrap_or(&self.placeholder)),
         ));
+        let sub_frame_composite = composite.and_then(|(_, s)| s);
+        if let Some((targets, _)) = composite {
+            bindings.extend(composite_bindings(
+                rec,
+                targets,
+                sub_frame_composite.is_some(),
+            )?);
+        }
         let push = DirectPush {
             samples: samples.max(1),
             seed,
@@ -254,7 +409,10 @@ impl DirectPass {
             radiance_cache: u32::from(glossy.is_some()),
             adaptive_shadows: u32::from(shadows.is_some()),
             specular_pool: u32::from(self.specular_pool),
-            pad2: 0,
+            composite: u32::from(sub_frame_composite.is_some()),
+            jitter: sub_frame_composite.map_or([0.0; 2], |s| s.jitter),
+            pad3: 0,
+            pad4: 0,
         };
         rec.pass("direct", |rec| {
             rec.bind_pipeline(&self.pipeline);
@@ -271,4 +429,37 @@ impl DirectPass {
     pub fn rays(&self) -> Result<u64> {
         Ok(u64::from(self.rays.read::<u32>(1)?[0]))
     }
+}
+
+/// The composite's resources at the bindings of the pass made to composite (`matching`: this
+/// sub-frame composites against the centre samples, which the composite pass must hold).
+fn composite_bindings<'a>(
+    rec: &mut Recorder,
+    targets: CompositeTargets<'a>,
+    matching: bool,
+) -> Result<Vec<(u32, Resource<'a>)>> {
+    let CompositeTargets {
+        composite,
+        splat,
+        glossy,
+    } = targets;
+    if matching && !composite.has_centres() {
+        return Err(Error::Invalid(
+            "the composite pass was made without centre samples".into(),
+        ));
+    }
+    // Without a glossy splat the target is not read; the splat's own stands in.
+    let glossy_sum = glossy.map_or(&splat.sum, |g| &g.sum);
+    for image in [&splat.sum, glossy_sum] {
+        rec.use_image(image, ImageUse::ComputeStorage);
+    }
+    let r = composite.resources();
+    Ok(vec![
+        (c::SPLAT_SUM, Resource::StorageImage(&splat.sum)),
+        (c::ACCUM, Resource::Buffer(r.accum)),
+        (c::NONFINITE, Resource::Buffer(r.nonfinite)),
+        (c::EMISSION_ACCUM, Resource::Buffer(r.emission_accum)),
+        (c::GLOSSY_SUM, Resource::StorageImage(glossy_sum)),
+        (c::CENTRE, Resource::Buffer(r.centre)),
+    ])
 }

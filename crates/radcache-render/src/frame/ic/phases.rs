@@ -15,6 +15,7 @@ use crate::frame::clock::FrameClock;
 use crate::frame::path::{FrameOutput, Progress};
 use crate::frame::settings::{sub_frame_jitter, IcSettings, IcStats, SplatMode};
 use crate::passes::composite::CentreSamples;
+use crate::passes::direct::{CompositeSubFrame, CompositeTargets};
 use crate::passes::holes::HoleSelection;
 use crate::passes::record::creation_seed;
 use crate::passes::splat::{SplatOutput, SplatScope, SplatWeights};
@@ -332,15 +333,32 @@ impl IcRenderer {
             run.gbuffer_at = Some(k);
         }
         let glossy = self.glossy();
-        self.direct.record_glossy(
-            &mut rec,
-            gpu,
-            gbuffer,
-            settings.direct_samples,
-            k,
-            settings.seed,
-            glossy,
-        )?;
+        let debug = settings.debug_aovs;
+        // Splatting once, the direct pass composites the later sub-frames itself (it has their
+        // samples loaded; docs/cache-frame.md §6.5) but for the debug AOVs; sub-frame 0 writes
+        // the direct image for the composite after the splat.
+        let composited = centre == CentreSamples::Match && !debug;
+        if self.splat_mode == SplatMode::Once {
+            let targets = CompositeTargets {
+                composite: &self.composite,
+                splat: &self.splat,
+                glossy,
+            };
+            let sub_frame = composited.then_some(CompositeSubFrame { jitter });
+            let (samples, seed) = (settings.direct_samples, settings.seed);
+            self.direct
+                .record_composited(&mut rec, gpu, gbuffer, samples, k, seed, targets, sub_frame)?;
+        } else {
+            self.direct.record_glossy(
+                &mut rec,
+                gpu,
+                gbuffer,
+                settings.direct_samples,
+                k,
+                settings.seed,
+                glossy,
+            )?;
+        }
         if splats {
             // The records per pixel only for the debug AOVs (a second blended target).
             let output = if settings.debug_aovs {
@@ -370,17 +388,18 @@ impl IcRenderer {
                 HoleSelection::CountOnly,
             )?;
         }
-        let debug = settings.debug_aovs;
-        self.composite.record_glossy(
-            &mut rec,
-            gpu,
-            gbuffer,
-            &self.splat,
-            glossy,
-            jitter,
-            centre,
-            debug,
-        )?;
+        if !composited {
+            self.composite.record_glossy(
+                &mut rec,
+                gpu,
+                gbuffer,
+                &self.splat,
+                glossy,
+                jitter,
+                centre,
+                debug,
+            )?;
+        }
         run.clock.submit(ctx, rec)?;
         run.add_rays("direct", self.direct.rays()?);
         if splats {

@@ -1,0 +1,108 @@
+//! The composite of the sub-frames after the first when the records are splatted once per frame:
+//! the direct pass made to composite adds their samples to the frame's accumulators itself
+//! (`DIRECT_COMPOSITE`, docs/cache-frame.md §6.5), and must add exactly what its direct image
+//! followed by the composite pass adds.
+
+use radcache_render::{
+    sub_frame_jitter, CentreSamples, CompositePass, CompositeSubFrame, CompositeTargets,
+    DirectPass, EmitterLight, SkyLight, SplatPass,
+};
+use radcache_tests::ic_fixture::{cornell, Gpu};
+use radcache_vk::ImageUse;
+
+/// The Cornell box at 48×40 (its closed-form emitter, adaptive shadows, the anti-aliasing
+/// moments): two direct passes made to composite, each with its own accumulators, shade the
+/// same sub-frames from the same G-buffers. Sub-frame 0 writes the direct image and the
+/// composite pass stores the centre samples in both; in sub-frames 1–4 one direct pass
+/// composites itself and the other writes its image for the composite pass. Means, squares,
+/// samples without a matching centre and dropped values agree bit for bit.
+#[test]
+fn the_direct_pass_composites_as_the_composite_pass() {
+    let (w, h) = (48, 40);
+    let gpu = Gpu::new(&cornell(), None, (w, h));
+    let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
+    let direct = || {
+        let (sky, emitters) = (SkyLight::Direct, EmitterLight::Analytic);
+        DirectPass::with_composite(ctx, shaders, &gpu.scene, sky, emitters, false, true)
+            .unwrap()
+            .with_adaptive_shadows(ctx, Some(w * h))
+            .unwrap()
+    };
+    let composite =
+        || CompositePass::with_options(ctx, shaders, &gpu.scene, w, h, false, true, true).unwrap();
+    // [fused, separate]
+    let passes = [(direct(), composite()), (direct(), composite())];
+    let splat = SplatPass::new(ctx, shaders, w, h).unwrap();
+    // A direct pass made to composite refuses the plain recording.
+    let mut rec = ctx.begin("test.refused").unwrap();
+    assert!(passes[0]
+        .0
+        .record(&mut rec, &gpu.scene, &gpu.gbuffer, 16, 0, 7)
+        .is_err());
+    drop(rec);
+    let (samples, seed) = (16, 7);
+    for k in 0..5 {
+        let jitter = sub_frame_jitter(k);
+        let mut rec = ctx.begin("test.sub_frame").unwrap();
+        gpu.pass
+            .record(&mut rec, &gpu.scene, &gpu.gbuffer, jitter)
+            .unwrap();
+        if k == 0 {
+            // Σw·Ẽ, Σw: every centre holds Ẽ = (0.5, 1, 1.5).
+            rec.use_image(&splat.sum, ImageUse::TransferDst);
+            rec.clear_color(&splat.sum, [1.0, 2.0, 3.0, 2.0]);
+        }
+        for (i, (direct, composite)) in passes.iter().enumerate() {
+            if k == 0 {
+                composite.record_clear(&mut rec);
+            }
+            let targets = CompositeTargets {
+                composite,
+                splat: &splat,
+                glossy: None,
+            };
+            let fused = k > 0 && i == 0;
+            let sub_frame = fused.then_some(CompositeSubFrame { jitter });
+            let g = &gpu.gbuffer;
+            direct
+                .record_composited(
+                    &mut rec, &gpu.scene, g, samples, k, seed, targets, sub_frame,
+                )
+                .unwrap();
+            if !fused {
+                let centre = if k == 0 {
+                    CentreSamples::Store
+                } else {
+                    CentreSamples::Match
+                };
+                composite
+                    .record_glossy(&mut rec, &gpu.scene, g, &splat, None, jitter, centre, false)
+                    .unwrap();
+            }
+        }
+        ctx.submit(rec).unwrap().wait().unwrap();
+    }
+    let [(_, fused), (_, separate)] = &passes;
+    let (mean, dropped) = fused.read_mean(ctx).unwrap();
+    assert_eq!((mean, dropped), separate.read_mean(ctx).unwrap());
+    assert_eq!(dropped, 0);
+    let moments = fused.read_moments(ctx).unwrap().unwrap();
+    assert_eq!(moments, separate.read_moments(ctx).unwrap().unwrap());
+    let (sums, squares) = moments;
+    assert!(
+        sums.iter().all(|s| s[3] == 5.0),
+        "every pixel has 5 samples"
+    );
+    let lit = sums.iter().filter(|s| s[0] > 0.0).count();
+    assert!(lit > (w * h) as usize / 2, "{lit} pixels with light");
+    assert!(squares
+        .iter()
+        .zip(&sums)
+        .all(|(q, s)| q[0] >= s[0] * s[0] / 5.0 * 0.999));
+    assert_eq!(
+        fused.read_unmatched().unwrap(),
+        separate.read_unmatched().unwrap()
+    );
+    drop((passes, splat));
+    gpu.end();
+}
