@@ -1,5 +1,5 @@
 // common/gbuffer.glsl: the G-buffer of crates/radcache-render/src/passes/gbuffer.rs as compute
-// and fragment passes read it: storage images at B_GBUFFER_* (crates/radcache-render/src/bindings.rs).
+// and fragment passes read it: storage images at B_GBUFFER_* (crates/radcache-render/src/bindings/mod.rs).
 //
 //   +0 position   xyz world position of the first hit; w = 1 on a surface, 0 on the background,
 //                 −1 where per-pixel adaptive anti-aliasing has stopped the pixel (no sample in

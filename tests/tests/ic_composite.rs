@@ -23,7 +23,7 @@ fn the_direct_pass_composites_as_the_composite_pass() {
     let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
     let direct = || {
         let (sky, emitters) = (SkyLight::Direct, EmitterLight::Analytic);
-        DirectPass::with_composite(ctx, shaders, &gpu.scene, sky, emitters, false, true)
+        DirectPass::with_composite(ctx, shaders, &gpu.scene, sky, emitters, false, Some(true))
             .unwrap()
             .with_adaptive_shadows(ctx, Some(w * h))
             .unwrap()

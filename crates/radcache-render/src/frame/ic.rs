@@ -121,26 +121,15 @@ impl IcRenderer {
             gbuffer: GBuffer::new(ctx, w, h)?,
             gbuffer_pass: GBufferPass::new(ctx, shaders, gpu)?,
             // Splatting once, the later sub-frames' composite is the direct pass's.
-            direct: if settings.splat == SplatMode::Once {
-                DirectPass::with_composite(
-                    ctx,
-                    shaders,
-                    gpu,
-                    settings.sky,
-                    settings.emitters,
-                    radiance,
-                    settings.anti_aliasing.is_some(),
-                )?
-            } else {
-                DirectPass::with_radiance(
-                    ctx,
-                    shaders,
-                    gpu,
-                    settings.sky,
-                    settings.emitters,
-                    radiance,
-                )?
-            }
+            direct: DirectPass::with_composite(
+                ctx,
+                shaders,
+                gpu,
+                settings.sky,
+                settings.emitters,
+                radiance,
+                (settings.splat == SplatMode::Once).then_some(settings.anti_aliasing.is_some()),
+            )?
             .with_adaptive_shadows(
                 ctx,
                 match settings.emitter_shadows {

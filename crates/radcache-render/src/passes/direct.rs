@@ -141,28 +141,15 @@ impl DirectPass {
         emitters: EmitterLight,
         radiance: bool,
     ) -> Result<DirectPass> {
-        Self::build(ctx, shaders, scene, sky, emitters, radiance, None)
+        Self::with_composite(ctx, shaders, scene, sky, emitters, radiance, None)
     }
 
-    /// As [`DirectPass::with_radiance`], made to composite: every recording binds the
-    /// composite's resources ([`DirectPass::record_composited`]), and a sub-frame composited
-    /// against the centre samples adds its samples to the frame's accumulators itself instead
-    /// of writing the direct image. `moments` as the composite pass's (`IC_AA_MOMENTS`).
-    #[allow(clippy::too_many_arguments)]
+    /// As [`DirectPass::with_radiance`]; with `composite` (`Some(moments)`, the composite
+    /// pass's `IC_AA_MOMENTS`) made to composite: every recording binds the composite's
+    /// resources ([`DirectPass::record_composited`]), and a sub-frame composited against the
+    /// centre samples adds its samples to the frame's accumulators itself instead of writing
+    /// the direct image.
     pub fn with_composite(
-        ctx: &Context,
-        shaders: &ShaderCompiler,
-        scene: &GpuScene,
-        sky: SkyLight,
-        emitters: EmitterLight,
-        radiance: bool,
-        moments: bool,
-    ) -> Result<DirectPass> {
-        Self::build(ctx, shaders, scene, sky, emitters, radiance, Some(moments))
-    }
-
-    /// The pass; `composite` made to composite, with the composite's moments or not.
-    fn build(
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
