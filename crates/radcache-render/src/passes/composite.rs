@@ -57,6 +57,10 @@ pub enum CentreSamples {
     Match,
 }
 
+/// Bytes a pixel of the centre samples (two vec4: position and surface flag, normal and
+/// footprint).
+const CENTRE_BYTES: u64 = 32;
+
 /// The buffers of a [`CompositePass`] that a direct pass made to composite binds
 /// ([`crate::passes::direct::CompositeTargets`]).
 pub(crate) struct CompositeResources<'a> {
@@ -160,7 +164,7 @@ impl CompositePass {
             moments,
             centre: buffer(
                 "composite.centre",
-                if centres { pixels * 32 } else { 16 },
+                if centres { pixels * CENTRE_BYTES } else { 16 },
                 MemoryLocation::GpuOnly,
             )?,
             nonfinite: buffer("composite.nonfinite", 16, MemoryLocation::GpuToCpu)?,
@@ -299,7 +303,7 @@ impl CompositePass {
 
     /// Whether the pass holds the centre samples ([`CentreSamples`]: made with `centres`).
     pub fn has_centres(&self) -> bool {
-        self.centre.size() >= u64::from(self.width) * u64::from(self.height) * 32
+        self.centre.size() >= u64::from(self.width) * u64::from(self.height) * CENTRE_BYTES
     }
 
     /// Width and height of the accumulator.

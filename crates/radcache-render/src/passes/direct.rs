@@ -100,9 +100,10 @@ pub struct DirectPass {
     analytic: bool,
     /// The scene has punctual lights (`HAS_LIGHTS`).
     punctual: bool,
-    /// Two `uint` a pixel: what its neighbourhood saw of the emitters in this frame's
-    /// sub-frames so far, and what sub-frame 0 saw of them and of the punctual lights
-    /// ([`DirectPass::with_adaptive_shadows`]).
+    /// [`DirectPass::shadow_bytes`] a pixel: what its neighbourhood saw of the emitters in
+    /// this frame's sub-frames so far, what sub-frame 0 saw of them and of the punctual lights,
+    /// its sample's distance (and, with emitters in closed form, its normal and their unshadowed
+    /// irradiance) ([`DirectPass::with_adaptive_shadows`]).
     shadows: Option<Buffer>,
     /// The specular paths are pooled over the neighbourhood ([`DirectPass::with_specular_pool`]).
     specular_pool: bool,
@@ -250,7 +251,7 @@ impl DirectPass {
                 ctx,
                 &BufferDesc {
                     name: "direct.shadows",
-                    size: u64::from(pixels.max(1)) * if self.analytic { 28 } else { 12 },
+                    size: u64::from(pixels.max(1)) * self.shadow_bytes(),
                     usage: vk::BufferUsageFlags::STORAGE_BUFFER,
                     location: MemoryLocation::GpuOnly,
                     alignment: 0,
@@ -258,6 +259,16 @@ impl DirectPass {
             )?);
         }
         Ok(self)
+    }
+
+    /// Bytes a pixel of the adaptive shadows' buffer: `SHADOW_WORDS` words of `direct.comp`,
+    /// seven with emitters in closed form, three without.
+    fn shadow_bytes(&self) -> u64 {
+        if self.analytic {
+            28
+        } else {
+            12
+        }
     }
 
     /// Records `samples` estimates per pixel into the G-buffer's direct image for sub-frame
@@ -367,7 +378,7 @@ impl DirectPass {
         bindings.push((b::GLOSSY_TABLE, Resource::Buffer(table)));
         let (w, h) = (gbuffer.width, gbuffer.height);
         let shadows = self.shadows.as_ref();
-        let per_pixel = if self.analytic { 28 } else { 12 };
+        let per_pixel = self.shadow_bytes();
         if let Some(buffer) = shadows {
             if buffer.size() < u64::from(w) * u64::from(h) * per_pixel {
                 return Err(Error::Invalid(format!(
