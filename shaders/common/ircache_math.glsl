@@ -29,6 +29,30 @@ float luminance_rec709(vec3 c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c
 
 uint stratum_index(uint j, uint k, uint n) { return j * n + k; }
 
+// IcParams::falloff_strata (params.rs): the fine strata m × n of a record `steps` levels finer
+// than the fine level. M' is the integer nearest m/√2^steps (at least 1), found by comparing
+// (k ± ½)² with m²/2^steps, exact in f32 for m ≤ 1728; N' = round(n·M'/m) (at least 3).
+void falloff_strata(uint m, uint n, uint steps, out uint m2, out uint n2) {
+    m2 = m;
+    n2 = n;
+    if (steps == 0u || m == 0u) {
+        return;
+    }
+    float x2 = float(m * m);
+    for (uint i = 0u; i < min(steps, 30u); ++i) {
+        x2 *= 0.5;
+    }
+    uint k = uint(round(sqrt(x2)));
+    while ((float(k) + 0.5) * (float(k) + 0.5) <= x2) {
+        k++;
+    }
+    while (k > 0u && (float(k) - 0.5) * (float(k) - 0.5) > x2) {
+        k--;
+    }
+    m2 = max(k, 1u);
+    n2 = max((2u * n * m2 + m) / (2u * m), 3u);
+}
+
 vec3 normalize_or_z(vec3 n) {
     float len2 = dot(n, n);
     if (len2 > 1.0e-30 && len2 < 1.0e30) {

@@ -460,11 +460,17 @@ void main() {
 
     // Records requested at a level no wider than R⁻ gather with the fine strata, unless they
     // were made for a glossy lobe (RECORD_FLAG_GLOSSY), whose radiance coefficients want the
-    // samples (IcParams::strata_at; docs/irradiance-cache.md §2.8). A refresh takes the
-    // record's own level and flag, hence its own strata.
-    bool fine = (g_level_subframe & 0xffffu) >= pc.fine_level && !glossy;
+    // samples, and with strata_falloff half the rays per level below the first of those
+    // (IcParams::strata_at; docs/irradiance-cache.md §2.8). A refresh takes the record's own
+    // level and flag, hence its own strata.
+    uint level = g_level_subframe & 0xffffu;
+    bool fine = level >= pc.fine_level && !glossy;
     uint m = clamp(fine ? pc.fine_m : pc.m, 1u, MAX_STRATA / 3u);
     uint n = clamp(fine ? pc.fine_n : pc.n, 3u, MAX_STRATA / m);
+    if (fine && pc.strata_falloff != 0u) {
+        uint fine_m = m, fine_n = n;
+        falloff_strata(fine_m, fine_n, level - pc.fine_level, m, n);
+    }
     uint count = m * n;
     // The test hook's stride per request: the larger strata, whichever a record took.
     uint stride = max(pc.m * pc.n, pc.fine_m * pc.fine_n);

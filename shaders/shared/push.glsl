@@ -69,8 +69,9 @@ struct RecordPush {
     uint fine_level;
     uint fine_m;
     uint fine_n;
+    uint strata_falloff;
     uint grid_epoch;
-};  // 52 bytes
+};  // 56 bytes
 
 struct SplatWeights {
     uint kind;

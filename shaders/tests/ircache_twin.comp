@@ -67,6 +67,12 @@ void sampling(Row i, inout Row o) {
     o.v[7].w = rs.z;
     o.v[14] = vec4(radiance_polar_wall_coeff(j, k, m, n), 0.0);
     o.v[15] = vec4(radiance_azimuthal_wall_coeff(j, k, m, n), 0.0);
+    // The strata falloff of fine strata (1 + hash input % 1728) × (3 + unit-float input % 1726),
+    // k % 16 levels finer.
+    uint fm, fn;
+    falloff_strata(1u + bits(i.v[3].y) % 1728u, 3u + bits(i.v[3].z) % 1726u, k % 16u, fm, fn);
+    o.v[12].w = from_bits(fm);
+    o.v[13].w = from_bits(fn);
 }
 
 // in: 0 p; 1 n; 2 p_i; 3 n_i; 4 (r_i, a, kappa, front tolerance); 5 (w_min, hole threshold, -, -).

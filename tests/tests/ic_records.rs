@@ -286,12 +286,15 @@ fn cornell_records_agree_with_an_independent_estimate() {
     let c = counters(0, k, k, 64);
     let a = run(&mut f, &pass_a, &points, &requests, c, 11, 1, 0);
     let again = run(&mut f, &pass_a, &points, &requests, c, 11, 1, 0);
-    let b = run(&mut f, &pass_b, &points, &requests, c, 12, 4, 2);
-    // The default's coarse levels gather 12×36 strata, its fine ones (spacing ≤ R⁻) 8×24.
+    let b = run(&mut f, &pass_b, &points, &requests, c, 12, 3, 2);
+    // The default's coarse levels gather 12×36 strata, its first fine one (spacing ≤ R⁻) 8×24,
+    // each finer one half the rays (IcParams::strata_falloff): 4×12 two levels on.
     let coarse = run(&mut f, &pass_b, &points, &requests, c, 13, 2, 2);
+    let finest = run(&mut f, &pass_b, &points, &requests, c, 14, 5, 2);
     assert_eq!(fine.fine_level(), 3);
     assert_eq!(fine.strata_at(2, false), (12, 36));
-    assert_eq!(fine.strata_at(4, false), (8, 24));
+    assert_eq!(fine.strata_at(3, false), (8, 24));
+    assert_eq!(fine.strata_at(5, false), (4, 12));
     assert_eq!(a.records, again.records, "not deterministic");
     // The test hook's stride is the larger strata's count.
     let (ca, cb) = (draft.sample_count() as usize, fine.sample_count() as usize);
@@ -300,11 +303,13 @@ fn cornell_records_agree_with_an_independent_estimate() {
         let sa = &a.samples[i * ca..(i + 1) * ca];
         let sb = &b.samples[i * cb..(i + 1) * cb];
         let ea = check_record(&f, &draft, q, &a.records[i], sa, 1, 0);
-        let eb = check_record(&f, &fine, q, &b.records[i], sb, 4, 2);
+        let eb = check_record(&f, &fine, q, &b.records[i], sb, 3, 2);
         let sc = &coarse.samples[i * cb..(i + 1) * cb];
         check_record(&f, &fine, q, &coarse.records[i], sc, 2, 2);
-        // The fine level's strata are the draft's: the same count of samples.
-        assert_eq!(fine.strata_at(4, false), draft.strata_at(1, false));
+        let sd = &finest.samples[i * cb..(i + 1) * cb];
+        check_record(&f, &fine, q, &finest.records[i], sd, 5, 2);
+        // The first fine level's strata are the draft's: the same count of samples.
+        assert_eq!(fine.strata_at(3, false), draft.strata_at(1, false));
         let sb = &sb[..ca];
         let (sea, seb) = (standard_error(&split(sa).0), standard_error(&split(sb).0));
         let r = &a.records[i];
@@ -327,6 +332,8 @@ fn cornell_records_agree_with_an_independent_estimate() {
     assert!(bad * 200 <= points.len() * ca, "{bad} distances differ");
     assert!(a.rays > u64::from(k) * ca as u64 && b.rays > u64::from(k) * ca as u64);
     assert!(coarse.rays > u64::from(k) * cb as u64);
+    // 48 gather rays and their paths a record, against the 192 of the first fine level's.
+    assert!(finest.rays > u64::from(k) * 48 && finest.rays * 2 < b.rays);
     assert_eq!(
         (a.counters.dropped_requests, a.counters.rejected_records),
         (0, 0)

@@ -21,7 +21,7 @@ use radcache_cache::record::*;
 use radcache_cache::sampling::*;
 use radcache_cache::temporal::*;
 use radcache_cache::weight::*;
-use radcache_cache::{luminance_rec709, IC_FAR};
+use radcache_cache::{falloff_strata, luminance_rec709, IC_FAR};
 use radcache_tests::twin::{
     check, twin_pipeline, ub, unit, v4, vec, Case, Expect, How, Row, TwinMode,
 };
@@ -101,6 +101,9 @@ fn sampling(rng: &mut Rng) -> Vec<Case> {
         e.v(14, rpw, rpw.length());
         let raw = radiance_azimuthal_wall_coeff(j, k, m, n);
         e.v(15, raw, raw.length());
+        let (fm, fn_) = falloff_strata(1 + h % 1728, 3 + bits % 1726, k % 16);
+        e.exact(12, 3, ub(fm));
+        e.exact(13, 3, ub(fn_));
         cases.push((row, e));
     }
     cases

@@ -52,7 +52,7 @@ pub mod weight;
 
 pub use extrapolate::extrapolate_irradiance;
 pub use hessian::compute_hessian;
-pub use params::{ErrorControl, IcParams, Preset};
+pub use params::{falloff_strata, ErrorControl, IcParams, Preset};
 pub use radius::{finalize_radius, FinalRadius};
 pub use record::{compute_record, RecordEstimate};
 pub use weight::{record_weight, splat_radius, WeightKind};

@@ -11,6 +11,7 @@
 //! | `max_spacing_px` | 32 | 20 | 15 | validity radius cap in pixels (§8.1); pbrt-v2 15 |
 //! | `strata_m × strata_n` | 8×24 | 12×36 | 24×72 | §2.2: interactive 192 rays, offline 768; default 432 measured (below); high ≈ 1.7k (`N = 3M`) |
 //! | `fine_strata_m × fine_strata_n` | 8×24 | 8×24 | 24×72 | §2.8: irradiance records requested at a level no wider than `R⁻`; default measured (below) |
+//! | `strata_falloff` | no | yes | no | §2.8: each level finer than that halves the fine strata's rays (6×18 at 2 px, 4×12 at 1 px); measured (below) |
 //! | `hole_threshold` | 0.25 | 0.5 | 0.75 | Σw, in units of [`weight_unit`], below which a pixel is a hole (pbrt-v2 minWeight 0.5) |
 //! | `levels` | 5 | 6 | 6 | coarse-to-fine spacings `2^(levels−1) … 1` px (docs/cache-frame.md §3.3: 32, 16, 8, 4, 2, 1) |
 //! | `creation_strictness` | 0.7 | 0.7 | 0.7 | docs/cache-frame.md §3.2: create at `a·0.7` (Ward) or `κ/0.7` (T&L) |
@@ -81,6 +82,14 @@
 //! from 14.1 M to 5.8 M (−59 %) for relMSE 1.426e-3 against 1.337e-3 (+7 %; block RMSE +1.5 %),
 //! and the Cornell box's by 26 % for +2–4 %. 8×24 from spacing 2 px only cut 39 % for +3 %;
 //! 4×12 from 2 px, 6×18 from 4 px and 8×24 at every level (the draft's strata) lost 17–23 %.
+//!
+//! The default's strata falloff (§2.8; 2026-12-06, once the radiance grid and adaptive
+//! anti-aliasing had made the frame's other costs smaller) was measured on the courtyard at 256²
+//! with the CLI's defaults, seeds 0, 2 and 3 (`radcache render … --seed S [--strata-falloff
+//! off]`, own relMSE net of the reference's noise): record rays −27 % (4.03 M → 2.98 M at seed
+//! 0) for own relMSE +8 to +9 % and block RMSE +1 to +4 %; on the Cornell box −7 % for +3 %.
+//! Steeper splits cost more error than they save: 6×18 already at 4 px and 4×12 at 1 px gave
+//! 2.65 M rays and +14 % (block RMSE +7 %), 4×12 at every fine level 2.01 M and +53 %.
 
 use crate::radius::radius_bounds;
 use crate::weight::{coverage_threshold, validity_scale, weight_unit, WeightKind};
@@ -132,6 +141,9 @@ pub struct IcParams {
     pub fine_strata_m: u32,
     /// Azimuthal strata of those records (§2.8).
     pub fine_strata_n: u32,
+    /// Whether each level finer than [`IcParams::fine_level`] halves the fine strata's rays
+    /// (`M` and `N` over √2 per level: [`falloff_strata`]; §2.8).
+    pub strata_falloff: bool,
     /// Σw, in units of [`weight_unit`], below which a pixel counts as a hole (§5.6;
     /// docs/cache-frame.md §3.3).
     pub hole_threshold: f32,
@@ -169,6 +181,7 @@ impl IcParams {
             strata_n: 36,
             fine_strata_m: 8,
             fine_strata_n: 24,
+            strata_falloff: true,
             hole_threshold: 0.5,
             levels: 6,
             creation_strictness: 0.7,
@@ -187,6 +200,7 @@ impl IcParams {
                 strata_n: 24,
                 fine_strata_m: 8,
                 fine_strata_n: 24,
+                strata_falloff: false,
                 hole_threshold: 0.25,
                 levels: 5,
                 temporal_accuracy: 0.1,
@@ -202,6 +216,7 @@ impl IcParams {
                 strata_n: 72,
                 fine_strata_m: 24,
                 fine_strata_n: 72,
+                strata_falloff: false,
                 hole_threshold: 0.75,
                 temporal_accuracy: 0.02,
                 max_age_frames: 15.0,
@@ -303,11 +318,15 @@ impl IcParams {
     /// The strata `(M, N)` of a record requested at creation level `level`; `glossy`: it is
     /// made for a glossy lobe from the cache (`RECORD_FLAG_GLOSSY`), whose radiance
     /// coefficients keep `strata_m × strata_n` at every level (§2.8).
+    /// With `strata_falloff`, the fine strata fall off below the fine level ([`falloff_strata`]).
     pub fn strata_at(&self, level: u32, glossy: bool) -> (u32, u32) {
-        if level >= self.fine_level() && !glossy {
-            (self.fine_strata_m, self.fine_strata_n)
-        } else {
+        let fine_level = self.fine_level();
+        if level < fine_level || glossy {
             (self.strata_m, self.strata_n)
+        } else if self.strata_falloff {
+            falloff_strata(self.fine_strata_m, self.fine_strata_n, level - fine_level)
+        } else {
+            (self.fine_strata_m, self.fine_strata_n)
         }
     }
 
@@ -335,4 +354,31 @@ impl IcParams {
             && self.temporal_accuracy >= 0.0
             && self.max_age_frames >= 0.0
     }
+}
+
+/// The strata `(M', N')` of a record `steps` levels finer than the fine level, from the fine
+/// strata `m × n` (§2.8): `M' = round(m / √2^steps)` (at least 1), `N' = round(n · M'/m)` (at
+/// least 3), so the rays halve per level and the strata keep their shape. The rounding is exact:
+/// `M'` is the integer `k` nearest to `x = m/√2^steps`, found by comparing `(k ± ½)²` with
+/// `x² = m²/2^steps`, all exact in `f32` for `m ≤ 1728` and `steps ≤ 30` (the GLSL twin `falloff_strata` of
+/// shaders/common/ircache_math.glsl computes the same in the same way).
+pub fn falloff_strata(m: u32, n: u32, steps: u32) -> (u32, u32) {
+    if steps == 0 || m == 0 {
+        return (m, n);
+    }
+    // Halving is exact (m² < 2²⁴, far from the subnormals).
+    let mut x2 = (m * m) as f32;
+    for _ in 0..steps.min(30) {
+        x2 *= 0.5;
+    }
+    let mut k = x2.sqrt().round() as u32;
+    while (k as f32 + 0.5) * (k as f32 + 0.5) <= x2 {
+        k += 1;
+    }
+    while k > 0 && (k as f32 - 0.5) * (k as f32 - 0.5) > x2 {
+        k -= 1;
+    }
+    let m2 = k.max(1);
+    let n2 = ((2 * n * m2 + m) / (2 * m)).max(3);
+    (m2, n2)
 }

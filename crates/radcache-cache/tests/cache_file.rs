@@ -82,6 +82,12 @@ fn clear_fine_strata(b: &mut [u8]) {
     }
 }
 
+/// Clears the high half of the levels word (bytes 68..72), as versions 1 to 3 wrote it.
+fn clear_falloff(b: &mut [u8]) {
+    let w = u32::from_le_bytes(b[68..72].try_into().unwrap());
+    b[68..72].copy_from_slice(&(w & 0xffff).to_le_bytes());
+}
+
 fn dir() -> PathBuf {
     let d = std::env::temp_dir().join(format!("radcache-cache-file-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
@@ -157,7 +163,7 @@ fn a_file_that_is_not_a_cache_file_is_refused() {
 
 #[test]
 fn another_format_version_is_refused() {
-    for version in [0u32, 4] {
+    for version in [0u32, 5] {
         let mut b = bytes(3);
         b[8..12].copy_from_slice(&version.to_le_bytes());
         let (r, text) = refusal(&write("version.rcache", &b), &identity());
@@ -167,12 +173,12 @@ fn another_format_version_is_refused() {
                 Refusal::Version {
                     found,
                     oldest: 1,
-                    newest: 3
+                    newest: 4
                 } if found == version
             ),
             "{text}"
         );
-        assert!(text.contains("reads versions 1 to 3"), "{text}");
+        assert!(text.contains("reads versions 1 to 4"), "{text}");
     }
 }
 
@@ -382,10 +388,12 @@ fn fine_strata_round_trip_and_older_files_read_as_uniform() {
     let mut v2 = b.clone();
     v2[8..12].copy_from_slice(&2u32.to_le_bytes());
     clear_fine_strata(&mut v2);
+    clear_falloff(&mut v2);
     reseal_header(&mut v2);
     let uniform = IcParams {
         fine_strata_m: m,
         fine_strata_n: n,
+        strata_falloff: false,
         ..id.params
     };
     let (r, text) = refusal(&write("v2-fine.rcache", &v2), &id);
@@ -409,6 +417,45 @@ fn fine_strata_round_trip_and_older_files_read_as_uniform() {
     let (r, text) = refusal(&write("v3-zero.rcache", &zero), &id);
     assert!(matches!(r, Refusal::Corrupt(_)), "{text}");
     assert!(text.contains("fine strata"), "{text}");
+}
+
+/// From version 4 bit 16 of the levels word is the strata falloff; a version-3 file's fine
+/// strata had none, and a render with it refuses the file by name.
+#[test]
+fn strata_falloff_round_trips_and_older_files_have_none() {
+    let mut id = identity();
+    id.params = IcParams::default();
+    assert!(id.params.strata_falloff && !IcParams::draft().strata_falloff);
+    let b = CacheFile::new(id, records(2)).encode();
+    let file = CacheFile::load(&write("falloff.rcache", &b), &id, 4).unwrap();
+    assert_eq!(file.header.identity.params, id.params);
+    assert!(file.header.describe().contains("strata_falloff: 1"));
+    let mut v3 = b.clone();
+    v3[8..12].copy_from_slice(&3u32.to_le_bytes());
+    clear_falloff(&mut v3);
+    reseal_header(&mut v3);
+    let (r, text) = refusal(&write("v3-falloff.rcache", &v3), &id);
+    assert!(matches!(r, Refusal::OtherParams(_)), "{text}");
+    assert!(text.contains("strata_falloff 0 (this render: 1)"), "{text}");
+    let without = CacheIdentity {
+        params: IcParams {
+            strata_falloff: false,
+            ..id.params
+        },
+        ..id
+    };
+    let file = CacheFile::load(&write("v3-plain.rcache", &v3), &without, 4).unwrap();
+    assert_eq!(
+        (file.header.version, file.header.identity.params),
+        (3, without.params)
+    );
+    // Other bits above the levels in a version-4 header are not what this build writes.
+    let mut junk = b;
+    junk[70] |= 0x02;
+    reseal_header(&mut junk);
+    let (r, text) = refusal(&write("v4-junk.rcache", &junk), &id);
+    assert!(matches!(r, Refusal::Corrupt(_)), "{text}");
+    assert!(text.contains("levels word"), "{text}");
 }
 
 #[test]

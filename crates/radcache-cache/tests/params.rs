@@ -2,7 +2,7 @@
 //! docs/cache-frame.md §3.2).
 
 use radcache_cache::weight::{splat_radius, WeightKind};
-use radcache_cache::{IcParams, Preset};
+use radcache_cache::{falloff_strata, IcParams, Preset};
 
 #[test]
 fn presets_are_valid_and_ordered() {
@@ -38,6 +38,10 @@ fn presets_are_valid_and_ordered() {
     );
     assert_eq!((d.fine_strata_m, d.fine_strata_n), (d.strata_m, d.strata_n));
     assert_eq!((h.fine_strata_m, h.fine_strata_n), (h.strata_m, h.strata_n));
+    assert!(
+        n.strata_falloff && !d.strata_falloff && !h.strata_falloff,
+        "measured (params.rs)"
+    );
     assert!(d.sample_count() < n.sample_count() && n.sample_count() < h.sample_count());
     assert!(d.accuracy > n.accuracy && n.accuracy > h.accuracy);
     assert!(
@@ -54,10 +58,17 @@ fn fine_strata_follow_the_level_spacing() {
     let n = IcParams::default();
     // Spacings 32, 16, 8, 4, 2, 1 px against R⁻ = 4 px.
     assert_eq!(n.fine_level(), 3);
+    // 8×24 at 4 px, then half the rays per level: 6×18 at 2 px, 4×12 at 1 px.
+    let fine = [(12, 36), (12, 36), (12, 36), (8, 24), (6, 18), (4, 12)];
     for level in 0..6 {
-        let fine = level >= 3;
-        let expected = if fine { (8, 24) } else { (12, 36) };
+        let expected = fine[level as usize];
         assert_eq!(n.strata_at(level, false), expected, "level {level}");
+        let whole = IcParams {
+            strata_falloff: false,
+            ..n
+        };
+        let expected = if level >= 3 { (8, 24) } else { (12, 36) };
+        assert_eq!(whole.strata_at(level, false), expected, "level {level}");
         assert_eq!(
             n.strata_at(level, true),
             (12, 36),
@@ -78,14 +89,46 @@ fn fine_strata_follow_the_level_spacing() {
     };
     assert_eq!(wide.fine_level(), 0);
     // with_strata: fine strata with fewer rays stay, others follow.
-    assert_eq!(n.with_strata(24, 72).strata_at(4, false), (8, 24));
+    assert_eq!(n.with_strata(24, 72).strata_at(3, false), (8, 24));
     assert_eq!(n.with_strata(24, 72).strata_at(0, false), (24, 72));
-    assert_eq!(n.with_strata(4, 12).strata_at(4, false), (4, 12));
+    assert_eq!(n.with_strata(4, 12).strata_at(3, false), (4, 12));
+    assert_eq!(n.with_strata(4, 12).strata_at(5, false), (2, 6));
     let bad = IcParams {
         fine_strata_n: 2,
         ..n
     };
     assert!(!bad.is_valid());
+}
+
+/// `falloff_strata`: `M'` the integer nearest `m/√2^steps` (f64 reference), `N'` keeps the shape,
+/// the rays halve per level while the strata are many, and never below 1 × 3.
+#[test]
+fn the_strata_falloff_halves_the_rays_per_level() {
+    assert_eq!(falloff_strata(8, 24, 0), (8, 24));
+    assert_eq!(falloff_strata(8, 24, 1), (6, 18));
+    assert_eq!(falloff_strata(8, 24, 2), (4, 12));
+    assert_eq!(falloff_strata(24, 72, 2), (12, 36));
+    assert_eq!(falloff_strata(1, 3, 9), (1, 3));
+    for m in 1..=1728u32 {
+        for steps in 0..=20u32 {
+            let n = 3 * m.min(576) + m % 5;
+            let (m2, n2) = falloff_strata(m, n, steps);
+            let x = f64::from(m) / 2f64.powf(f64::from(steps) / 2.0);
+            assert!(
+                (f64::from(m2) - x).abs() <= 0.5 || m2 == 1,
+                "{m} {steps}: {m2} vs {x}"
+            );
+            let shape = f64::from(n) * f64::from(m2) / f64::from(m);
+            assert!(
+                (f64::from(n2) - shape).abs() <= 0.5 || n2 == 3,
+                "{m}×{n}: {n2}"
+            );
+            if steps == 1 && m >= 16 {
+                let ratio = f64::from(m2 * n2) / f64::from(m * n);
+                assert!((ratio - 0.5).abs() < 0.1, "{m}×{n}: {ratio}");
+            }
+        }
+    }
 }
 
 #[test]

@@ -93,9 +93,10 @@ fn a_cache_file_round_trips_through_render_and_info() {
     let json: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["records"].as_u64(), Some(records));
     assert_eq!(json["params"]["accuracy"].as_f64(), Some(0.3));
-    assert_eq!(json["format_version"].as_u64(), Some(3));
+    assert_eq!(json["format_version"].as_u64(), Some(4));
     // Draft: the same strata at every level.
     assert_eq!(json["params"]["fine_strata_m"].as_u64(), Some(8));
+    assert_eq!(json["params"]["strata_falloff"].as_u64(), Some(0));
     // The Cornell box has no glossy lobe from the cache: no radiance blocks.
     assert_eq!(json["radiance"].as_bool(), Some(false));
     assert!(info.contains("radiance coefficients: no"), "{info}");

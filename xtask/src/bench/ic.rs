@@ -83,10 +83,13 @@ enum Variant {
     /// A quarter of the direct samples as emitter shadow rays at every pixel and sub-frame
     /// (`--emitter-shadows fixed`; scenes whose emitters are taken in closed form).
     FixedShadows,
-    /// The preset's strata at every level (`--fine-strata` = `--strata`).
+    /// The preset's strata at every level (`--fine-strata` = `--strata`, `--strata-falloff off`).
     UniformStrata,
     /// Adaptive anti-aliasing and the preset's strata at every level.
     AaUniformStrata,
+    /// Adaptive anti-aliasing and the fine strata whole at every fine level
+    /// (`--strata-falloff off`).
+    AaNoFalloff,
 }
 
 impl Variant {
@@ -101,6 +104,7 @@ impl Variant {
             Variant::FixedShadows => "_fixed_shadows",
             Variant::UniformStrata => "_uniform_strata",
             Variant::AaUniformStrata => "_aa_uniform_strata",
+            Variant::AaNoFalloff => "_aa_no_falloff",
         }
     }
 }
@@ -175,9 +179,11 @@ pub fn run(args: &[&str]) -> Result<()> {
     }
     cases.push((256, Preset::Default, UniformStrata));
     cases.push((256, Preset::Default, AaUniformStrata));
-    // (case, relMSE, time, the path tracer's time per spp timed just before) of the frames with
-    // a reference.
+    cases.push((256, Preset::Default, AaNoFalloff));
+    // (case, relMSE, time, the index in `pt_beside` of the path tracer's time per spp timed just
+    // before) of the frames with a reference; one more is timed after the last.
     let mut matched = Vec::new();
+    let mut pt_beside = Vec::new();
     let pt_settings = |spp: u32| PathSettings {
         width: reference.width(),
         height: reference.height(),
@@ -187,8 +193,9 @@ pub fn run(args: &[&str]) -> Result<()> {
     };
     for (size, preset, variant) in cases {
         // This machine's speed drifts by up to 2× over minutes: the path tracer's time per spp
-        // is timed next to each frame with a reference, and the comparison uses that.
-        let pt_local_s = if size == reference.width() {
+        // is timed before and after each frame with a reference, and the comparison uses their
+        // mean.
+        if size == reference.width() {
             let out = render_path(
                 ctx,
                 shaders,
@@ -197,10 +204,8 @@ pub fn run(args: &[&str]) -> Result<()> {
                 &pt_settings(16),
                 &mut |_| {},
             )?;
-            out.time_s / 16.0
-        } else {
-            0.0
-        };
+            pt_beside.push(out.time_s / 16.0);
+        }
         let mut settings = IcSettings {
             width: size,
             height: size,
@@ -224,9 +229,14 @@ pub fn run(args: &[&str]) -> Result<()> {
                 settings.splat = SplatMode::PerSubFrame;
             }
             FixedShadows => settings.emitter_shadows = EmitterShadows::Fixed,
+            AaNoFalloff => {
+                settings.anti_aliasing = Some(AntiAliasing::preset(preset));
+                settings.params.strata_falloff = false;
+            }
             UniformStrata | AaUniformStrata => {
                 let p = &mut settings.params;
                 (p.fine_strata_m, p.fine_strata_n) = (p.strata_m, p.strata_n);
+                p.strata_falloff = false;
                 if variant == AaUniformStrata {
                     settings.anti_aliasing = Some(AntiAliasing::preset(preset));
                 }
@@ -311,9 +321,19 @@ pub fn run(args: &[&str]) -> Result<()> {
             );
             figures.push(Figure::new(&case, "ic_relmse", m.relmse, "relMSE"));
             figures.push(Figure::new(&case, "ic_block_rmse", m.block_rmse, "rmse"));
-            matched.push((case, m.relmse, out.time_s, pt_local_s));
+            matched.push((case, m.relmse, out.time_s, pt_beside.len() - 1));
         }
     }
+
+    let out = render_path(
+        ctx,
+        shaders,
+        &scene,
+        &mut gpu,
+        &pt_settings(16),
+        &mut |_| {},
+    )?;
+    pt_beside.push(out.time_s / 16.0);
 
     // The path tracer at growing spp against the same reference.
     let mut fit = Vec::new();
@@ -364,7 +384,8 @@ pub fn run(args: &[&str]) -> Result<()> {
         e_ref,
         "relMSE",
     ));
-    for (case, relmse, time, t_local) in matched {
+    for (case, relmse, time, k) in matched {
+        let t_local = 0.5 * (pt_beside[k] + pt_beside[k + 1]);
         let own = relmse - e_ref;
         if own <= 0.0 {
             println!("{case}: relMSE {relmse:.2e} is within the reference's own noise");
@@ -373,7 +394,7 @@ pub fn run(args: &[&str]) -> Result<()> {
         let spp_needed = c / own;
         let pt_time = spp_needed * t_local;
         println!(
-            "{case}: own relMSE {own:.2e} ({relmse:.2e} against the reference); PT needs ~{spp_needed:.0} spp = {pt_time:.1} s at {t_local:.3} s per spp timed beside it ({:.1} s at the fit's {t1:.3}); IC took {time:.1} s: {:.1}× faster",
+            "{case}: own relMSE {own:.2e} ({relmse:.2e} against the reference); PT needs ~{spp_needed:.0} spp = {pt_time:.1} s at {t_local:.3} s per spp timed around it ({:.1} s at the fit's {t1:.3}); IC took {time:.1} s: {:.1}× faster",
             spp_needed * t1,
             pt_time / time
         );

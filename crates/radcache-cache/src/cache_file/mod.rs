@@ -12,7 +12,7 @@
 //! | 12..20 | scene content hash (`radcache_scene::Scene::content_hash`, FNV-1a 64) |
 //! | 20..32 | settings: width, height (u32), time step in s (f32) |
 //! | 32..36 | CRC-32 of the settings' 12 bytes (the settings hash) |
-//! | 36..88 | [`IcParams`], 13 words in declaration order (`weight_kind` as its GLSL constant; from version 3 the high 16 bits of `strata_m` and `strata_n` hold `fine_strata_m` and `fine_strata_n`) |
+//! | 36..88 | [`IcParams`], 13 words in declaration order (`weight_kind` as its GLSL constant; from version 3 the high 16 bits of `strata_m` and `strata_n` hold `fine_strata_m` and `fine_strata_n`, from version 4 bit 16 of `levels` `strata_falloff`) |
 //! | 88..92 | record count n |
 //! | 92..96 | the renderer's frame count at export (the clock of the last-use marks and of the temporal state's frame numbers) |
 //! | 96..100 | flags (bit 0: the records carry lifespans; bit 1: they hold a constant environment's light, the sky; bit 2: the Hessian error control sized them, `IcParams::error_control`; bit 3, from version 2: the payload holds their radiance blocks) |
@@ -24,7 +24,7 @@
 //!
 //! Version 1 had no bit 3 (its records never carry radiance blocks); it is read as it was
 //! written. Versions 1 and 2 had no fine strata: every record was gathered with `strata_m ×
-//! strata_n`, which a reader takes as their fine strata too. A file with the flag but a renderer without radiance records, or the reverse, is the
+//! strata_n`, which a reader takes as their fine strata too; versions 1 to 3 had no strata falloff. A file with the flag but a renderer without radiance records, or the reverse, is the
 //! renderer's to settle (`radcache_render::IcRenderer::import_cache`).
 //!
 //! [`CacheFile::decode`] refuses, in this order: a file that does not start with the magic, a
@@ -52,7 +52,7 @@ use params::{param_values, param_words, params_from_words};
 /// The first eight bytes of a cache file.
 pub const MAGIC: [u8; 8] = *b"RADCACHE";
 /// The format version this build writes.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 /// The oldest format version this build reads (version 1: no radiance blocks).
 pub const OLDEST_VERSION: u32 = 1;
 /// Bytes of the header (the payload starts here).

@@ -1,6 +1,6 @@
 //! The cache parameters in a cache file's header: 13 words in declaration order (the strata
-//! words also carry the fine strata from format version 3), and the parameters by name for
-//! messages and reports.
+//! words also carry the fine strata from format version 3, the levels word the strata falloff
+//! from version 4), and the parameters by name for messages and reports.
 
 use super::Refusal;
 use crate::params::IcParams;
@@ -35,7 +35,7 @@ impl std::fmt::Display for ParamValue {
 }
 
 /// The cache parameters by name, as reports and refusals show them: the 13 header words'
-/// fields in declaration order, then the fine strata.
+/// fields in declaration order, then the fine strata and their falloff.
 pub(super) fn param_values(p: &IcParams) -> Vec<(&'static str, ParamValue)> {
     let f = |name, v: f32| (name, ParamValue::Real(v));
     let u = |name, v: u32| (name, ParamValue::Int(v));
@@ -55,11 +55,13 @@ pub(super) fn param_values(p: &IcParams) -> Vec<(&'static str, ParamValue)> {
         f("max_age_frames", p.max_age_frames),
         u("fine_strata_m", p.fine_strata_m),
         u("fine_strata_n", p.fine_strata_n),
+        u("strata_falloff", u32::from(p.strata_falloff)),
     ]
 }
 
 /// The cache parameters as the header's 13 words, in declaration order; from version 3 the
-/// strata words carry the fine strata in their high 16 bits.
+/// strata words carry the fine strata in their high 16 bits, from version 4 the levels word the
+/// strata falloff in bit 16.
 pub(super) fn param_words(p: &IcParams) -> [u32; 13] {
     let packed = |coarse: u32, fine: u32| (coarse & 0xffff) | (fine << 16);
     [
@@ -71,7 +73,7 @@ pub(super) fn param_words(p: &IcParams) -> [u32; 13] {
         packed(p.strata_m, p.fine_strata_m),
         packed(p.strata_n, p.fine_strata_n),
         p.hole_threshold.to_bits(),
-        p.levels,
+        (p.levels & 0xffff) | (u32::from(p.strata_falloff) << 16),
         p.creation_strictness.to_bits(),
         p.front_tolerance_px.to_bits(),
         p.temporal_accuracy.to_bits(),
@@ -80,7 +82,7 @@ pub(super) fn param_words(p: &IcParams) -> [u32; 13] {
 }
 
 /// The parameters of a file of format `version`: before version 3 every record had the same
-/// strata, which are then also the fine ones.
+/// strata, which are then also the fine ones; before version 4 the fine strata had no falloff.
 pub(super) fn params_from_words(w: &[u32; 13], version: u32) -> Result<IcParams, Refusal> {
     let weight_kind = WeightKind::from_u32(w[0]);
     if weight_kind as u32 != w[0] {
@@ -98,6 +100,17 @@ pub(super) fn params_from_words(w: &[u32; 13], version: u32) -> Result<IcParams,
     } else {
         (w[5], w[6], w[5], w[6])
     };
+    let (levels, strata_falloff) = if version >= 4 {
+        if w[8] >> 17 != 0 {
+            return Err(Refusal::Corrupt(format!(
+                "levels word {:#x} in a version-{version} header",
+                w[8]
+            )));
+        }
+        (w[8] & 0xffff, w[8] >> 16 == 1)
+    } else {
+        (w[8], false)
+    };
     let f = f32::from_bits;
     Ok(IcParams {
         weight_kind,
@@ -111,8 +124,9 @@ pub(super) fn params_from_words(w: &[u32; 13], version: u32) -> Result<IcParams,
         strata_n,
         fine_strata_m,
         fine_strata_n,
+        strata_falloff,
         hole_threshold: f(w[7]),
-        levels: w[8],
+        levels,
         creation_strictness: f(w[9]),
         front_tolerance_px: f(w[10]),
         temporal_accuracy: f(w[11]),

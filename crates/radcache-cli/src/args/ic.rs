@@ -105,6 +105,16 @@ pub enum PathGridArg {
     Off,
 }
 
+/// Whether the fine strata fall off below the first level that takes them
+/// (docs/irradiance-cache.md §2.8).
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StrataFalloffArg {
+    /// Each finer level halves their rays (the default preset's).
+    On,
+    /// Every level from the first takes them whole (draft's and high's).
+    Off,
+}
+
 /// Whose paths a pixel's specular lobe takes its indirect light from (docs/materials.md §10).
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SpecularPathsArg {
@@ -156,6 +166,10 @@ pub struct IcArgs {
     /// glossy lobes (`--fine-strata 8x24`; docs/irradiance-cache.md §2.8).
     #[arg(long, value_name = "MxN")]
     pub fine_strata: Option<String>,
+    /// Whether each creation level finer than the first that takes the fine strata halves their
+    /// rays (`on` in the default preset; docs/irradiance-cache.md §2.8).
+    #[arg(long, value_enum)]
+    pub strata_falloff: Option<StrataFalloffArg>,
     /// Record validity radius bounds R⁻,R⁺ in pixels (`--spacing 2,20`).
     #[arg(long, value_name = "MIN,MAX")]
     pub spacing: Option<String>,
@@ -359,6 +373,9 @@ impl IcArgs {
         }
         if let Some(text) = &self.fine_strata {
             (params.fine_strata_m, params.fine_strata_n) = strata(text, "--fine-strata")?;
+        }
+        if let Some(falloff) = self.strata_falloff {
+            params.strata_falloff = falloff == StrataFalloffArg::On;
         }
         if let Some(text) = &self.spacing {
             let (lo, hi) = pair::<f32>(text, ',', "--spacing")?;

@@ -86,6 +86,9 @@ radcache_shared::gpu_struct! {
         pub fine_m: u32 => "uint",
         /// Fine N.
         pub fine_n: u32 => "uint",
+        /// 1: the fine strata fall off below `fine_level` (`IcParams::strata_falloff`,
+        /// `falloff_strata`; docs/irradiance-cache.md §2.8).
+        pub strata_falloff: u32 => "uint",
         /// The dispatch's epoch in the frame's radiance grid (`PATH_GRID`; 0: the grid is
         /// neither read nor written; docs/cache-frame.md §4.1).
         pub grid_epoch: u32 => "uint",
@@ -454,6 +457,7 @@ impl RecordPass {
             fine_level: p.fine_level(),
             fine_m: p.fine_strata_m,
             fine_n: p.fine_strata_n,
+            strata_falloff: u32::from(p.strata_falloff),
             // New records and refreshes alike (docs/temporal.md §3.8).
             grid_epoch: self.grid.as_ref().map_or(0, |g| g.next_epoch()),
         };
