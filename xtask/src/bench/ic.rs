@@ -191,20 +191,15 @@ pub fn run(args: &[&str]) -> Result<()> {
         seed: 777,
         ..PathSettings::default()
     };
+    // This machine's speed drifts by up to 2× over minutes: the path tracer's time per spp is
+    // timed before and after each frame with a reference, and the comparison uses their mean.
+    let pt_s_per_spp = |gpu: &mut GpuScene| -> Result<f64> {
+        let out = render_path(ctx, shaders, &scene, gpu, &pt_settings(16), &mut |_| {})?;
+        Ok(out.time_s / 16.0)
+    };
     for (size, preset, variant) in cases {
-        // This machine's speed drifts by up to 2× over minutes: the path tracer's time per spp
-        // is timed before and after each frame with a reference, and the comparison uses their
-        // mean.
         if size == reference.width() {
-            let out = render_path(
-                ctx,
-                shaders,
-                &scene,
-                &mut gpu,
-                &pt_settings(16),
-                &mut |_| {},
-            )?;
-            pt_beside.push(out.time_s / 16.0);
+            pt_beside.push(pt_s_per_spp(&mut gpu)?);
         }
         let mut settings = IcSettings {
             width: size,
@@ -325,15 +320,7 @@ pub fn run(args: &[&str]) -> Result<()> {
         }
     }
 
-    let out = render_path(
-        ctx,
-        shaders,
-        &scene,
-        &mut gpu,
-        &pt_settings(16),
-        &mut |_| {},
-    )?;
-    pt_beside.push(out.time_s / 16.0);
+    pt_beside.push(pt_s_per_spp(&mut gpu)?);
 
     // The path tracer at growing spp against the same reference.
     let mut fit = Vec::new();
