@@ -57,7 +57,8 @@ fn the_estimate_bounds_the_sampling_error_and_the_frame_goes_on_to_its_target() 
     // jitters being a low-discrepancy sequence, converge much faster, so the relMSE of the 8
     // against the 64 is about the 8's own sampling error. The estimate assumes independent
     // samples (σ²/n): it must not fall below that error (a frame would stop too early) and
-    // overestimates the jitters' part (docs/cache-frame.md §7.1: 2.9× here).
+    // overestimates the jitters' part (docs/cache-frame.md §7.1: 4.5× here, the antithetic pairs
+    // of jitters cancelling what it counts as independent).
     assert_eq!(stats8.records, stats64.records);
     let m = compare(&image(&out64), &image(&out8)).unwrap();
     eprintln!(
@@ -66,7 +67,7 @@ fn the_estimate_bounds_the_sampling_error_and_the_frame_goes_on_to_its_target() 
     );
     assert!(est8 > 1e-4, "the box at 48² has edges: {est8}");
     let ratio = est8 / m.relmse;
-    assert!((1.0..4.0).contains(&ratio), "estimate / error = {ratio}");
+    assert!((1.0..6.0).contains(&ratio), "estimate / error = {ratio}");
     // 1/n: eight times the sub-frames, about an eighth of the estimate.
     let fall = est8 / est64;
     assert!((5.0..11.0).contains(&fall), "estimate fell {fall}×");

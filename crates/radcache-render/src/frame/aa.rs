@@ -7,9 +7,10 @@
 //! the variance of the mean of `n` independent samples `s²/n`. Divided by `m² + 0.01`
 //! (`m = S/n`) and averaged over pixels and channels, as `radcache compare`'s relMSE, it
 //! estimates the relMSE that the sub-frame sampling leaves in the image. The jitters are not
-//! independent (the R2 sequence: their means converge faster than `1/n`), so for edges it is an
-//! overestimate: 2.9× on the Cornell box at 48² (tests/tests/ic_anti_aliasing.rs), a frame stops
-//! later than it needs to, never earlier. (The difference of the even and odd sub-frames' means
+//! independent (the R2 sequence in antithetic pairs: their means converge faster than `1/n`), so
+//! for edges it is an overestimate: 4.5× on the Cornell box at 48²
+//! (tests/tests/ic_anti_aliasing.rs), a frame stops later than it needs to, never earlier. (With
+//! the plain sequence it was 2.9×, and the difference of the even and odd sub-frames' means
 //! overestimated more, 5.2×: each half is a sparser set of the sequence.)
 
 /// The relMSE offset, as `radcache_image::Metrics::relmse`.

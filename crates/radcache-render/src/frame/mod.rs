@@ -5,8 +5,9 @@
 //! # The cache's frame
 //!
 //! [`ic::IcRenderer::render`] is a list of phases over the frame's `sub_frames` jittered
-//! sub-frames (default 8; the centre, then the R2 sequence, [`settings::sub_frame_jitter`]),
-//! each phase a function of its own (`ic/phases.rs`, `ic/temporal.rs`):
+//! sub-frames (default 8; the centre, then the R2 sequence in antithetic pairs,
+//! [`settings::sub_frame_jitter`]), each phase a function of its own (`ic/phases.rs`,
+//! `ic/temporal.rs`):
 //!
 //! 1. **Setup**: the scene at the frame's time (TLAS refit) and view; records unused for
 //!    `evict_after_frames` are evicted; kept records are moved with their instances and the
