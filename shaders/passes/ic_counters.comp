@@ -1,4 +1,4 @@
-// passes/ic_counters.comp — Rust: crates/radcache-render/src/passes/ic_counters.rs
+// passes/ic_counters.comp — Rust: crates/radcache-render/src/state/ic_counters.rs
 // Bookkeeping of the irradiance cache's counters and indirect arguments (one invocation), so the
 // host never reads counts back to size the next dispatch or draw:
 //   COUNTERS_RESET        no records, no requests (capacities from the push constants)

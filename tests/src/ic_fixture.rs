@@ -3,7 +3,9 @@
 //! triangles for CPU ray casting, and comparison helpers.
 
 use glam::{DVec3, Mat3, Quat, Vec3};
-use radcache_render::{DirectPass, EnvMap, GBuffer, GBufferPass, GpuScene};
+use radcache_render::{
+    DirectInputs, DirectOutputs, DirectPass, EnvMap, GBuffer, GBufferPass, GpuScene,
+};
 use radcache_scene::writer::{GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
 use radcache_scene::Scene;
 use radcache_vk::{Context, PassTiming, ShaderCompiler};
@@ -133,7 +135,15 @@ impl Gpu {
             .record(&mut rec, &self.scene, &self.gbuffer, jitter)
             .unwrap();
         if let Some((pass, samples, seed)) = direct {
-            pass.record(&mut rec, &self.scene, &self.gbuffer, samples, 0, seed)
+            let inputs = DirectInputs {
+                scene: &self.scene,
+                gbuffer: &self.gbuffer,
+                samples,
+                sub_frame: 0,
+                seed,
+                glossy: None,
+            };
+            pass.record(&mut rec, &inputs, &DirectOutputs::Image)
                 .unwrap();
         }
         names(&self.ctx.submit(rec).unwrap().wait().unwrap())
@@ -153,15 +163,16 @@ impl Gpu {
         for image in self.gbuffer.images() {
             rec.use_image(image, radcache_vk::ImageUse::ComputeStorage);
         }
+        let inputs = DirectInputs {
+            scene: &self.scene,
+            gbuffer: &self.gbuffer,
+            samples,
+            sub_frame,
+            seed,
+            glossy: None,
+        };
         direct
-            .record(
-                &mut rec,
-                &self.scene,
-                &self.gbuffer,
-                samples,
-                sub_frame,
-                seed,
-            )
+            .record(&mut rec, &inputs, &DirectOutputs::Image)
             .unwrap();
         self.ctx.submit(rec).unwrap().wait().unwrap();
         (self.read(&self.gbuffer.direct), direct.rays().unwrap())

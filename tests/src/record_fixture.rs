@@ -9,7 +9,10 @@ use radcache_cache::radius::pixel_footprint;
 use radcache_cache::sampling::{
     basis_from_normal, frame_to_world, normalize_or_z, stratum_direction_local, stratum_jitter,
 };
-use radcache_render::{record_seed, GBuffer, GpuScene, IcState, RecordPass, R_EPS_REL};
+use radcache_render::{
+    record_seed, GBuffer, GpuScene, IcState, RecordInputs, RecordJob, RecordOutputs, RecordPass,
+    R_EPS_REL,
+};
 use radcache_scene::Scene;
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_vk::{vk, Access, Buffer, Context, Pipeline, ShaderCompiler};
@@ -98,18 +101,49 @@ pub fn sentinel() -> GpuRecord {
 
 /// One batch: `requests` over a G-buffer holding `points` (every other pixel is background),
 /// with `counters` as given.
-#[allow(clippy::too_many_arguments)]
+#[derive(Debug, Clone, Copy)]
+pub struct Batch<'a> {
+    /// The G-buffer's points.
+    pub points: &'a [GbufferPoint],
+    /// The requests (pixel indices).
+    pub requests: &'a [u32],
+    /// The counters before the dispatch.
+    pub counters: IcCounters,
+}
+
+impl<'a> Batch<'a> {
+    pub fn new(points: &'a [GbufferPoint], requests: &'a [u32], counters: IcCounters) -> Self {
+        Batch {
+            points,
+            requests,
+            counters,
+        }
+    }
+}
+
+/// Records created at `level` and `sub_frame` with the pass seed `seed`.
+pub fn create(seed: u32, level: u32, sub_frame: u32) -> RecordJob {
+    RecordJob::Create {
+        level,
+        sub_frame,
+        seed,
+    }
+}
+
+/// Runs `job` over `batch`, dumping the strata's samples, with `radiance` for the records'
+/// radiance blocks.
 pub fn run_with_radiance(
     f: &mut Fixture,
     pass: &RecordPass,
-    points: &[GbufferPoint],
-    requests: &[u32],
-    counters: IcCounters,
-    seed: u32,
-    level: u32,
-    sub_frame: u32,
+    batch: &Batch<'_>,
+    job: RecordJob,
     radiance: Option<&Buffer>,
 ) -> Run {
+    let Batch {
+        points,
+        requests,
+        counters,
+    } = *batch;
     let per = pass.params().sample_count() as usize;
     let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
     let zeros = vec![[0.0f32; 4]; requests.len() * per];
@@ -124,16 +158,23 @@ pub fn run_with_radiance(
     rec.update_buffer(&st.counters, 0, &[counters]);
     rec.update_buffer(&st.records, 0, &[sentinel(); SLOTS]);
     rec.barrier(Access::ALL_WRITES, Access::ALL);
-    let (requests, counters, records) = (&st.requests, &st.counters, &st.records);
-    pass.record_with_samples(
-        &mut rec, &f.gpu, g, requests, counters, records, level, sub_frame, seed, &samples,
+    let inputs = RecordInputs {
+        scene: &f.gpu,
+        gbuffer: g,
+        requests: &st.requests,
+        counters: &st.counters,
+        job,
+    };
+    let outputs = RecordOutputs {
+        records: &st.records,
         radiance,
-    )
-    .unwrap();
+        samples: Some(&samples),
+    };
+    pass.record(&mut rec, &inputs, &outputs).unwrap();
     let timings = f.ctx.submit(rec).unwrap().wait().unwrap();
     assert!(timings.iter().any(|t| t.name == "records"), "no scope");
     Run {
-        records: f.ctx.read_buffer(records, SLOTS).unwrap(),
+        records: f.ctx.read_buffer(&st.records, SLOTS).unwrap(),
         samples: f.ctx.read_buffer(&samples, zeros.len()).unwrap(),
         counters: st.read_counters().unwrap(),
         rays: pass.rays().unwrap(),
@@ -142,20 +183,8 @@ pub fn run_with_radiance(
 }
 
 /// [`run_with_radiance`] without radiance coefficients.
-#[allow(clippy::too_many_arguments)]
-pub fn run(
-    f: &mut Fixture,
-    pass: &RecordPass,
-    points: &[GbufferPoint],
-    requests: &[u32],
-    counters: IcCounters,
-    seed: u32,
-    level: u32,
-    sub_frame: u32,
-) -> Run {
-    run_with_radiance(
-        f, pass, points, requests, counters, seed, level, sub_frame, None,
-    )
+pub fn run(f: &mut Fixture, pass: &RecordPass, batch: &Batch<'_>, job: RecordJob) -> Run {
+    run_with_radiance(f, pass, batch, job, None)
 }
 
 /// Every vec4 of `buffer`.

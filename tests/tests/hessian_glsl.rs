@@ -153,7 +153,7 @@ fn terms(rng: &mut Rng) -> Vec<Case> {
         e.exact(4, 1, hessian_farthest(a, y.x, b, y.y, c, y.z));
         // |λ| is a sum of magnitudes here (no cancellation): relative rounding only.
         e.f(4, 2, hessian_radius(hsum, footprint), 0.0);
-        let cell = hessian_cell(
+        let cell = hessian_cell(&HessianCell {
             a,
             b,
             c,
@@ -164,9 +164,9 @@ fn terms(rng: &mut Rng) -> Vec<Case> {
             y_bl,
             y_au,
             y_cap,
-            flags & 1 != 0,
-            flags & 2 != 0,
-        );
+            first: flags & 1 != 0,
+            last: flags & 2 != 0,
+        });
         let cs = 2.0 * (edge_scale(b, d) + edge_scale(a, b) + edge_scale(a, d) + edge_scale(b, c));
         e.f(5, 0, cell.x, 8.0);
         for lane in 1..4 {

@@ -4,8 +4,9 @@
 //! followed by the composite pass adds.
 
 use radcache_render::{
-    sub_frame_jitter, CentreSamples, CompositePass, CompositeSubFrame, CompositeTargets,
-    DirectPass, EmitterLight, SkyLight, SplatPass,
+    sub_frame_jitter, CentreSamples, CompositeInputs, CompositePass, CompositeSubFrame,
+    CompositeTargets, CompositeVariant, DirectCompositing, DirectInputs, DirectOutputs, DirectPass,
+    DirectShadows, DirectVariant, EmitterLight, SkyLight, SplatPass,
 };
 use radcache_tests::ic_fixture::{cornell, Gpu};
 use radcache_vk::ImageUse;
@@ -21,26 +22,37 @@ fn the_direct_pass_composites_as_the_composite_pass() {
     let (w, h) = (48, 40);
     let gpu = Gpu::new(&cornell(), None, (w, h));
     let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
-    let direct = || {
-        let (sky, emitters) = (SkyLight::Direct, EmitterLight::Analytic);
-        DirectPass::with_composite(ctx, shaders, &gpu.scene, sky, emitters, false, Some(true))
-            .unwrap()
-            .with_adaptive_shadows(ctx, Some(w * h))
-            .unwrap()
+    let direct_variant = DirectVariant {
+        composite: Some(DirectCompositing { moments: true }),
+        shadows: DirectShadows::Adaptive { pixels: w * h },
+        ..DirectVariant::new(SkyLight::Direct, EmitterLight::Analytic)
     };
-    let composite =
-        || CompositePass::with_options(ctx, shaders, &gpu.scene, w, h, false, true, true).unwrap();
+    let direct = || DirectPass::new(ctx, shaders, &gpu.scene, &direct_variant).unwrap();
+    let variant = CompositeVariant {
+        moments: true,
+        centres: true,
+        ..CompositeVariant::new(w, h)
+    };
+    let composite = || CompositePass::new(ctx, shaders, &gpu.scene, &variant).unwrap();
     // [fused, separate]
     let passes = [(direct(), composite()), (direct(), composite())];
     let splat = SplatPass::new(ctx, shaders, w, h).unwrap();
+    let (samples, seed) = (16, 7);
+    let inputs = |sub_frame| DirectInputs {
+        scene: &gpu.scene,
+        gbuffer: &gpu.gbuffer,
+        samples,
+        sub_frame,
+        seed,
+        glossy: None,
+    };
     // A direct pass made to composite refuses the plain recording.
     let mut rec = ctx.begin("test.refused").unwrap();
-    assert!(passes[0]
+    let plain = passes[0]
         .0
-        .record(&mut rec, &gpu.scene, &gpu.gbuffer, 16, 0, 7)
-        .is_err());
+        .record(&mut rec, &inputs(0), &DirectOutputs::Image);
+    assert!(plain.is_err());
     drop(rec);
-    let (samples, seed) = (16, 7);
     for k in 0..5 {
         let jitter = sub_frame_jitter(k);
         let mut rec = ctx.begin("test.sub_frame").unwrap();
@@ -56,28 +68,27 @@ fn the_direct_pass_composites_as_the_composite_pass() {
             if k == 0 {
                 composite.record_clear(&mut rec);
             }
-            let targets = CompositeTargets {
-                composite,
-                splat: &splat,
-                glossy: None,
-            };
             let fused = k > 0 && i == 0;
-            let sub_frame = fused.then_some(CompositeSubFrame { jitter });
+            let outputs = DirectOutputs::Composited {
+                targets: CompositeTargets {
+                    composite,
+                    splat: &splat,
+                },
+                sub_frame: fused.then_some(CompositeSubFrame { jitter }),
+            };
+            direct.record(&mut rec, &inputs(k), &outputs).unwrap();
             let g = &gpu.gbuffer;
-            direct
-                .record_composited(
-                    &mut rec, &gpu.scene, g, samples, k, seed, targets, sub_frame,
-                )
-                .unwrap();
             if !fused {
                 let centre = if k == 0 {
                     CentreSamples::Store
                 } else {
                     CentreSamples::Match
                 };
-                composite
-                    .record_glossy(&mut rec, &gpu.scene, g, &splat, None, jitter, centre, false)
-                    .unwrap();
+                let inputs = CompositeInputs {
+                    centre,
+                    ..CompositeInputs::own(&gpu.scene, g, &splat, jitter)
+                };
+                composite.record(&mut rec, &inputs).unwrap();
             }
         }
         ctx.submit(rec).unwrap().wait().unwrap();

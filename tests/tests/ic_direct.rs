@@ -6,7 +6,8 @@ use std::f64::consts::PI;
 
 use glam::{DVec3, Quat, Vec3};
 use radcache_render::{
-    CompositePass, DirectPass, EmissionPass, EmitterLight, EnvMap, SkyLight, SplatPass,
+    CompositeInputs, CompositePass, CompositeVariant, DirectPass, DirectVariant, EmissionPass,
+    EmitterLight, EnvMap, SkyLight, SplatPass,
 };
 use radcache_scene::light::LightKind;
 use radcache_scene::writer::{GltfBuilder, LightDesc, MaterialDesc, NodeDesc};
@@ -74,8 +75,7 @@ fn direct_light_matches_a_point_light_and_a_constant_sky() {
             &gpu.ctx,
             &gpu.shaders,
             &gpu.scene,
-            sky_light,
-            EmitterLight::Sampled,
+            &DirectVariant::new(sky_light, EmitterLight::Sampled),
         )
         .unwrap();
         let in_records = sky_light == SkyLight::Records;
@@ -141,7 +141,13 @@ fn direct_light_is_unbiased_on_the_cornell_box() {
 
 fn direct_agrees_with_the_cpu(gpu: &Gpu, g: &GRead, cpu: &[DVec3], emitters: EmitterLight) {
     let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
-    let direct = DirectPass::new(ctx, shaders, &gpu.scene, SkyLight::Direct, emitters).unwrap();
+    let direct = DirectPass::new(
+        ctx,
+        shaders,
+        &gpu.scene,
+        &DirectVariant::new(SkyLight::Direct, emitters),
+    )
+    .unwrap();
     let mut runs = Vec::new();
     for (samples, seed) in [(4, 11), (256, 12)] {
         gpu.render([0.0; 2], Some((&direct, samples, seed)));
@@ -181,7 +187,13 @@ fn closed_form_emitters_in_a_specular_scene_agree_with_sampling() {
     let g = gpu.read_gbuffer();
     let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
     let run = |emitters: EmitterLight, samples: u32, seed: u32| -> (Vec<DVec3>, u64) {
-        let direct = DirectPass::new(ctx, shaders, &gpu.scene, SkyLight::Direct, emitters).unwrap();
+        let direct = DirectPass::new(
+            ctx,
+            shaders,
+            &gpu.scene,
+            &DirectVariant::new(SkyLight::Direct, emitters),
+        )
+        .unwrap();
         gpu.render([0.0; 2], Some((&direct, samples, seed)));
         let out = gpu.read(&gpu.gbuffer.direct).into_iter().map(xyz).collect();
         (out, direct.rays().unwrap())
@@ -231,8 +243,7 @@ fn direct_light_in_the_furnace_is_albedo_times_emission() {
         ctx,
         shaders,
         &gpu.scene,
-        SkyLight::Direct,
-        EmitterLight::Sampled,
+        &DirectVariant::new(SkyLight::Direct, EmitterLight::Sampled),
     );
     let sampled = sampled.unwrap();
     gpu.render([0.0; 2], Some((&sampled, 4, 3)));
@@ -254,8 +265,7 @@ fn direct_light_in_the_furnace_is_albedo_times_emission() {
         ctx,
         shaders,
         &gpu.scene,
-        SkyLight::Direct,
-        EmitterLight::Analytic,
+        &DirectVariant::new(SkyLight::Direct, EmitterLight::Analytic),
     );
     let analytic = analytic.unwrap();
     gpu.render([0.0; 2], Some((&analytic, 4, 3)));
@@ -309,12 +319,12 @@ fn composite_sums_direct_indirect_emission_and_environment() {
         ctx,
         shaders,
         &gpu.scene,
-        SkyLight::Direct,
-        EmitterLight::Sampled,
+        &DirectVariant::new(SkyLight::Direct, EmitterLight::Sampled),
     )
     .unwrap();
     let splat = SplatPass::new(ctx, shaders, w, h).unwrap();
-    let composite = CompositePass::new(ctx, shaders, &gpu.scene, w, h).unwrap();
+    let variant = CompositeVariant::new(w, h);
+    let composite = CompositePass::new(ctx, shaders, &gpu.scene, &variant).unwrap();
     let emission = EmissionPass::new(ctx, shaders, &gpu.scene).unwrap();
     let jitter = [0.2, -0.3];
     gpu.render(jitter, Some((&direct, 4, 9)));
@@ -330,9 +340,8 @@ fn composite_sums_direct_indirect_emission_and_environment() {
             rec.use_image(image, ImageUse::TransferDst);
             rec.clear_color(image, value);
         }
-        composite
-            .record(&mut rec, &gpu.scene, &gpu.gbuffer, &splat, jitter, false)
-            .unwrap();
+        let inputs = CompositeInputs::own(&gpu.scene, &gpu.gbuffer, &splat, jitter);
+        composite.record(&mut rec, &inputs).unwrap();
         names(&ctx.submit(rec).unwrap().wait().unwrap())
     };
     // No record reaches any pixel (Σw = 0: no indirect light), then Ẽ = (1, 2, 3) everywhere.

@@ -6,7 +6,7 @@
 //! along it, and along an object thinner than a pixel that the first sub-frame missed.
 
 use glam::{DVec3, Quat, Vec3};
-use radcache_render::{DirectPass, EmitterLight, SkyLight};
+use radcache_render::{DirectPass, DirectShadows, DirectVariant, EmitterLight, SkyLight};
 use radcache_scene::writer::{GltfBuilder, MaterialDesc};
 use radcache_scene::Scene;
 use radcache_tests::direct_cpu::{agree, cpu_direct};
@@ -24,17 +24,13 @@ fn mean_image(images: &[Vec<Px>]) -> Vec<DVec3> {
 /// The emitters' light in closed form, with adaptive shadows for `pixels` pixels (`None`: a
 /// quarter of the samples at every pixel and sub-frame).
 fn analytic_pass(gpu: &Gpu, pixels: Option<u32>) -> DirectPass {
-    let direct = DirectPass::new(
-        &gpu.ctx,
-        &gpu.shaders,
-        &gpu.scene,
-        SkyLight::Direct,
-        EmitterLight::Analytic,
-    );
-    direct
-        .unwrap()
-        .with_adaptive_shadows(&gpu.ctx, pixels)
-        .unwrap()
+    let variant = DirectVariant {
+        shadows: pixels.map_or(DirectShadows::Fixed, |pixels| DirectShadows::Adaptive {
+            pixels,
+        }),
+        ..DirectVariant::new(SkyLight::Direct, EmitterLight::Analytic)
+    };
+    DirectPass::new(&gpu.ctx, &gpu.shaders, &gpu.scene, &variant).unwrap()
 }
 
 /// Adaptive emitter shadows (docs/cache-frame.md §8.2) on the Cornell box: sub-frame 0 is the

@@ -12,7 +12,10 @@ use glam::Vec3;
 use radcache_cache::hessian::{compute_hessian, hessian_luminance, hessian_radius};
 use radcache_cache::radius::{finalize_radius, pixel_footprint};
 use radcache_cache::{luminance_rec709, ErrorControl, IcParams, IC_FAR};
-use radcache_render::{record_seed, GBuffer, GpuScene, IcState, RecordPass, SkyLight, R_EPS_REL};
+use radcache_render::{
+    record_seed, GBuffer, GpuScene, IcState, RecordInputs, RecordJob, RecordOutputs, RecordPass,
+    RecordVariant, SkyLight, R_EPS_REL,
+};
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::geometry::intersect;
 use radcache_tests::ic_fixture::{fill_gbuffer_points, gbuffer_fill_pipeline, GbufferPoint};
@@ -92,8 +95,15 @@ fn hessian_records_match_the_cpu_twin() {
         error_control: ErrorControl::Hessian,
         ..IcParams::draft()
     };
-    let passes = [IcParams::draft(), hessian]
-        .map(|p| RecordPass::new(&ctx, &shaders, &gpu, &p, SkyLight::Records).unwrap());
+    let passes = [IcParams::draft(), hessian].map(|p| {
+        RecordPass::new(
+            &ctx,
+            &shaders,
+            &gpu,
+            &RecordVariant::new(p, SkyLight::Records),
+        )
+        .unwrap()
+    });
     let per = hessian.sample_count() as usize;
     let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
     let texels = ctx
@@ -123,11 +133,23 @@ fn hessian_records_match_the_cpu_twin() {
         rec.update_buffer(&state.requests, 0, &requests);
         rec.update_buffer(&state.counters, 0, &[counters]);
         rec.barrier(Access::ALL_WRITES, Access::ALL);
-        let (rq, ct, rc) = (&state.requests, &state.counters, &state.records);
-        pass.record_with_samples(
-            &mut rec, &gpu, &gbuffer, rq, ct, rc, 1, 0, seed, &samples, None,
-        )
-        .unwrap();
+        let inputs = RecordInputs {
+            scene: &gpu,
+            gbuffer: &gbuffer,
+            requests: &state.requests,
+            counters: &state.counters,
+            job: RecordJob::Create {
+                level: 1,
+                sub_frame: 0,
+                seed,
+            },
+        };
+        let outputs = RecordOutputs {
+            samples: Some(&samples),
+            ..RecordOutputs::records(&state.records)
+        };
+        pass.record(&mut rec, &inputs, &outputs).unwrap();
+        let rc = &state.records;
         ctx.submit(rec).unwrap().wait().unwrap();
         let records: Vec<GpuRecord> = ctx.read_buffer(rc, k as usize).unwrap();
         let dumped: Vec<[f32; 4]> = ctx.read_buffer(&samples, per * points.len()).unwrap();

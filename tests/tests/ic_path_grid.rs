@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use radcache_cache::IcParams;
 use radcache_image::{compare, read_exr, Image, Metrics};
 use radcache_render::{
-    GlossySpacing, GpuScene, IcRenderer, IcSettings, IcStats, PathGridMode, RecordPass, SkyLight,
+    GpuScene, IcRenderer, IcSettings, IcStats, PathGridMode, RecordPass, RecordVariant, SkyLight,
 };
 use radcache_shared::consts::GPU_RECORD_R_ORIG_WORD;
 use radcache_shared::gpu::GpuRecord;
@@ -152,17 +152,11 @@ fn the_grid_is_compiled_where_the_plan_and_the_settings_ask_for_it() {
         assert!(scene.plan().path_grid(), "{name}");
         let gpu = GpuScene::new(&ctx, &scene, None).unwrap();
         for (mode, on) in [(PathGridMode::On, true), (PathGridMode::Off, false)] {
-            let pass = RecordPass::with_options(
-                &ctx,
-                &shaders,
-                &gpu,
-                &params,
-                SkyLight::Records,
-                false,
-                GlossySpacing::Lobe,
-                mode,
-            )
-            .unwrap();
+            let variant = RecordVariant {
+                path_grid: mode,
+                ..RecordVariant::new(params, SkyLight::Records)
+            };
+            let pass = RecordPass::new(&ctx, &shaders, &gpu, &variant).unwrap();
             assert_eq!(pass.path_grid(), on, "{name}, {mode:?}");
         }
         drop(gpu);

@@ -14,7 +14,7 @@ use radcache_cache::radius::finalize_radius;
 use radcache_cache::record::*;
 use radcache_cache::sampling::*;
 use radcache_cache::{IcParams, IC_FAR, R_FLOOR};
-use radcache_render::{RecordPass, SkyLight};
+use radcache_render::{RecordPass, RecordVariant, SkyLight};
 use radcache_render::{RECORD_FLAGS_MASK, RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE};
 use radcache_render::{RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED};
 use radcache_scene::Scene;
@@ -169,7 +169,13 @@ fn furnace_records_match_the_analytic_irradiance() {
     let (albedo, le) = (0.5f32, 1.0f32);
     let mut f = fixture(&furnace_scene(le));
     let params = IcParams::draft();
-    let pass = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &params, SkyLight::Records).unwrap();
+    let pass = RecordPass::new(
+        &f.ctx,
+        &f.shaders,
+        &f.gpu,
+        &RecordVariant::new(params, SkyLight::Records),
+    )
+    .unwrap();
     let (m, n) = (params.strata_m, params.strata_n);
     // Shading normal tilted off the geometric one: some directions must be folded.
     let tilted = Vec3::new(0.6, 1.0, 0.0).normalize();
@@ -185,7 +191,12 @@ fn furnace_records_match_the_analytic_irradiance() {
     let requests: Vec<u32> = points.iter().map(point_index).collect();
     let (base, seed, level, sub_frame) = (3u32, 17u32, 2u32, 1u32);
     let c = counters(base, 5, 5, 64);
-    let out = run(&mut f, &pass, &points, &requests, c, seed, level, sub_frame);
+    let out = run(
+        &mut f,
+        &pass,
+        &Batch::new(&points, &requests, c),
+        create(seed, level, sub_frame),
+    );
     // Radiance leaving every wall is Le/(1−ρ); the direct pass counts the emission Le arriving
     // directly, so a gather ray returns ρ·Le/(1−ρ) and E_ind = π·ρ·Le/(1−ρ).
     let expected = PI * albedo * le / (1.0 - albedo);
@@ -233,13 +244,24 @@ fn invalid_irradiance_background_and_overflow_are_guarded() {
     // Le = 1e36: every sample is finite (≈ 1e36) but their sum over the 12×36 strata overflows.
     let mut f = fixture(&furnace_scene(1e36));
     let params = IcParams::default();
-    let pass = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &params, SkyLight::Records).unwrap();
+    let pass = RecordPass::new(
+        &f.ctx,
+        &f.shaders,
+        &f.gpu,
+        &RecordVariant::new(params, SkyLight::Records),
+    )
+    .unwrap();
     let q = point(5, 5, Vec3::new(0.0, -1.0, 0.0), Vec3::Y);
     // Surface (overflows), background pixel, pixel past the image, and one request past the
     // capacity (base 2 + 3 records); one workgroup more than there are requests.
     let requests = [point_index(&q), 10 * W + 10, W * H + 7, point_index(&q)];
     let c = counters(2, 4, 5, 5);
-    let out = run(&mut f, &pass, &[q], &requests, c, 5, 0, 3);
+    let out = run(
+        &mut f,
+        &pass,
+        &Batch::new(&[q], &requests, c),
+        create(5, 0, 3),
+    );
     let (l, r) = split(&out.samples[..params.sample_count() as usize]);
     let est = compute_record(&l, &r, params.strata_m, params.strata_n, q.n, f.r_eps);
     assert!(!irradiance_is_valid(est.e), "the CPU twin rejects it too");
@@ -281,16 +303,53 @@ fn cornell_records_agree_with_an_independent_estimate() {
     let requests: Vec<u32> = points.iter().map(point_index).collect();
     let k = points.len() as u32;
     let (draft, fine) = (IcParams::draft(), IcParams::default());
-    let pass_a = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &draft, SkyLight::Records).unwrap();
-    let pass_b = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &fine, SkyLight::Records).unwrap();
+    let pass_a = RecordPass::new(
+        &f.ctx,
+        &f.shaders,
+        &f.gpu,
+        &RecordVariant::new(draft, SkyLight::Records),
+    )
+    .unwrap();
+    let pass_b = RecordPass::new(
+        &f.ctx,
+        &f.shaders,
+        &f.gpu,
+        &RecordVariant::new(fine, SkyLight::Records),
+    )
+    .unwrap();
     let c = counters(0, k, k, 64);
-    let a = run(&mut f, &pass_a, &points, &requests, c, 11, 1, 0);
-    let again = run(&mut f, &pass_a, &points, &requests, c, 11, 1, 0);
-    let b = run(&mut f, &pass_b, &points, &requests, c, 12, 3, 2);
+    let a = run(
+        &mut f,
+        &pass_a,
+        &Batch::new(&points, &requests, c),
+        create(11, 1, 0),
+    );
+    let again = run(
+        &mut f,
+        &pass_a,
+        &Batch::new(&points, &requests, c),
+        create(11, 1, 0),
+    );
+    let b = run(
+        &mut f,
+        &pass_b,
+        &Batch::new(&points, &requests, c),
+        create(12, 3, 2),
+    );
     // The default's coarse levels gather 12×36 strata, its first fine one (spacing ≤ R⁻) 8×24,
     // each finer one half the rays (IcParams::strata_falloff): 4×12 two levels on.
-    let coarse = run(&mut f, &pass_b, &points, &requests, c, 13, 2, 2);
-    let finest = run(&mut f, &pass_b, &points, &requests, c, 14, 5, 2);
+    let coarse = run(
+        &mut f,
+        &pass_b,
+        &Batch::new(&points, &requests, c),
+        create(13, 2, 2),
+    );
+    let finest = run(
+        &mut f,
+        &pass_b,
+        &Batch::new(&points, &requests, c),
+        create(14, 5, 2),
+    );
     assert_eq!(fine.fine_level(), 3);
     assert_eq!(fine.strata_at(2, false), (12, 36));
     assert_eq!(fine.strata_at(3, false), (8, 24));

@@ -5,7 +5,8 @@
 
 use radcache_cache::IcParams;
 use radcache_render::{
-    GBuffer, GpuScene, IcRenderer, IcSettings, PathGridMode, RecordPass, SplatMode,
+    GBuffer, GpuScene, IcRenderer, IcSettings, PathGridMode, RecordInputs, RecordJob,
+    RecordOutputs, RecordPass, RecordVariant, SplatMode,
 };
 use radcache_shared::gpu::{DispatchArgs, GpuRecord, IcCounters};
 use radcache_tests::scenes::load;
@@ -33,17 +34,15 @@ fn refresh(
     rec.update_buffer(&state.requests, 0, which);
     rec.update_buffer(&state.counters, 0, std::slice::from_ref(&c));
     rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
-    pass.record_refresh(
-        &mut rec,
-        gpu,
+    let inputs = RecordInputs {
+        scene: gpu,
         gbuffer,
-        &state.requests,
-        &state.counters,
-        &state.records,
-        None,
-        seed,
-    )
-    .unwrap();
+        requests: &state.requests,
+        counters: &state.counters,
+        job: RecordJob::Refresh { frame_seed: seed },
+    };
+    pass.record(&mut rec, &inputs, &RecordOutputs::records(&state.records))
+        .unwrap();
     ctx.submit(rec).unwrap().wait().unwrap();
     ctx.read_buffer(&state.records, count).unwrap()
 }
@@ -97,7 +96,13 @@ fn a_refreshed_record_reproduces_its_value() {
         which.iter().any(|&i| before[i as usize].info[2] == 1),
         "no sub-frame 1 record"
     );
-    let pass = RecordPass::new(&ctx, &shaders, &gpu, &settings.params, settings.sky).unwrap();
+    let pass = RecordPass::new(
+        &ctx,
+        &shaders,
+        &gpu,
+        &RecordVariant::new(settings.params, settings.sky),
+    )
+    .unwrap();
     let gbuffer = GBuffer::new(&ctx, SIZE, SIZE).unwrap();
 
     let same = refresh(&ctx, &pass, &gpu, &gbuffer, &r, &which, SEED);

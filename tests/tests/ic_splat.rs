@@ -3,10 +3,10 @@
 //! so each expected value is exact; and the splat quads' bound on the Cornell box's own G-buffer.
 
 use glam::Vec3;
-use radcache_cache::{extrapolate_irradiance, record_weight, IcParams, WeightKind};
+use radcache_cache::{extrapolate_irradiance, record_weight, IcParams, WeightKind, WeightRecord};
 use radcache_render::{
-    GBuffer, GpuScene, HolePass, HoleSelection, IcState, NeighbourPass, SplatOutput, SplatPass,
-    SplatScope, SplatWeights,
+    GBuffer, GpuScene, HolePass, HoleSelection, IcState, NeighbourPass, SplatDraw, SplatInputs,
+    SplatOutput, SplatPass, SplatWeights,
 };
 use radcache_scene::{LoadOptions, Scene};
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
@@ -58,9 +58,11 @@ fn cpu_weight(params: &IcParams, r: &GpuRecord, p: Vec3, n: Vec3, footprint: f32
         params.weight_kind,
         p,
         n,
-        Vec3::from_slice(&r.position_radius[..3]),
-        Vec3::from_slice(&r.normal_rorig[..3]),
-        r.position_radius[3],
+        WeightRecord {
+            p: Vec3::from_slice(&r.position_radius[..3]),
+            n: Vec3::from_slice(&r.normal_rorig[..3]),
+            r: r.position_radius[3],
+        },
         params.weight_param(),
         params.front_tolerance_px * footprint,
     )
@@ -116,6 +118,17 @@ struct Fixture {
     gbuffer: GBuffer,
     splat: SplatPass,
     state: IcState,
+}
+
+impl Fixture {
+    /// The splat's inputs: the fixture's scene, G-buffer and records.
+    fn inputs(&self) -> SplatInputs<'_> {
+        SplatInputs {
+            scene: &self.gpu,
+            gbuffer: &self.gbuffer,
+            state: &self.state,
+        }
+    }
 }
 
 fn fixture() -> Fixture {
@@ -178,15 +191,7 @@ fn splat_sums_match_the_cpu_weight_and_extrapolation() {
     fill_gbuffer(&mut rec, &f.gbuffer);
     set_state(&mut rec, &f.state, &recs, counters(2, 0));
     f.splat
-        .record(
-            &mut rec,
-            "splat",
-            SplatScope::All,
-            &f.gpu,
-            &f.gbuffer,
-            &f.state,
-            &weights,
-        )
+        .record(&mut rec, &f.inputs(), &SplatDraw::all(&weights))
         .unwrap();
     f.ctx.submit(rec).unwrap().wait().unwrap();
     let sums: Vec<[f32; 4]> = f.ctx.read_image(&f.splat.sum).unwrap();
@@ -275,12 +280,16 @@ fn splat_quads_cover_every_pixel_of_each_zone() {
         for image in gpu.gbuffer.images() {
             rec.use_image(image, ImageUse::ComputeStorage);
         }
-        let (scene, gbuffer, all) = (&gpu.scene, &gpu.gbuffer, SplatScope::All);
-        let (state, weights) = (&state, &weights);
-        let r = splat.record_output(
-            output, &mut rec, "splat", all, scene, gbuffer, state, weights,
-        );
-        r.unwrap();
+        let inputs = SplatInputs {
+            scene: &gpu.scene,
+            gbuffer: &gpu.gbuffer,
+            state: &state,
+        };
+        let draw = SplatDraw {
+            output,
+            ..SplatDraw::all(&weights)
+        };
+        splat.record(&mut rec, &inputs, &draw).unwrap();
         gpu.ctx.submit(rec).unwrap().wait().unwrap();
         gpu.ctx.read_image(&splat.sum).unwrap()
     };
@@ -348,15 +357,7 @@ fn holes_request_one_record_per_block_and_vanish_when_covered() {
     fill_gbuffer(&mut rec, &f.gbuffer);
     set_state(&mut rec, &f.state, &[], counters(0, 0));
     f.splat
-        .record(
-            &mut rec,
-            "splat",
-            SplatScope::All,
-            &f.gpu,
-            &f.gbuffer,
-            &f.state,
-            &weights,
-        )
+        .record(&mut rec, &f.inputs(), &SplatDraw::all(&weights))
         .unwrap();
     holes
         .record(
@@ -398,15 +399,7 @@ fn holes_request_one_record_per_block_and_vanish_when_covered() {
     set_state(&mut rec, &f.state, &[cover], counters(1, 0));
     f.state.record_begin_level(&mut rec).unwrap();
     f.splat
-        .record(
-            &mut rec,
-            "splat",
-            SplatScope::All,
-            &f.gpu,
-            &f.gbuffer,
-            &f.state,
-            &weights,
-        )
+        .record(&mut rec, &f.inputs(), &SplatDraw::all(&weights))
         .unwrap();
     holes
         .record(

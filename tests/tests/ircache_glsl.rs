@@ -148,8 +148,13 @@ fn weights(rng: &mut Rng) -> Vec<Case> {
         let facing = n.dot(n_i);
         e.f(0, 0, ward_weight(p, n, p_i, n_i, r_i, a, tol), 0.0);
         e.f(0, 1, tl_weight(p, n, p_i, n_i, r_i, kappa, tol), 1.0);
-        e.f(0, 2, record_weight(ward, p, n, p_i, n_i, r_i, a, tol), 0.0);
-        let w_tl = record_weight(tl, p, n, p_i, n_i, r_i, kappa, tol);
+        let record = WeightRecord {
+            p: p_i,
+            n: n_i,
+            r: r_i,
+        };
+        e.f(0, 2, record_weight(ward, p, n, record, a, tol), 0.0);
+        let w_tl = record_weight(tl, p, n, record, kappa, tol);
         e.f(0, 3, w_tl, 1.0);
         // Ward's weight steps at ε = a and wherever a test flips: ties are not compared.
         let ward_tie = (eps - a).abs() <= 1e-5 * a || front.abs() <= 1e-5 || facing.abs() <= 1e-6;

@@ -20,7 +20,7 @@ use radcache_cache::radiance::{
 use radcache_cache::record::wall_term;
 use radcache_cache::sampling::stratum_index;
 use radcache_cache::{IcParams, IC_FAR};
-use radcache_render::{RecordPass, SkyLight};
+use radcache_render::{RecordPass, RecordVariant, SkyLight};
 use radcache_shared::consts::{
     RADIANCE_VEC4S, RECORD_FLAG_GLOSSY, RECORD_RADIANCE_VEC4S, SH_COEFFS,
 };
@@ -105,9 +105,7 @@ fn radiance_coefficients_and_gradients_match_the_cpu_twin() {
     let requests: Vec<u32> = points.iter().map(point_index).collect();
     let k = points.len() as u32;
     let params = IcParams::draft();
-    let pass =
-        RecordPass::with_radiance(&f.ctx, &f.shaders, &f.gpu, &params, SkyLight::Records, true)
-            .unwrap();
+    let pass = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &radiance_variant(params)).unwrap();
     let stride = RECORD_RADIANCE_VEC4S as usize;
     let slots = 16usize;
     let sentinel = vec![[-7.0f32; 4]; slots * stride];
@@ -118,17 +116,8 @@ fn radiance_coefficients_and_gradients_match_the_cpu_twin() {
         .unwrap();
     let (base, seed) = (2u32, 23u32);
     let c = counters(base, k, k, 64);
-    let out = run_with_radiance(
-        &mut f,
-        &pass,
-        &points,
-        &requests,
-        c,
-        seed,
-        1,
-        0,
-        Some(&radiance),
-    );
+    let batch = Batch::new(&points, &requests, c);
+    let out = run_with_radiance(&mut f, &pass, &batch, create(seed, 1, 0), Some(&radiance));
     let (m, n) = (params.strata_m, params.strata_n);
     let count = (m * n) as usize;
     let mut folded_any = false;
@@ -231,9 +220,7 @@ fn records_for_glossy_lobes_keep_the_full_strata_at_fine_levels() {
     sharp.metallic_roughness = pack_metallic_roughness(1.0, 0.3);
     let points = [rough, sharp];
     let requests: Vec<u32> = points.iter().map(point_index).collect();
-    let pass =
-        RecordPass::with_radiance(&f.ctx, &f.shaders, &f.gpu, &params, SkyLight::Records, true)
-            .unwrap();
+    let pass = RecordPass::new(&f.ctx, &f.shaders, &f.gpu, &radiance_variant(params)).unwrap();
     let zeros = vec![[0.0f32; 4]; SLOTS * RECORD_RADIANCE_VEC4S as usize];
     let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
     let radiance = f
@@ -241,17 +228,8 @@ fn records_for_glossy_lobes_keep_the_full_strata_at_fine_levels() {
         .create_buffer_init("test.radiance", storage, &zeros)
         .unwrap();
     let c = counters(0, 2, 2, 64);
-    let out = run_with_radiance(
-        &mut f,
-        &pass,
-        &points,
-        &requests,
-        c,
-        5,
-        level,
-        0,
-        Some(&radiance),
-    );
+    let batch = Batch::new(&points, &requests, c);
+    let out = run_with_radiance(&mut f, &pass, &batch, create(5, level, 0), Some(&radiance));
     let per = params.sample_count() as usize;
     // A stratum the pass traced has a positive distance (the room is closed); the others keep
     // the dump's zeros.
@@ -266,4 +244,12 @@ fn records_for_glossy_lobes_keep_the_full_strata_at_fine_levels() {
     assert_eq!((traced(1), glossy(1)), (8 * 24, false), "roughness 0.3");
     drop((pass, radiance));
     end(f);
+}
+
+/// Records with radiance coefficients, for `params`.
+fn radiance_variant(params: IcParams) -> RecordVariant {
+    RecordVariant {
+        radiance: true,
+        ..RecordVariant::new(params, SkyLight::Records)
+    }
 }

@@ -201,27 +201,56 @@ pub fn hessian_farthest(a: Vec4, y_a: f32, b: Vec4, y_b: f32, c: Vec4, y_c: f32)
     }
 }
 
+/// One cell of the hemisphere's mesh for [`hessian_cell`] (the GLSL twin's arguments, in order).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HessianCell {
+    /// Vertex `A = (j, k)`.
+    pub a: Vec4,
+    /// Vertex `B = (j+1, k)`.
+    pub b: Vec4,
+    /// Vertex `C = (j+1, k+1)`.
+    pub c: Vec4,
+    /// Vertex `D = (j, k+1)`.
+    pub d: Vec4,
+    /// Vertex `(j+1, k−1)`.
+    pub bl: Vec4,
+    /// Vertex `(j−1, k+1)` (unused when `first`).
+    pub au: Vec4,
+    /// The luminances of `A, B, C, D`.
+    pub y: Vec4,
+    /// The luminance at `bl`.
+    pub y_bl: f32,
+    /// The luminance at `au`.
+    pub y_au: f32,
+    /// The cap's luminance (for the first row).
+    pub y_cap: f32,
+    /// The cell is on the first row.
+    pub first: bool,
+    /// The cell is on the last row.
+    pub last: bool,
+}
+
 /// The edges cell `(j, k)` owns, weighted (§10.1): the diagonal `B → D` by `Y_lo − Y_hi`, the
 /// polar edge `A → B` by `Y_lo − Y_left` (the `T_hi` of cell `(j, k−1)`), the azimuthal edge
 /// `A → D` by `Y_above − Y_lo` (`T_hi` of cell `(j−1, k)`, or the cap), and on the last row the
 /// horizon edge `B → C` by `Y_hi`. `bl` is vertex `(j+1, k−1)` and `au` vertex `(j−1, k+1)`
 /// (unused when `first`); `y` holds the luminances of `A, B, C, D`. Returns the weighted sum of
 /// [`hessian_edge`]'s `(f, H_tt, H_tb, H_bb)`.
-#[allow(clippy::too_many_arguments)]
-pub fn hessian_cell(
-    a: Vec4,
-    b: Vec4,
-    c: Vec4,
-    d: Vec4,
-    bl: Vec4,
-    au: Vec4,
-    y: Vec4,
-    y_bl: f32,
-    y_au: f32,
-    y_cap: f32,
-    first: bool,
-    last: bool,
-) -> Vec4 {
+pub fn hessian_cell(cell: &HessianCell) -> Vec4 {
+    let HessianCell {
+        a,
+        b,
+        c,
+        d,
+        bl,
+        au,
+        y,
+        y_bl,
+        y_au,
+        y_cap,
+        first,
+        last,
+    } = *cell;
     let y_lo = hessian_farthest(a, y.x, b, y.y, d, y.w);
     let y_hi = hessian_farthest(b, y.y, c, y.z, d, y.w);
     let y_left = hessian_farthest(bl, y_bl, b, y.y, a, y.x);
@@ -300,7 +329,20 @@ pub fn compute_hessian(l: &[Vec3], r: &[f32], m: u32, n: u32, seed: u32, r_eps: 
                 (Vec4::ZERO, 0.0)
             };
             let y = Vec4::new(ya, yb, yc, yd);
-            sum += hessian_cell(a, b, c, d, bl, au, y, y_bl, y_au, y_cap, j == 0, j + 1 == m);
+            sum += hessian_cell(&HessianCell {
+                a,
+                b,
+                c,
+                d,
+                bl,
+                au,
+                y,
+                y_bl,
+                y_au,
+                y_cap,
+                first: j == 0,
+                last: j + 1 == m,
+            });
         }
     }
     sum

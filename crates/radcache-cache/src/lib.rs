@@ -55,7 +55,7 @@ pub use hessian::compute_hessian;
 pub use params::{falloff_strata, ErrorControl, IcParams, Preset};
 pub use radius::{finalize_radius, FinalRadius};
 pub use record::{compute_record, RecordEstimate};
-pub use weight::{record_weight, splat_radius, WeightKind};
+pub use weight::{record_weight, splat_radius, WeightKind, WeightRecord};
 
 use glam::Vec3;
 

@@ -16,8 +16,6 @@
 use core::f32::consts::{PI, TAU};
 use glam::Vec3;
 
-/// Default strata for interactive quality, `M × N = 8 × 24` (§2.2).
-pub const STRATA_INTERACTIVE: (u32, u32) = (8, 24);
 /// The course's strata for offline quality, `M × N = 16 × 48` (§2.2, §8.1; the default preset
 /// takes 12 × 36, measured: params.rs).
 pub const STRATA_DEFAULT: (u32, u32) = (16, 48);

@@ -127,19 +127,32 @@ pub fn tl_weight(
     }
 }
 
-/// Weight of record `i` at `(p, n)` for `kind`; `param` is `a` (Ward) or `κ` (T&L).
-/// The argument list mirrors the GLSL twin (plain values for table tests).
-#[allow(clippy::too_many_arguments)]
+/// A record as its weight sees it: its point `p_i`, normal `n_i` and harmonic-mean distance
+/// `R_i` (the GLSL twin's `p_i, n_i, r_i`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WeightRecord {
+    /// The record's point `p_i`.
+    pub p: Vec3,
+    /// Its normal `n_i`.
+    pub n: Vec3,
+    /// Its harmonic-mean distance `R_i`.
+    pub r: f32,
+}
+
+/// Weight of `record` at `(p, n)` for `kind`; `param` is `a` (Ward) or `κ` (T&L).
 pub fn record_weight(
     kind: WeightKind,
     p: Vec3,
     n: Vec3,
-    p_i: Vec3,
-    n_i: Vec3,
-    r_i: f32,
+    record: WeightRecord,
     param: f32,
     front_tol: f32,
 ) -> f32 {
+    let WeightRecord {
+        p: p_i,
+        n: n_i,
+        r: r_i,
+    } = record;
     match kind {
         WeightKind::Ward => ward_weight(p, n, p_i, n_i, r_i, param, front_tol),
         WeightKind::TabellionLamorlette => tl_weight(p, n, p_i, n_i, r_i, param, front_tol),

@@ -157,7 +157,7 @@ fn no_nan_or_inf_anywhere() {
         }
         assert!(f.r_used > 0.0 && f.grad_t_scale <= 1.0);
         for kind in [WeightKind::Ward, WeightKind::TabellionLamorlette] {
-            let w = record_weight(kind, p, n, p_i, n_i, r, s1, s2);
+            let w = record_weight(kind, p, n, WeightRecord { p: p_i, n: n_i, r }, s1, s2);
             ok(w, "weight");
             assert!((0.0..=1000.0).contains(&w));
             ok(

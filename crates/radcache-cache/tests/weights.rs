@@ -15,7 +15,12 @@ const R: f32 = 2.0;
 const TOL: f32 = 0.01;
 
 fn w(kind: WeightKind, param: f32, p: Vec3, n: Vec3) -> f32 {
-    record_weight(kind, p, n, Vec3::ZERO, Vec3::Z, R, param, TOL)
+    let record = WeightRecord {
+        p: Vec3::ZERO,
+        n: Vec3::Z,
+        r: R,
+    };
+    record_weight(kind, p, n, record, param, TOL)
 }
 
 fn tilt(angle: f32) -> Vec3 {
@@ -92,27 +97,14 @@ fn weight_cap_and_maximum() {
         1.0
     );
     // R = 0 (corner, §4.6): no Inf/NaN, the weight is the cap at p_i and 0 elsewhere.
+    let corner = WeightRecord {
+        p: Vec3::ZERO,
+        n: Vec3::Z,
+        r: 0.0,
+    };
     for (kind, param) in KINDS {
-        let at = record_weight(
-            kind,
-            Vec3::ZERO,
-            Vec3::Z,
-            Vec3::ZERO,
-            Vec3::Z,
-            0.0,
-            param,
-            TOL,
-        );
-        let off = record_weight(
-            kind,
-            Vec3::X * 1e-3,
-            Vec3::Z,
-            Vec3::ZERO,
-            Vec3::Z,
-            0.0,
-            param,
-            TOL,
-        );
+        let at = record_weight(kind, Vec3::ZERO, Vec3::Z, corner, param, TOL);
+        let off = record_weight(kind, Vec3::X * 1e-3, Vec3::Z, corner, param, TOL);
         assert!(at.is_finite() && at > 0.0 && off == 0.0);
         assert!(
             splat_radius(kind, 0.0, param, 0.0) >= 0.0

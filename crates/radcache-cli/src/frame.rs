@@ -168,7 +168,7 @@ pub fn render(
 /// The cache's settings of `--method ic` at `size` with `seed` (frame 1 at time 0, one frame
 /// without temporal caching: the caller sets those).
 pub fn ic_settings(ic: &IcArgs, size: (u32, u32), seed: u32) -> Result<IcSettings> {
-    let defaults = IcSettings::default();
+    let defaults = IcSettings::preset(ic.preset());
     Ok(IcSettings {
         width: size.0,
         height: size.1,

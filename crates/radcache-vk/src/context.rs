@@ -442,15 +442,6 @@ impl Context {
         lock(&self.shared.tracking).live.values().cloned().collect()
     }
 
-    /// Bytes of device memory allocated, by the allocator's own report.
-    pub fn allocated_bytes(&self) -> u64 {
-        self.shared
-            .lock_allocator()
-            .as_ref()
-            .map(|a| a.generate_report().total_allocated_bytes)
-            .unwrap_or(0)
-    }
-
     /// Bytes of device memory allocated per category: the part of each allocation's name before
     /// its first `.` (`ic.records` → `ic`, `scene.vertices` → `scene`), from the allocator's
     /// report; unnamed allocations count as `other`.

@@ -361,12 +361,6 @@ impl crate::Context {
     pub fn pipeline_cache_warning(&self) -> Option<&str> {
         self.shared.pipeline_cache.warning()
     }
-
-    /// Writes the persistent pipeline cache now if a pipeline was compiled since the last save
-    /// (it is saved anyway when the context shuts down or its device is dropped).
-    pub fn save_pipeline_cache(&self) {
-        self.shared.pipeline_cache.save(&self.shared.device);
-    }
 }
 
 #[cfg(test)]

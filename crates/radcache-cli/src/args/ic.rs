@@ -12,11 +12,13 @@ use radcache_render::{
 /// Cache quality preset.
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Quality {
-    /// Fast previews (a = 0.3, 8×24 strata).
+    /// Fast previews (Tabellion–Lamorlette κ = 0.75, Ward's a = 0.3 with `--weight ward`; 8×24
+    /// strata).
     Draft,
-    /// The default (a = 0.15, 12×36 strata, 8×24 where records are at least as dense as R⁻).
+    /// The default (κ = 0.75, Ward's a = 0.15; 12×36 strata, 8×24 where records are at least as
+    /// dense as R⁻).
     Default,
-    /// Offline quality (a = 0.1, 24×72 strata).
+    /// Offline quality (κ = 1.5, Ward's a = 0.1; 24×72 strata).
     High,
 }
 
@@ -155,7 +157,8 @@ pub struct IcArgs {
     /// Record radius rule (`--method ic`): split-sphere (default) or hessian.
     #[arg(long, value_enum)]
     pub error_control: Option<ErrorControlArg>,
-    /// Cache accuracy: Ward's a, or 1/κ for Tabellion–Lamorlette (smaller is more accurate).
+    /// Cache accuracy, smaller is more accurate: 1/κ for the default Tabellion–Lamorlette weight
+    /// (the presets: 1.33, 1.33, 0.67), Ward's a with `--weight ward` (0.3, 0.15, 0.1).
     #[arg(long)]
     pub accuracy: Option<f32>,
     /// Hemisphere strata of a record, polar × azimuthal (`--strata 16x48`); M·N ≤ 1728. The

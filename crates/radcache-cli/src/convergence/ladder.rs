@@ -344,7 +344,7 @@ impl Bench<'_> {
             frame: self.frame,
             time: self.time,
             glossy: case.glossy,
-            ..IcSettings::default()
+            ..IcSettings::preset(case.preset)
         };
         let (out, stats) = render_ic(
             self.ctx,

@@ -14,15 +14,15 @@ use radcache_vk::{Context, ShaderCompiler};
 use crate::error::{Error, Result};
 use crate::frame::path::{FrameOutput, Progress};
 use crate::frame::settings::{
-    EmitterShadows, GlossyLight, IcDebug, IcSettings, IcStats, SpecularPaths, SplatMode,
+    EmitterShadows, GlossyLight, IcDebug, IcSettings, IcStats, SplatMode,
 };
-use crate::passes::composite::CompositePass;
-use crate::passes::direct::DirectPass;
+use crate::passes::composite::{CompositePass, CompositeVariant};
+use crate::passes::direct::{DirectCompositing, DirectPass, DirectShadows, DirectVariant};
 use crate::passes::emission::EmissionPass;
 use crate::passes::gbuffer::{GBuffer, GBufferPass};
 use crate::passes::holes::HolePass;
 use crate::passes::neighbours::NeighbourPass;
-use crate::passes::record::RecordPass;
+use crate::passes::record::{RecordPass, RecordVariant};
 use crate::passes::splat::SplatPass;
 use crate::passes::splat_glossy::GlossySplatPass;
 use crate::passes::temporal::TemporalPass;
@@ -74,6 +74,8 @@ pub struct IcRenderer {
     sky_in_records: bool,
     /// How often the records are splatted (set at creation: the composite's centre samples).
     splat_mode: SplatMode,
+    /// The settings the renderer was made with: a frame must ask for the same `config` fields.
+    made_with: IcSettings,
 }
 
 impl std::fmt::Debug for IcRenderer {
@@ -121,47 +123,52 @@ impl IcRenderer {
             gbuffer: GBuffer::new(ctx, w, h)?,
             gbuffer_pass: GBufferPass::new(ctx, shaders, gpu)?,
             // Splatting once, the later sub-frames' composite is the direct pass's.
-            direct: DirectPass::with_composite(
+            direct: DirectPass::new(
                 ctx,
                 shaders,
                 gpu,
-                settings.sky,
-                settings.emitters,
-                radiance,
-                (settings.splat == SplatMode::Once).then_some(settings.anti_aliasing.is_some()),
-            )?
-            .with_adaptive_shadows(
-                ctx,
-                match settings.emitter_shadows {
-                    EmitterShadows::Adaptive => Some(w * h),
-                    EmitterShadows::Fixed => None,
+                &DirectVariant {
+                    sky: settings.sky,
+                    emitters: settings.emitters,
+                    radiance,
+                    composite: (settings.splat == SplatMode::Once).then_some(DirectCompositing {
+                        moments: settings.anti_aliasing.is_some(),
+                    }),
+                    shadows: match settings.emitter_shadows {
+                        EmitterShadows::Adaptive => DirectShadows::Adaptive { pixels: w * h },
+                        EmitterShadows::Fixed => DirectShadows::Fixed,
+                    },
+                    specular_paths: settings.specular_paths,
                 },
-            )?
-            .with_specular_pool(settings.specular_paths == SpecularPaths::Pooled),
+            )?,
             splat: SplatPass::new(ctx, shaders, w, h)?,
             glossy,
             glossy_valid: true,
             holes: HolePass::new(ctx, shaders)?,
             neighbours: NeighbourPass::new(ctx, shaders)?,
-            records: RecordPass::with_options(
+            records: RecordPass::new(
                 ctx,
                 shaders,
                 gpu,
-                &params,
-                settings.sky,
-                radiance,
-                settings.glossy_spacing,
-                settings.path_grid,
+                &RecordVariant {
+                    params,
+                    sky: settings.sky,
+                    radiance,
+                    glossy_spacing: settings.glossy_spacing,
+                    path_grid: settings.path_grid,
+                },
             )?,
-            composite: CompositePass::with_options(
+            composite: CompositePass::new(
                 ctx,
                 shaders,
                 gpu,
-                w,
-                h,
-                radiance,
-                settings.anti_aliasing.is_some(),
-                settings.splat == SplatMode::Once,
+                &CompositeVariant {
+                    width: w,
+                    height: h,
+                    radiance,
+                    moments: settings.anti_aliasing.is_some(),
+                    centres: settings.splat == SplatMode::Once,
+                },
             )?,
             emission: EmissionPass::new(ctx, shaders, gpu)?,
             state: IcState::with_radiance(ctx, shaders, capacity, w * h, radiance)?,
@@ -182,6 +189,7 @@ impl IcRenderer {
                 .define(gpu.has_constant_environment())
                 .is_some(),
             splat_mode: settings.splat,
+            made_with: settings.clone(),
         })
     }
 
@@ -203,8 +211,8 @@ impl IcRenderer {
 
     /// Renders `scene` at `settings.time`, keeping the records of the previous frame unless
     /// [`IcRenderer::forget`] was called (records are world-space: right for a static scene
-    /// under any camera motion). `settings` must have the size and parameters the renderer was
-    /// created with. The phases are described in [`crate::frame`].
+    /// under any camera motion). `settings` must have the `config` fields the renderer was
+    /// created with (an error names the first that differs). The phases are described in [`crate::frame`].
     pub fn render(
         &mut self,
         ctx: &Context,
@@ -241,35 +249,13 @@ impl IcRenderer {
         self.finish(ctx, gpu, settings, run)
     }
 
-    /// Refuses settings the renderer was not made for.
+    /// Refuses settings the renderer was not made for, naming the first `config` field that
+    /// differs ([`IcSettings::config_change`]).
     fn check(&self, settings: &IcSettings) -> Result<()> {
-        let same = (
-            settings.width,
-            settings.height,
-            settings.params,
-            settings.splat,
-        ) == (self.width, self.height, self.params, self.splat_mode);
-        let lifespans = self.temporal.as_ref().is_some_and(|t| t.lifespans());
-        if same && (settings.time_step_s <= 0.0 || lifespans) {
-            return Ok(());
+        match settings.config_change(&self.made_with) {
+            None => Ok(()),
+            Some(change) => Err(Error::Invalid(change.to_string())),
         }
-        Err(Error::Invalid(format!(
-            "the renderer was made for {}x{}, {:?} and {:?}{}, not {}x{}, {:?} and {:?} with a time step of {} s",
-            self.width,
-            self.height,
-            self.params,
-            self.splat_mode,
-            if self.temporal.is_some() {
-                " with temporal caching"
-            } else {
-                ""
-            },
-            settings.width,
-            settings.height,
-            settings.params,
-            settings.splat,
-            settings.time_step_s
-        )))
     }
 
     fn read_debug(&self, ctx: &Context, sub_frames: u32, records: u64) -> Result<IcDebug> {

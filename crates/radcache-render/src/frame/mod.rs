@@ -18,7 +18,7 @@
 //!    are **splatted** with the stricter creation weights (`passes/splat.rs`), **holes** picks
 //!    one hole per S×S block (`passes/holes.rs`, GPU atomics), the **record** pass computes
 //!    those records (`passes/record.rs`, one workgroup each, dispatched indirectly from the
-//!    counters that **ic_counters** keeps, `passes/ic_counters.rs`), and **neighbours** clamps
+//!    counters that **ic_counters** keeps, `state/ic_counters.rs`), and **neighbours** clamps
 //!    their radii against the records nearby (`passes/neighbours.rs`, a hash grid). The host
 //!    only loops over levels and reads the counters for the figures; a level that finds no hole
 //!    ends the sub-frame. With `settle_records` the phase repeats until a pass creates nothing.

@@ -10,116 +10,149 @@ use std::collections::BTreeMap;
 
 use radcache_cache::{IcParams, Preset};
 
-/// Settings of one frame rendered with the cache.
-#[derive(Debug, Clone, PartialEq)]
-pub struct IcSettings {
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// Cache parameters (`IcParams::preset`).
-    pub params: IcParams,
-    /// Jittered sub-frames averaged into the image (anti-aliasing; default 8: on the Cornell box at
-    /// 256², 8 sub-frames halve the relMSE of 4 at the same number of direct samples, because
-    /// edges dominate the error).
-    pub sub_frames: u32,
-    /// Direct-lighting samples per pixel and sub-frame (one ray each, one-sample MIS). Where
-    /// the emitters' light is taken in closed form ([`EmitterLight::Analytic`]), a quarter of
-    /// them (rounded up) are the emitters' shadow rays, which measured about the noise of all of
-    /// them sampled with MIS (docs/cache-frame.md §8.2), and the rest go to the environment.
-    pub direct_samples: u32,
-    /// Seed of the random sequences.
-    pub seed: u32,
-    /// Frame number.
-    pub frame: u32,
-    /// Scene time in seconds.
-    pub time: f32,
-    /// Largest number of records (memory: 176 bytes each).
-    pub record_capacity: u32,
-    /// Also produce the debug AOVs ([`IcDebug`]).
-    pub debug_aovs: bool,
-    /// Records kept across frames that weighed on no pixel for this many frames are evicted at
-    /// the start of the next one (memory stays bounded over long sequences).
-    pub evict_after_frames: u32,
-    /// Repeat the cache phase until a pass over the sub-frames creates no record (see
-    /// [`crate::IcRenderer::render`]), so that a next frame that keeps the records finds no hole
-    /// where nothing changed (sequences; a single frame does not need it).
-    pub settle_records: bool,
-    /// Seconds from this frame to the next (`1 / fps`) when the scene's geometry or lights move
-    /// and records are kept: records then follow their instances and carry temporal gradients
-    /// and lifespans (`crate::temporal`). 0 (the default) for a single frame or a scene whose
-    /// lighting does not change. Must be set when the renderer is created.
-    pub time_step_s: f32,
-    /// Where a constant environment's light (a sky) enters the frame: through the records
-    /// (the default) or the direct pass. Must be set when the renderer is created.
-    pub sky: SkyLight,
-    /// How the direct pass estimates the light of emissive triangles. Must be set when the
-    /// renderer is created.
-    pub emitters: EmitterLight,
-    /// How many shadow rays the closed-form emitters' light casts after the first sub-frame
-    /// ([`EmitterShadows`]). Must be set when the renderer is created.
-    pub emitter_shadows: EmitterShadows,
-    /// Where glossy lobes take their indirect light from. Must be set when the renderer is
-    /// created.
-    pub glossy: GlossyLight,
-    /// How records for glossy lobes from the cache are spaced. Must be set when the renderer is
-    /// created.
-    pub glossy_spacing: GlossySpacing,
-    /// Adaptive anti-aliasing ([`AntiAliasing`]): more sub-frames after the first `sub_frames`
-    /// until the image's sampling error is estimated small enough. `None` (the default) shades
-    /// exactly `sub_frames`. Must be set when the renderer is created.
-    pub anti_aliasing: Option<AntiAliasing>,
-    /// How often the records are splatted: once per frame (the default) or at every
-    /// sub-frame. Must be set when the renderer is created.
-    pub splat: SplatMode,
-    /// Whether the gathers of new records share a radiance grid (docs/cache-frame.md §4.1).
-    pub path_grid: PathGridMode,
-    /// Whose paths a pixel's specular lobe takes its indirect light from (docs/materials.md
-    /// §10). Must be set when the renderer is created.
-    pub specular_paths: SpecularPaths,
+pub use crate::technique::{
+    EmitterLight, EmitterShadows, GlossyLight, GlossySpacing, PathGridMode, SkyLight,
+    SpecularPaths, SplatMode,
+};
+
+/// Declares the settings struct with its fields in two groups, and generates the lists of the
+/// groups' field names ([`IcSettings::CONFIG_FIELDS`], [`IcSettings::FRAME_FIELDS`]) and the
+/// comparison of the `config` group ([`IcSettings::config_change`]) from the one declaration, so a
+/// field added to the struct is classed, listed and compared without another edit.
+macro_rules! settings_struct {
+    (
+        $(#[$meta:meta])*
+        pub struct $name:ident {
+            config { $( $(#[$cmeta:meta])* $cfield:ident : $cty:ty, )* }
+            per_frame { $( $(#[$fmeta:meta])* $ffield:ident : $fty:ty, )* }
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, PartialEq)]
+        pub struct $name {
+            $( $(#[$cmeta])* pub $cfield: $cty, )*
+            $( $(#[$fmeta])* pub $ffield: $fty, )*
+        }
+
+        impl $name {
+            /// The fields that make the renderer: fixed for its lifetime.
+            pub const CONFIG_FIELDS: &'static [&'static str] = &[$(stringify!($cfield)),*];
+            /// The fields that may change from frame to frame.
+            pub const FRAME_FIELDS: &'static [&'static str] = &[$(stringify!($ffield)),*];
+
+            /// The first `config` field in which `self` differs from `made_with`, with both
+            /// values as text (`made_with`'s first); `None` where every one is the same.
+            pub fn config_change(&self, made_with: &$name) -> Option<ConfigChange> {
+                $(
+                    if self.$cfield != made_with.$cfield {
+                        return Some(ConfigChange {
+                            field: stringify!($cfield),
+                            made_with: format!("{:?}", made_with.$cfield),
+                            requested: format!("{:?}", self.$cfield),
+                        });
+                    }
+                )*
+                None
+            }
+        }
+    };
 }
 
-/// Whose paths estimate a pixel's specular indirect light (scenes with specular materials;
-/// docs/materials.md §10).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum SpecularPaths {
-    /// The pixel's own and those of the pixels of its 3×3 neighbourhood (within its 8×8
-    /// workgroup) on its surface, of its material, whose lobes point within twice the lobe's
-    /// width of its own: each weighed by the pixel's BRDF over the density it was drawn from.
-    /// Unbiased but for the radiance being seen from a point a pixel away; up to nine times the
-    /// paths per pixel for the rays of one.
-    #[default]
-    Pooled,
-    /// The pixel's own paths alone.
-    PerPixel,
+/// A `config` field of [`IcSettings`] that a frame asked to change ([`IcSettings::config_change`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ConfigChange {
+    /// The field's name.
+    pub field: &'static str,
+    /// The value the renderer was made with.
+    pub made_with: String,
+    /// The value the frame asked for.
+    pub requested: String,
 }
 
-/// How often a frame rendered with the cache splats its records (docs/cache-frame.md §6.5).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum SplatMode {
-    /// Once per frame, at the pixel centres (sub-frame 0, whose jitter is 0): every other
-    /// sub-frame interpolates each sample's cached light between the four nearest centres
-    /// that match it (the closest centre of its 3×3 neighbourhood where none does), and the
-    /// cache phase fills the holes of the centres alone. The splat's cost no longer grows with
-    /// the sub-frames.
-    #[default]
-    Once,
-    /// At every sub-frame's own samples, and the cache phase fills the holes of every
-    /// sub-frame: the exact per-sample interpolation, one splat per sub-frame.
-    PerSubFrame,
+impl std::fmt::Display for ConfigChange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the cache setting `{}` cannot change between frames: the renderer was made with {} \
+             and this frame asks for {} (make a new renderer for it)",
+            self.field, self.made_with, self.requested
+        )
+    }
 }
 
-/// Whether the gather paths of a frame's new records share a radiance grid
-/// (docs/cache-frame.md §4.1; `shaders/common/path_grid.glsl`).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum PathGridMode {
-    /// Where the plan allows it (`ScenePlan::path_grid`: every material Lambertian), a gather
-    /// path's vertex whose grid cell already holds enough continuations ends there with their
-    /// mean, and the continuations from first hits fill the cells.
-    #[default]
-    On,
-    /// Every gather path continues to its end (Russian roulette).
-    Off,
+settings_struct! {
+    /// Settings of one frame rendered with the cache. Those under `config` make the renderer
+    /// ([`crate::IcRenderer::new`] builds its passes, shader variants and buffers from them) and
+    /// cannot change between its frames: a frame asking for another value is refused with an
+    /// error naming the field ([`IcSettings::config_change`]). Those under `per_frame` may
+    /// differ from frame to frame.
+    pub struct IcSettings {
+        config {
+            /// Image width in pixels.
+            width: u32,
+            /// Image height in pixels.
+            height: u32,
+            /// Cache parameters (`IcParams::preset`).
+            params: IcParams,
+            /// Largest number of records (memory: 176 bytes each).
+            record_capacity: u32,
+            /// Repeat the cache phase until a pass over the sub-frames creates no record (see
+            /// [`crate::IcRenderer::render`]), so that a next frame that keeps the records finds no hole
+            /// where nothing changed (sequences; a single frame does not need it).
+            settle_records: bool,
+            /// Seconds from this frame to the next (`1 / fps`) when the scene's geometry or lights move
+            /// and records are kept: records then follow their instances and carry temporal gradients
+            /// and lifespans (`crate::passes::temporal`). 0 (the default) for a single frame or a scene whose
+            /// lighting does not change.
+            time_step_s: f32,
+            /// Where a constant environment's light (a sky) enters the frame: through the records
+            /// (the default) or the direct pass.
+            sky: SkyLight,
+            /// How the direct pass estimates the light of emissive triangles.
+            emitters: EmitterLight,
+            /// How many shadow rays the closed-form emitters' light casts after the first sub-frame
+            /// ([`EmitterShadows`]).
+            emitter_shadows: EmitterShadows,
+            /// Where glossy lobes take their indirect light from.
+            glossy: GlossyLight,
+            /// How records for glossy lobes from the cache are spaced.
+            glossy_spacing: GlossySpacing,
+            /// Adaptive anti-aliasing ([`AntiAliasing`]): more sub-frames after the first `sub_frames`
+            /// until the image's sampling error is estimated small enough. `None` (the default) shades
+            /// exactly `sub_frames`.
+            anti_aliasing: Option<AntiAliasing>,
+            /// How often the records are splatted: once per frame (the default) or at every
+            /// sub-frame.
+            splat: SplatMode,
+            /// Whether the gathers of new records share a radiance grid (docs/cache-frame.md §4.1).
+            path_grid: PathGridMode,
+            /// Whose paths a pixel's specular lobe takes its indirect light from (docs/materials.md
+            /// §10).
+            specular_paths: SpecularPaths,
+        }
+        per_frame {
+            /// Jittered sub-frames averaged into the image (anti-aliasing; default 8: on the Cornell box at
+            /// 256², 8 sub-frames halve the relMSE of 4 at the same number of direct samples, because
+            /// edges dominate the error).
+            sub_frames: u32,
+            /// Direct-lighting samples per pixel and sub-frame (one ray each, one-sample MIS). Where
+            /// the emitters' light is taken in closed form ([`EmitterLight::Analytic`]), a quarter of
+            /// them (rounded up) are the emitters' shadow rays, which measured about the noise of all of
+            /// them sampled with MIS (docs/cache-frame.md §8.2), and the rest go to the environment.
+            direct_samples: u32,
+            /// Seed of the random sequences.
+            seed: u32,
+            /// Frame number.
+            frame: u32,
+            /// Scene time in seconds.
+            time: f32,
+            /// Also produce the debug AOVs ([`IcDebug`]).
+            debug_aovs: bool,
+            /// Records kept across frames that weighed on no pixel for this many frames are evicted at
+            /// the start of the next one (memory stays bounded over long sequences).
+            evict_after_frames: u32,
+        }
+    }
 }
 
 /// Adaptive anti-aliasing of a frame rendered with the cache (docs/cache-frame.md §7.1): after
@@ -161,104 +194,17 @@ impl AntiAliasing {
     }
 }
 
-/// How the records made for glossy lobes from the cache are spaced (docs/radiance-caching.md
-/// §9); records of every other pixel are spaced by the irradiance alone either way.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum GlossySpacing {
-    /// Their radius also obeys the glossy gradient limit (`GLOSSY_DENSITY`): density follows
-    /// the incoming radiance's directional detail.
-    #[default]
-    Lobe,
-    /// As every record: by the irradiance's rule alone.
-    Irradiance,
-}
-
-/// Where the specular lobe's indirect light comes from in a frame rendered with the cache
-/// (docs/radiance-caching.md §6).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum GlossyLight {
-    /// Radiance records for lobes at or above `GLOSSY_ROUGHNESS_MIN`, where the plan has such
-    /// materials; sharper lobes (and every lobe otherwise) as [`GlossyLight::Paths`].
-    #[default]
-    Records,
-    /// As [`GlossyLight::Records`] with each record's coefficients taken as constant over its
-    /// zone (no translational gradients): for measuring what the gradients bring
-    /// (docs/radiance-caching.md §7).
-    RecordsWithoutGradients,
-    /// BRDF-sampled paths per pixel and sub-frame (docs/materials.md §10).
-    Paths,
-}
-
-impl GlossyLight {
-    /// Glossy lobes take their light from radiance records (with or without gradients).
-    pub fn records(self) -> bool {
-        matches!(
-            self,
-            GlossyLight::Records | GlossyLight::RecordsWithoutGradients
-        )
-    }
-}
-
-/// How the cache's direct pass estimates the light of emissive triangles (docs/cache-frame.md
-/// §2.2).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum EmitterLight {
-    /// Where the plan allows it (`ScenePlan::analytic_emitters`: a few untextured emitters),
-    /// the unshadowed light in closed form times the visible fraction of the light samples
-    /// (the ratio estimator); elsewhere as [`EmitterLight::Sampled`].
-    #[default]
-    Analytic,
-    /// One-sample MIS of light and BSDF sampling.
-    Sampled,
-}
-
-impl EmitterLight {
-    /// The shader define of `self` for a scene whose plan allows the closed form
-    /// (`analytic_allowed`).
-    pub fn define(self, analytic_allowed: bool) -> Option<(&'static str, &'static str)> {
-        (self == EmitterLight::Analytic && analytic_allowed)
-            .then_some(("HAS_ANALYTIC_EMITTERS", "1"))
-    }
-}
-
-/// How many shadow rays the direct pass casts toward emitters whose light is in closed form
-/// ([`EmitterLight::Analytic`]; docs/cache-frame.md §8.2) in the sub-frames after the first.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum EmitterShadows {
-    /// Sub-frame 0 casts a quarter of the direct samples at every pixel and classes each pixel
-    /// by what its 3×3 neighbourhood saw: the emitters wholly visible, wholly hidden, or a
-    /// penumbra (dilated by the same neighbourhood). Later sub-frames cast one ray where the
-    /// pixel was lit or hidden, where the ratio estimator is exact whatever the count, and a
-    /// quarter of the samples in penumbrae; a sub-frame that sees a lit or hidden pixel
-    /// otherwise than sub-frame 0 did marks it a penumbra. Where the pixel and all its 3×3
-    /// neighbours saw the same at sub-frame 0 (the emitters, and each punctual light's shadow
-    /// ray), later sub-frames take that answer and cast no ray.
-    #[default]
-    Adaptive,
-    /// A quarter of the direct samples at every pixel and sub-frame.
-    Fixed,
-}
-
-/// Where the light of a constant environment (a sky) enters a frame rendered with the cache
-/// (docs/cache-frame.md §8.3).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub enum SkyLight {
-    /// The records' gathers count it on a first-segment miss and the direct pass leaves it
-    /// out: the sky's smooth irradiance is interpolated like the indirect light, and the
-    /// direct pass spends no ray on it (on the courtyard at 256², 16 of the 17 rays per pixel
-    /// and sub-frame were sky rays; measured in `bench/results.csv`, case `sky_*`).
-    #[default]
-    Records,
-    /// The direct pass samples it at every pixel (one-sample MIS with BSDF sampling), as it
-    /// samples emitters.
-    Direct,
-}
-
-impl SkyLight {
-    /// The shader define of `self` for a scene with (`constant_env`) or without a constant
-    /// environment: none unless the sky goes through the records of a scene that has one.
-    pub fn define(self, constant_env: bool) -> Option<(&'static str, &'static str)> {
-        (self == SkyLight::Records && constant_env).then_some(("IC_SKY_IN_RECORDS", "1"))
+impl IcSettings {
+    /// The configuration `radcache render --quality` renders with: `preset`'s cache parameters
+    /// and adaptive anti-aliasing ([`AntiAliasing::preset`]), every technique at its default.
+    /// The CLI, `radcache convergence` and the benches start from it, so that they measure what
+    /// a render renders; the size is the default's until set.
+    pub fn preset(preset: Preset) -> IcSettings {
+        IcSettings {
+            params: IcParams::preset(preset),
+            anti_aliasing: Some(AntiAliasing::preset(preset)),
+            ..IcSettings::default()
+        }
     }
 }
 

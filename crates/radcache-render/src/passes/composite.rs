@@ -8,7 +8,7 @@
 //! frame accumulator, the non-finite counter, the emission accumulator (read by
 //! [`crate::EmissionPass`], which adds the box-filtered emission), the debug accumulator and the
 //! splat record count, and with adaptive anti-aliasing the accumulator of squares
-//! (`IC_AA_MOMENTS`, [`CompositePass::read_sampling_relmse`]), and the pixels' centre samples
+//! (`IC_AA_MOMENTS`, [`CompositePass::read_moments`]), and the pixels' centre samples
 //! ([`CentreSamples`]: splatting once per frame). A non-finite value is replaced by 0 and
 //! counted.
 
@@ -97,33 +97,92 @@ impl std::fmt::Debug for CompositePass {
     }
 }
 
+/// What the composite pass is compiled for: its accumulators' size and shader variant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CompositeVariant {
+    /// Accumulator width in pixels.
+    pub width: u32,
+    /// Accumulator height in pixels.
+    pub height: u32,
+    /// The pass can add the glossy splat's target (`HAS_RADIANCE_CACHE`,
+    /// [`CompositeInputs::glossy`]).
+    pub radiance: bool,
+    /// It also sums the squares of the radiance (`IC_AA_MOMENTS`,
+    /// [`CompositePass::read_moments`]).
+    pub moments: bool,
+    /// It can store and match centre samples ([`CentreSamples`]).
+    pub centres: bool,
+}
+
+impl CompositeVariant {
+    /// A `width × height` accumulator of the sub-frames' own samples: no glossy target, no
+    /// moments, no centre samples.
+    pub fn new(width: u32, height: u32) -> CompositeVariant {
+        CompositeVariant {
+            width,
+            height,
+            radiance: false,
+            moments: false,
+            centres: false,
+        }
+    }
+}
+
+/// What one composite dispatch reads: the G-buffer's samples, the splat's targets, and the
+/// sub-frame's parameters.
+#[derive(Debug, Clone, Copy)]
+pub struct CompositeInputs<'a> {
+    /// The scene.
+    pub scene: &'a GpuScene,
+    /// The sub-frame's samples and direct light.
+    pub gbuffer: &'a GBuffer,
+    /// The splat's targets (Σw·Ẽ, Σw, and the records per pixel for the debug AOVs).
+    pub splat: &'a SplatPass,
+    /// The glossy splat, where the frame has one.
+    pub glossy: Option<&'a GlossySplatPass>,
+    /// The sub-frame's jitter.
+    pub jitter: [f32; 2],
+    /// Whose samples the splat targets hold.
+    pub centre: CentreSamples,
+    /// Also accumulate the debug AOVs.
+    pub debug: bool,
+}
+
+impl<'a> CompositeInputs<'a> {
+    /// The sub-frame at `jitter` over its own splat, without glossy target or debug AOVs.
+    pub fn own(
+        scene: &'a GpuScene,
+        gbuffer: &'a GBuffer,
+        splat: &'a SplatPass,
+        jitter: [f32; 2],
+    ) -> CompositeInputs<'a> {
+        CompositeInputs {
+            scene,
+            gbuffer,
+            splat,
+            glossy: None,
+            jitter,
+            centre: CentreSamples::Own,
+            debug: false,
+        }
+    }
+}
+
 impl CompositePass {
-    /// Compiles the pass for `scene`'s plan and allocates the `width × height` accumulator.
+    /// Compiles the pass for `scene`'s plan and `variant`, and allocates its accumulators.
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
-        width: u32,
-        height: u32,
+        variant: &CompositeVariant,
     ) -> Result<CompositePass> {
-        Self::with_options(ctx, shaders, scene, width, height, false, false, false)
-    }
-
-    /// As [`CompositePass::new`]; with `radiance` the pass can add the glossy splat's target
-    /// (`HAS_RADIANCE_CACHE`, [`CompositePass::record_glossy`]); with `moments` it also sums
-    /// the squares of the radiance (`IC_AA_MOMENTS`, [`CompositePass::read_sampling_relmse`]);
-    /// with `centres` it can store and match centre samples ([`CentreSamples`]).
-    #[allow(clippy::too_many_arguments)]
-    pub fn with_options(
-        ctx: &Context,
-        shaders: &ShaderCompiler,
-        scene: &GpuScene,
-        width: u32,
-        height: u32,
-        radiance: bool,
-        moments: bool,
-        centres: bool,
-    ) -> Result<CompositePass> {
+        let CompositeVariant {
+            width,
+            height,
+            radiance,
+            moments,
+            centres,
+        } = *variant;
         let mut defines = scene.defines();
         if radiance {
             defines.push(("HAS_RADIANCE_CACHE", "1"));
@@ -182,35 +241,20 @@ impl CompositePass {
         rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
     }
 
-    /// Records adding the sub-frame rendered with `jitter` to the accumulator.
-    pub fn record(
-        &self,
-        rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        splat: &SplatPass,
-        jitter: [f32; 2],
-        debug: bool,
-    ) -> Result<()> {
-        let centre = CentreSamples::Own;
-        self.record_glossy(rec, scene, gbuffer, splat, None, jitter, centre, debug)
-    }
-
-    /// As [`CompositePass::record`]; with `glossy`, the glossy target's `rgb/a` is added where
-    /// its weight is positive; `centre` says whose samples the splat targets hold (anything but
+    /// Records adding the sub-frame rendered with `inputs.jitter` to the accumulator: with
+    /// `inputs.glossy`, the glossy target's `rgb/a` is added where its weight is positive;
+    /// `inputs.centre` says whose samples the splat targets hold (anything but
     /// [`CentreSamples::Own`] needs a pass made with `centres`).
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_glossy(
-        &self,
-        rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        splat: &SplatPass,
-        glossy: Option<&GlossySplatPass>,
-        jitter: [f32; 2],
-        centre: CentreSamples,
-        debug: bool,
-    ) -> Result<()> {
+    pub fn record(&self, rec: &mut Recorder, inputs: &CompositeInputs<'_>) -> Result<()> {
+        let CompositeInputs {
+            scene,
+            gbuffer,
+            splat,
+            glossy,
+            jitter,
+            centre,
+            debug,
+        } = *inputs;
         if centre != CentreSamples::Own && !self.has_centres() {
             return Err(crate::error::Error::Invalid(
                 "the composite pass was made without centre samples".into(),
@@ -309,14 +353,6 @@ impl CompositePass {
     /// Width and height of the accumulator.
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)
-    }
-
-    /// The sampling relMSE of the mean over the sub-frames accumulated so far
-    /// ([`crate::frame::aa::sampling_relmse`]); `None` for a pass made without moments.
-    pub fn read_sampling_relmse(&self, ctx: &Context) -> Result<Option<f64>> {
-        Ok(self
-            .read_moments(ctx)?
-            .map(|(sums, squares)| crate::frame::aa::sampling_relmse(&sums, &squares)))
     }
 
     /// Each pixel's sums `(Σl rgb, n)` and `(Σl² rgb, ·)` over the sub-frames accumulated so

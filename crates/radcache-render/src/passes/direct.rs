@@ -2,7 +2,7 @@
 //! MIS per surface pixel, compiled with the plan's defines (only the scene's light sources; a
 //! constant environment only where the sky does not go through the records, [`SkyLight`]).
 //!
-//! Made to composite ([`DirectPass::with_composite`], `DIRECT_COMPOSITE`), the pass can also add
+//! Made to composite ([`DirectVariant::composite`], `DIRECT_COMPOSITE`), the pass can also add
 //! a sub-frame's samples to the frame's accumulators itself, against the centre samples of a
 //! splat made once per frame ([`crate::CentreSamples::Match`]), instead of writing the direct
 //! image for [`CompositePass`]: the composite's own pass would load the G-buffer and that image
@@ -16,12 +16,12 @@ use radcache_vk::{
 
 use crate::bindings::{direct as b, direct_composite as c, direct_composite_layout};
 use crate::error::{Error, Result};
-use crate::frame::settings::{EmitterLight, SkyLight};
 use crate::passes::composite::CompositePass;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::splat::SplatPass;
 use crate::passes::splat_glossy::GlossySplatPass;
 use crate::scene::GpuScene;
+use crate::technique::{EmitterLight, SkyLight, SpecularPaths};
 
 radcache_shared::gpu_struct! {
     /// The push constants of the pass (`DirectPush` in GLSL).
@@ -42,13 +42,13 @@ radcache_shared::gpu_struct! {
         /// wholly hidden (and no neighbour a penumbra) cast one emitter shadow ray instead of a
         /// quarter of the samples, none where every 3×3 neighbour saw the same, and punctual
         /// lights' shadow rays are left out there likewise
-        /// ([`DirectPass::with_adaptive_shadows`]; docs/cache-frame.md §8.2).
+        /// ([`DirectVariant::shadows`]; docs/cache-frame.md §8.2).
         pub adaptive_shadows: u32 => "uint",
         /// 1: a pixel's specular paths are pooled with those of its 3×3 neighbours whose lobes
-        /// overlap its own ([`DirectPass::with_specular_pool`]; docs/materials.md §10).
+        /// overlap its own ([`DirectVariant::specular_paths`]; docs/materials.md §10).
         pub specular_pool: u32 => "uint",
         /// 1: the samples go to the frame's accumulators against the stored centre samples
-        /// instead of the direct image (a pass made to composite, [`DirectPass::with_composite`]).
+        /// instead of the direct image (a pass made to composite, [`DirectVariant::composite`]).
         pub composite: u32 => "uint",
         /// The sub-frame's jitter (read where `composite` is set).
         pub jitter: [f32; 2] => "vec2",
@@ -60,15 +60,14 @@ radcache_shared::gpu_struct! {
 }
 
 /// What a pass made to composite reads and writes beside the direct pass's own resources: the
-/// composite's accumulators and centre samples, the splat's targets (and the glossy splat's).
+/// composite's accumulators and centre samples, the splat's targets (and the glossy splat's
+/// target, [`DirectInputs::glossy`]).
 #[derive(Clone, Copy, Debug)]
 pub struct CompositeTargets<'a> {
     /// The accumulators and the centre samples.
     pub composite: &'a CompositePass,
     /// The splat made at the centre samples.
     pub splat: &'a SplatPass,
-    /// The glossy splat, where the frame has one.
-    pub glossy: Option<&'a GlossySplatPass>,
 }
 
 /// A sub-frame composited by the direct pass (never one with the debug AOVs, whose
@@ -77,6 +76,103 @@ pub struct CompositeTargets<'a> {
 pub struct CompositeSubFrame {
     /// The sub-frame's sample within its pixel, from the pixel's centre.
     pub jitter: [f32; 2],
+}
+
+/// What the direct pass is compiled for: its shader variant and its own buffers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DirectVariant {
+    /// With [`SkyLight::Records`] the pass leaves a constant environment out (the records bring
+    /// it).
+    pub sky: SkyLight,
+    /// With [`EmitterLight::Analytic`] it takes the emitters' unshadowed light in closed form
+    /// where the plan allows.
+    pub emitters: EmitterLight,
+    /// Glossy lobes may leave their indirect light to the radiance records
+    /// (`HAS_RADIANCE_CACHE`), writing each such pixel's glossy world weights
+    /// ([`DirectInputs::glossy`]).
+    pub radiance: bool,
+    /// Made to composite (`DIRECT_COMPOSITE`): every recording binds the composite's resources
+    /// ([`DirectOutputs::Composited`]), and a sub-frame composited against the centre samples
+    /// adds its samples to the frame's accumulators itself instead of writing the direct image.
+    pub composite: Option<DirectCompositing>,
+    /// How many shadow rays the emitters and punctual lights cast after sub-frame 0.
+    pub shadows: DirectShadows,
+    /// Whose paths a pixel's specular lobe takes its indirect light from.
+    pub specular_paths: SpecularPaths,
+}
+
+impl DirectVariant {
+    /// Writing the direct image, every shadow ray at every sub-frame, no radiance records, the
+    /// specular paths pooled.
+    pub fn new(sky: SkyLight, emitters: EmitterLight) -> DirectVariant {
+        DirectVariant {
+            sky,
+            emitters,
+            radiance: false,
+            composite: None,
+            shadows: DirectShadows::Fixed,
+            specular_paths: SpecularPaths::Pooled,
+        }
+    }
+}
+
+/// A direct pass made to composite ([`DirectVariant::composite`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DirectCompositing {
+    /// The composite pass sums the squares of the radiance too (`IC_AA_MOMENTS`, adaptive
+    /// anti-aliasing).
+    pub moments: bool,
+}
+
+/// How many shadow rays the direct pass casts after sub-frame 0 (docs/cache-frame.md §8.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DirectShadows {
+    /// A quarter of the samples toward the emitters and one ray per punctual light, at every
+    /// pixel and sub-frame.
+    Fixed,
+    /// Where they are needed, for images of `pixels` pixels
+    /// ([`crate::technique::EmitterShadows::Adaptive`]; the pass's buffer holds what each
+    /// pixel's neighbourhood saw at sub-frame 0).
+    Adaptive {
+        /// Pixels of the images the pass shades.
+        pixels: u32,
+    },
+}
+
+/// What one direct dispatch reads.
+#[derive(Clone, Copy, Debug)]
+pub struct DirectInputs<'a> {
+    /// The scene.
+    pub scene: &'a GpuScene,
+    /// The sub-frame's samples.
+    pub gbuffer: &'a GBuffer,
+    /// Estimates per pixel.
+    pub samples: u32,
+    /// The sub-frame.
+    pub sub_frame: u32,
+    /// The frame's seed.
+    pub seed: u32,
+    /// The glossy splat whose weights rough lobes write (a pass made with radiance), where the
+    /// frame has one.
+    pub glossy: Option<&'a GlossySplatPass>,
+}
+
+/// Where a direct dispatch's light goes.
+#[derive(Clone, Copy, Debug)]
+pub enum DirectOutputs<'a> {
+    /// The G-buffer's direct image (a pass made without compositing).
+    Image,
+    /// A pass made to composite, with the composite's resources: with `sub_frame` the
+    /// sub-frame's samples go to the frame's accumulators against the centre samples stored by
+    /// [`CompositePass`] at sub-frame 0 ([`crate::CentreSamples::Match`]), as the composite
+    /// pass would add them, and the direct image is left as it is; without it the pass writes
+    /// the direct image as any other.
+    Composited {
+        /// The composite's accumulators and the splat.
+        targets: CompositeTargets<'a>,
+        /// What this sub-frame composites.
+        sub_frame: Option<CompositeSubFrame>,
+    },
 }
 
 /// Paths per pixel and sub-frame that trace the specular lobe's indirect light (scenes with
@@ -103,11 +199,11 @@ pub struct DirectPass {
     /// [`DirectPass::shadow_bytes`] a pixel: what its neighbourhood saw of the emitters in
     /// this frame's sub-frames so far, what sub-frame 0 saw of them and of the punctual lights,
     /// its sample's distance (and, with emitters in closed form, its normal and their unshadowed
-    /// irradiance) ([`DirectPass::with_adaptive_shadows`]).
+    /// irradiance) ([`DirectVariant::shadows`]).
     shadows: Option<Buffer>,
-    /// The specular paths are pooled over the neighbourhood ([`DirectPass::with_specular_pool`]).
+    /// The specular paths are pooled over the neighbourhood ([`DirectVariant::specular_paths`]).
     specular_pool: bool,
-    /// Made to composite ([`DirectPass::with_composite`]).
+    /// Made to composite ([`DirectVariant::composite`]).
     composites: bool,
 }
 
@@ -118,47 +214,21 @@ impl std::fmt::Debug for DirectPass {
 }
 
 impl DirectPass {
-    /// Compiles the pass for `scene`'s plan; with [`SkyLight::Records`] it leaves a constant
-    /// environment out (the records bring it), with [`EmitterLight::Analytic`] it takes the
-    /// emitters' unshadowed light in closed form where the plan allows.
+    /// Compiles the pass for `scene`'s plan and `variant`.
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
-        sky: SkyLight,
-        emitters: EmitterLight,
+        variant: &DirectVariant,
     ) -> Result<DirectPass> {
-        Self::with_radiance(ctx, shaders, scene, sky, emitters, false)
-    }
-
-    /// As [`DirectPass::new`]; with `radiance` the pass can leave glossy lobes' indirect light to
-    /// the radiance records (`HAS_RADIANCE_CACHE`), writing each such pixel's glossy world
-    /// weights ([`DirectPass::record_glossy`]).
-    pub fn with_radiance(
-        ctx: &Context,
-        shaders: &ShaderCompiler,
-        scene: &GpuScene,
-        sky: SkyLight,
-        emitters: EmitterLight,
-        radiance: bool,
-    ) -> Result<DirectPass> {
-        Self::with_composite(ctx, shaders, scene, sky, emitters, radiance, None)
-    }
-
-    /// As [`DirectPass::with_radiance`]; with `composite` (`Some(moments)`, the composite
-    /// pass's `IC_AA_MOMENTS`) made to composite: every recording binds the composite's
-    /// resources ([`DirectPass::record_composited`]), and a sub-frame composited against the
-    /// centre samples adds its samples to the frame's accumulators itself instead of writing
-    /// the direct image.
-    pub fn with_composite(
-        ctx: &Context,
-        shaders: &ShaderCompiler,
-        scene: &GpuScene,
-        sky: SkyLight,
-        emitters: EmitterLight,
-        radiance: bool,
-        composite: Option<bool>,
-    ) -> Result<DirectPass> {
+        let DirectVariant {
+            sky,
+            emitters,
+            radiance,
+            composite,
+            shadows,
+            specular_paths,
+        } = *variant;
         let mut defines = scene.defines();
         defines.extend(sky.define(scene.has_constant_environment()));
         let analytic = emitters.define(scene.plan().analytic_emitters);
@@ -166,7 +236,7 @@ impl DirectPass {
         if radiance {
             defines.push(("HAS_RADIANCE_CACHE", "1"));
         }
-        if let Some(moments) = composite {
+        if let Some(DirectCompositing { moments }) = composite {
             defines.push(("DIRECT_COMPOSITE", "1"));
             if moments {
                 defines.push(("IC_AA_MOMENTS", "1"));
@@ -204,30 +274,23 @@ impl DirectPass {
                 alignment: 0,
             },
         )?;
-        Ok(DirectPass {
+        let pass = DirectPass {
             pipeline,
             rays,
             placeholder,
             analytic: analytic.is_some(),
             punctual: scene.plan().has_punctual_lights(),
             shadows: None,
-            specular_pool: true,
+            specular_pool: specular_paths == SpecularPaths::Pooled,
             composites: composite.is_some(),
-        })
+        };
+        match shadows {
+            DirectShadows::Adaptive { pixels } => pass.with_adaptive_shadows(ctx, pixels),
+            DirectShadows::Fixed => Ok(pass),
+        }
     }
 
-    /// Whether a pixel's specular lobe takes its indirect light from its own paths alone
-    /// (`false`) or from those of the pixels of its 3×3 neighbourhood (within its 8×8 workgroup)
-    /// whose lobes overlap its own (`true`, the default; [`crate::SpecularPaths`]): each
-    /// neighbour's paths, weighed by this pixel's BRDF over the neighbour's density, are an
-    /// unbiased estimate of this pixel's integral but for the radiance being seen from a point a
-    /// pixel away (docs/materials.md §10).
-    pub fn with_specular_pool(mut self, pool: bool) -> DirectPass {
-        self.specular_pool = pool;
-        self
-    }
-
-    /// Makes a pass whose emitters' light is in closed form, or whose scene has punctual
+    /// Gives a pass whose emitters' light is in closed form, or whose scene has punctual
     /// lights, spend its shadow rays where they are needed ([`crate::EmitterShadows::Adaptive`]),
     /// for images of `pixels` pixels (12 bytes each, 28 with emitters in closed form): sub-frame
     /// 0 casts every pixel's rays (a quarter of the samples toward the emitters, one per
@@ -239,14 +302,9 @@ impl DirectPass {
     /// sample lies on the surface of the pixel's first, one toward the emitters at other lit and
     /// hidden pixels, mark the penumbrae their rays find, and take the stored irradiance where
     /// the sample lies on the first one's surface with its normal (docs/cache-frame.md §8.2).
-    /// Other passes are returned as they are, and so is every pass for `pixels` `None` (every
-    /// ray always).
-    pub fn with_adaptive_shadows(
-        mut self,
-        ctx: &Context,
-        pixels: Option<u32>,
-    ) -> Result<DirectPass> {
-        if let (true, Some(pixels)) = (self.analytic || self.punctual, pixels) {
+    /// Other passes are returned as they are.
+    fn with_adaptive_shadows(mut self, ctx: &Context, pixels: u32) -> Result<DirectPass> {
+        if self.analytic || self.punctual {
             self.shadows = Some(Buffer::new(
                 ctx,
                 &BufferDesc {
@@ -271,95 +329,52 @@ impl DirectPass {
         }
     }
 
-    /// Records `samples` estimates per pixel into the G-buffer's direct image for sub-frame
-    /// `sub_frame` of the frame's `seed`: the pixel's low-discrepancy sequences continue from
-    /// one sub-frame to the next (sub-frame k takes their samples `k × count ..`).
+    /// Records `inputs.samples` estimates per pixel for sub-frame `inputs.sub_frame` of the
+    /// frame's `inputs.seed` (the pixel's low-discrepancy sequences continue from one sub-frame
+    /// to the next: sub-frame k takes their samples `k × count ..`) into `outputs`. With
+    /// `inputs.glossy` (a pass built with radiance), pixels whose lobe is rough enough leave
+    /// their specular indirect light to the radiance records and write their world weights into
+    /// `glossy.weights`.
     pub fn record(
         &self,
         rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        samples: u32,
-        sub_frame: u32,
-        seed: u32,
+        inputs: &DirectInputs<'_>,
+        outputs: &DirectOutputs<'_>,
     ) -> Result<()> {
-        self.record_glossy(rec, scene, gbuffer, samples, sub_frame, seed, None)
+        let composite = match (*outputs, self.composites) {
+            (DirectOutputs::Image, false) => None,
+            (DirectOutputs::Composited { targets, sub_frame }, true) => Some((targets, sub_frame)),
+            (DirectOutputs::Image, true) => {
+                return Err(Error::Invalid(
+                    "the direct pass made to composite records with the composite's resources"
+                        .into(),
+                ))
+            }
+            (DirectOutputs::Composited { .. }, false) => {
+                return Err(Error::Invalid(
+                    "the direct pass was made without the composite".into(),
+                ))
+            }
+        };
+        self.record_inner(rec, inputs, composite)
     }
 
-    /// As [`DirectPass::record`]; with `glossy` (a pass built with radiance), pixels whose lobe
-    /// is rough enough leave their specular indirect light to the radiance records and write
-    /// their world weights into `glossy.weights`.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_glossy(
-        &self,
-        rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        samples: u32,
-        sub_frame: u32,
-        seed: u32,
-        glossy: Option<&GlossySplatPass>,
-    ) -> Result<()> {
-        if self.composites {
-            return Err(Error::Invalid(
-                "the direct pass made to composite records with the composite's resources".into(),
-            ));
-        }
-        self.record_inner(
-            rec,
-            scene,
-            gbuffer,
-            [samples, sub_frame, seed],
-            glossy,
-            None,
-        )
-    }
-
-    /// As [`DirectPass::record_glossy`] for a pass made to composite, the glossy splat taken
-    /// from `targets`: with `sub_frame_composite` the sub-frame's samples go to the frame's
-    /// accumulators against the centre samples stored by [`CompositePass`] at sub-frame 0
-    /// ([`crate::CentreSamples::Match`]), as the composite pass would add them, and the direct
-    /// image is left as it is; without it the pass writes the direct image as any other.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_composited(
-        &self,
-        rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        samples: u32,
-        sub_frame: u32,
-        seed: u32,
-        targets: CompositeTargets<'_>,
-        sub_frame_composite: Option<CompositeSubFrame>,
-    ) -> Result<()> {
-        if !self.composites {
-            return Err(Error::Invalid(
-                "the direct pass was made without the composite".into(),
-            ));
-        }
-        let composite = (targets, sub_frame_composite);
-        let sequence = [samples, sub_frame, seed];
-        self.record_inner(
-            rec,
-            scene,
-            gbuffer,
-            sequence,
-            targets.glossy,
-            Some(composite),
-        )
-    }
-
-    /// Records the pass: `[samples, sub_frame, seed]`, and for a pass made to composite its
-    /// resources and what this sub-frame composites.
+    /// Records the pass over `inputs`, and for a pass made to composite its resources and what
+    /// this sub-frame composites.
     fn record_inner(
         &self,
         rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        [samples, sub_frame, seed]: [u32; 3],
-        glossy: Option<&GlossySplatPass>,
+        inputs: &DirectInputs<'_>,
         composite: Option<(CompositeTargets<'_>, Option<CompositeSubFrame>)>,
     ) -> Result<()> {
+        let DirectInputs {
+            scene,
+            gbuffer,
+            samples,
+            sub_frame,
+            seed,
+            glossy,
+        } = *inputs;
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
         // The composite's resources were last written by other passes (the splat's targets by
         // rasterization) as well.
@@ -396,6 +411,7 @@ impl DirectPass {
             bindings.extend(composite_bindings(
                 rec,
                 targets,
+                glossy,
                 sub_frame_composite.is_some(),
             )?);
         }
@@ -429,18 +445,16 @@ impl DirectPass {
     }
 }
 
-/// The composite's resources at the bindings of the pass made to composite (`matching`: this
-/// sub-frame composites against the centre samples, which the composite pass must hold).
+/// The composite's resources at the bindings of the pass made to composite, with `glossy`'s
+/// target where the frame has one (`matching`: this sub-frame composites against the centre
+/// samples, which the composite pass must hold).
 fn composite_bindings<'a>(
     rec: &mut Recorder,
     targets: CompositeTargets<'a>,
+    glossy: Option<&'a GlossySplatPass>,
     matching: bool,
 ) -> Result<Vec<(u32, Resource<'a>)>> {
-    let CompositeTargets {
-        composite,
-        splat,
-        glossy,
-    } = targets;
+    let CompositeTargets { composite, splat } = targets;
     if matching && !composite.has_centres() {
         return Err(Error::Invalid(
             "the composite pass was made without centre samples".into(),

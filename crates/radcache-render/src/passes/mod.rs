@@ -9,7 +9,6 @@ pub mod direct;
 pub mod emission;
 pub mod gbuffer;
 pub mod holes;
-pub mod ic_counters;
 pub mod neighbours;
 pub mod path_trace;
 pub mod record;
@@ -31,7 +30,7 @@ pub fn push_constants_glsl() -> String {
         glsl_struct::<direct::DirectPush>(),
         glsl_struct::<gbuffer::GBufferPush>(),
         glsl_struct::<holes::HolesPush>(),
-        glsl_struct::<ic_counters::IcCountersPush>(),
+        glsl_struct::<crate::state::ic_counters::IcCountersPush>(),
         glsl_struct::<neighbours::NeighboursPush>(),
         glsl_struct::<path_trace::PathTracePush>(),
         glsl_struct::<record::RecordPush>(),
@@ -58,7 +57,7 @@ mod tests {
         errors.extend(std430_violations::<direct::DirectPush>());
         errors.extend(std430_violations::<gbuffer::GBufferPush>());
         errors.extend(std430_violations::<holes::HolesPush>());
-        errors.extend(std430_violations::<ic_counters::IcCountersPush>());
+        errors.extend(std430_violations::<crate::state::ic_counters::IcCountersPush>());
         errors.extend(std430_violations::<neighbours::NeighboursPush>());
         errors.extend(std430_violations::<path_trace::PathTracePush>());
         errors.extend(std430_violations::<record::RecordPush>());

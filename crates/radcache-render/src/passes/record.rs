@@ -13,16 +13,16 @@
 //! - `RECORDS`: `GpuRecord[]`;
 //! - `RAY_COUNT`: the ray count (`uint`, host-readable, [`RecordPass::rays`]);
 //! - `SAMPLES`: the optional sample dump, `vec4[]` of `(L_jk, r_jk)`
-//!   ([`RecordPass::record_with_samples`]);
+//!   ([`RecordOutputs::samples`]);
 //! - `RADIANCE`: the records' radiance coefficients (`HAS_RADIANCE_CACHE`);
 //! - `PATH_GRID`, `PATH_GRID_SUMS`: the frame's radiance grid (`PATH_GRID`, docs/cache-frame.md
-//!   §4.1), the pass's own buffers ([`RecordPass::with_options`]).
+//!   §4.1), the pass's own buffers ([`RecordVariant::path_grid`]).
 //!
 //! Push constants ([`RecordPush`], 56 bytes): `M`, `N`, seed, level | sub-frame << 16, then
 //! `min_px`, `max_px` (R⁻/R⁺ as validity radii in pixel footprints), the validity scale
 //! (`IcParams::validity_scale`) and `r_eps` relative to the scene scale, then the source
 //! ([`RecordSource`]: pixel requests, or record indices evaluated again,
-//! [`RecordPass::record_refresh`]), the fine level and strata and whether they fall off below it,
+//! [`RecordJob::Refresh`]), the fine level and strata and whether they fall off below it,
 //! and the dispatch's epoch in the radiance grid (0: not used).
 
 use radcache_cache::{ErrorControl, IcParams};
@@ -33,9 +33,9 @@ use radcache_vk::{
 
 use crate::bindings::record as b;
 use crate::error::{Error, Result};
-use crate::frame::settings::{GlossySpacing, PathGridMode, SkyLight};
 use crate::passes::gbuffer::GBuffer;
 use crate::scene::GpuScene;
+use crate::technique::{GlossySpacing, PathGridMode, SkyLight};
 use radcache_shared::consts::RecordSource;
 use radcache_shared::gpu::IcCounters;
 
@@ -46,8 +46,6 @@ pub use push::{creation_seed, record_seed, RecordPush};
 
 /// The shader, relative to `shaders/`.
 pub const SHADER: &str = "passes/record.comp";
-/// First binding of the pass's own resources (`B_RECORD_REQUESTS` in GLSL).
-pub const RECORD_BINDINGS_BASE: u32 = b::REQUESTS;
 /// Distances at or below this fraction of the scene's size are invalid samples (self-hits).
 pub const R_EPS_REL: f32 = 1.0e-5;
 /// Byte offset of the record pass's `VkDispatchIndirectCommand` in `IcCounters`.
@@ -79,62 +77,146 @@ impl std::fmt::Debug for RecordPass {
     }
 }
 
-/// The storage buffers a record dispatch reads and writes.
-struct Io<'a> {
-    requests: &'a Buffer,
-    counters: &'a Buffer,
-    records: &'a Buffer,
-    samples: &'a Buffer,
-    radiance: &'a Buffer,
+/// What the record pass is compiled for: its shader variant and its own buffers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RecordVariant {
+    /// The cache parameters: strata, spacing limits and weight kind (which sets the validity
+    /// scale of `R⁻`/`R⁺`); the Hessian error control is compiled in (`IC_HESSIAN`).
+    pub params: IcParams,
+    /// With [`SkyLight::Records`] a gather ray that escapes brings a constant environment's
+    /// radiance.
+    pub sky: SkyLight,
+    /// The records also project their strata onto the SH coefficients of the incoming radiance
+    /// (`HAS_RADIANCE_CACHE`, docs/radiance-caching.md §6.1), written to
+    /// [`RecordOutputs::radiance`].
+    pub radiance: bool,
+    /// How records for glossy lobes are spaced (with `radiance`; docs/radiance-caching.md §9:
+    /// `GLOSSY_DENSITY` with [`GlossySpacing::Lobe`]).
+    pub glossy_spacing: GlossySpacing,
+    /// With [`PathGridMode::On`] and a scene whose plan allows it (`ScenePlan::path_grid`: some
+    /// material is Lambertian) the gathers share a radiance grid (`PATH_GRID`,
+    /// docs/cache-frame.md §4.1), which [`RecordPass::record_grid_frame`] readies at the start
+    /// of each frame.
+    pub path_grid: PathGridMode,
+}
+
+impl RecordVariant {
+    /// Irradiance records with `params`, the sky as `sky`: no radiance coefficients, no grid.
+    pub fn new(params: IcParams, sky: SkyLight) -> RecordVariant {
+        RecordVariant {
+            params,
+            sky,
+            radiance: false,
+            glossy_spacing: GlossySpacing::Lobe,
+            path_grid: PathGridMode::Off,
+        }
+    }
+
+    /// The shader's defines for `scene`'s plan, and whether the gathers share a grid.
+    fn defines(&self, scene: &GpuScene) -> (Vec<(&'static str, &'static str)>, bool) {
+        let mut defines = scene.defines();
+        defines.extend(self.sky.define(scene.has_constant_environment()));
+        if self.params.error_control == ErrorControl::Hessian {
+            defines.push(("IC_HESSIAN", "1"));
+        }
+        if scene.plan().closed_form_gathers {
+            // The emitters' light at each gather vertex in closed form less a one-sample
+            // estimate of its hidden part (`shaders/common/path.glsl`).
+            defines.push(("PATH_CLOSED_FORM_EMITTERS", "1"));
+        }
+        if self.radiance {
+            defines.push(("HAS_RADIANCE_CACHE", "1"));
+            if self.glossy_spacing == GlossySpacing::Lobe {
+                defines.push(("GLOSSY_DENSITY", "1"));
+            }
+        }
+        let grid = self.path_grid == PathGridMode::On && scene.plan().path_grid();
+        if grid {
+            defines.push(("PATH_GRID", "1"));
+        }
+        (defines, grid)
+    }
+}
+
+/// What a record dispatch computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RecordJob {
+    /// New records for the pending batch of pixel requests: request `i` of the requests
+    /// (`i < min(requested, request_capacity)` of the counters) becomes record `batch_first + i`
+    /// of the records. `level` and `sub_frame` are stored in the record's `info`; `seed`
+    /// selects the jitter ([`record_seed`]).
+    Create {
+        /// The creation level.
+        level: u32,
+        /// The sub-frame.
+        sub_frame: u32,
+        /// The pass seed.
+        seed: u32,
+    },
+    /// Records refreshed in place (temporal caching, docs/temporal.md §3.5): each request is a
+    /// record index; that record is computed again at its own point, normal and footprint,
+    /// with its own pixel, level and sub-frame, and the pass seed
+    /// [`creation_seed`]`(frame_seed, sub-frame)`, so under unchanged lighting its irradiance
+    /// and gradients come out bit for bit as they were (its radius comes back before neighbour
+    /// clamping). Rejected records are left as they are; the G-buffer is bound but not read.
+    Refresh {
+        /// The frame's seed.
+        frame_seed: u32,
+    },
+}
+
+/// What a record dispatch reads.
+#[derive(Debug, Clone, Copy)]
+pub struct RecordInputs<'a> {
+    /// The scene.
+    pub scene: &'a GpuScene,
+    /// The G-buffer the pixel requests point into.
+    pub gbuffer: &'a GBuffer,
+    /// `uint[]`: pixel indices `y·width + x` ([`RecordJob::Create`]) or record indices
+    /// ([`RecordJob::Refresh`]).
+    pub requests: &'a Buffer,
+    /// `IcCounters`: the request count and the indirect dispatch (read at [`DISPATCH_OFFSET`],
+    /// which must be visible to indirect reads); the pass counts dropped requests and rejected
+    /// records there.
+    pub counters: &'a Buffer,
+    /// What the dispatch computes.
+    pub job: RecordJob,
+}
+
+/// What a record dispatch writes.
+#[derive(Debug, Clone, Copy)]
+pub struct RecordOutputs<'a> {
+    /// `GpuRecord[]`.
+    pub records: &'a Buffer,
+    /// The records' radiance blocks (a pass whose variant has `radiance`): record `r` writes its
+    /// `RECORD_RADIANCE_VEC4S` vec4 of coefficients and gradients at `radiance[r·48..]`.
+    pub radiance: Option<&'a Buffer>,
+    /// For tests and diagnostics: request `i` also writes the samples of its strata,
+    /// `(L_jk.rgb, r_jk)` as `[f32; 4]`, at `samples[i·M·N + j·N + k]`, when the buffer holds at
+    /// least `(i + 1)·M·N` of them.
+    pub samples: Option<&'a Buffer>,
+}
+
+impl<'a> RecordOutputs<'a> {
+    /// Records alone: no radiance blocks, no sample dump.
+    pub fn records(records: &'a Buffer) -> RecordOutputs<'a> {
+        RecordOutputs {
+            records,
+            radiance: None,
+            samples: None,
+        }
+    }
 }
 
 impl RecordPass {
-    /// Compiles the pass for `scene`'s plan with the cache parameters `params` (strata, spacing
-    /// limits and weight kind, which sets the validity scale of `R⁻`/`R⁺`; the Hessian error
-    /// control is compiled in with the define `IC_HESSIAN`); with [`SkyLight::Records`] a gather
-    /// ray that escapes brings a constant environment's radiance.
+    /// Compiles the pass for `scene`'s plan and `variant`.
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
-        params: &IcParams,
-        sky: SkyLight,
+        variant: &RecordVariant,
     ) -> Result<RecordPass> {
-        Self::with_radiance(ctx, shaders, scene, params, sky, false)
-    }
-
-    /// As [`RecordPass::new`]; with `radiance` the records also project their strata onto the
-    /// SH coefficients of the incoming radiance (`HAS_RADIANCE_CACHE`, docs/radiance-caching.md
-    /// §6.1), written by [`RecordPass::record_with_radiance`], and records for glossy lobes
-    /// obey the glossy gradient limit ([`GlossySpacing::Lobe`]).
-    pub fn with_radiance(
-        ctx: &Context,
-        shaders: &ShaderCompiler,
-        scene: &GpuScene,
-        params: &IcParams,
-        sky: SkyLight,
-        radiance: bool,
-    ) -> Result<RecordPass> {
-        let (spacing, grid) = (GlossySpacing::Lobe, PathGridMode::Off);
-        Self::with_options(ctx, shaders, scene, params, sky, radiance, spacing, grid)
-    }
-
-    /// As [`RecordPass::with_radiance`], the records for glossy lobes spaced by `spacing`
-    /// (docs/radiance-caching.md §9; `GLOSSY_DENSITY` with [`GlossySpacing::Lobe`]); with
-    /// [`PathGridMode::On`] and a scene whose plan allows it (`ScenePlan::path_grid`: some
-    /// material is Lambertian) the gathers share a radiance grid (`PATH_GRID`, docs/cache-frame.md
-    /// §4.1), which [`RecordPass::record_grid_frame`] readies at the start of each frame.
-    #[allow(clippy::too_many_arguments)]
-    pub fn with_options(
-        ctx: &Context,
-        shaders: &ShaderCompiler,
-        scene: &GpuScene,
-        params: &IcParams,
-        sky: SkyLight,
-        radiance: bool,
-        spacing: GlossySpacing,
-        grid: PathGridMode,
-    ) -> Result<RecordPass> {
+        let params = &variant.params;
         let strata = [
             (params.strata_m, params.strata_n),
             (params.fine_strata_m, params.fine_strata_n),
@@ -146,26 +228,7 @@ impl RecordPass {
                 )));
             }
         }
-        let mut defines = scene.defines();
-        defines.extend(sky.define(scene.has_constant_environment()));
-        if params.error_control == ErrorControl::Hessian {
-            defines.push(("IC_HESSIAN", "1"));
-        }
-        if scene.plan().closed_form_gathers {
-            // The emitters' light at each gather vertex in closed form less a one-sample
-            // estimate of its hidden part (`shaders/common/path.glsl`).
-            defines.push(("PATH_CLOSED_FORM_EMITTERS", "1"));
-        }
-        if radiance {
-            defines.push(("HAS_RADIANCE_CACHE", "1"));
-            if spacing == GlossySpacing::Lobe {
-                defines.push(("GLOSSY_DENSITY", "1"));
-            }
-        }
-        let grid = grid == PathGridMode::On && scene.plan().path_grid();
-        if grid {
-            defines.push(("PATH_GRID", "1"));
-        }
+        let (defines, grid) = variant.defines(scene);
         let spirv = shaders.compile(SHADER, &defines)?;
         let pipeline = Pipeline::compute(
             ctx,
@@ -193,7 +256,7 @@ impl RecordPass {
             no_samples: buffer("records.no_samples", MemoryLocation::GpuOnly)?,
             no_radiance: buffer("records.no_radiance", MemoryLocation::GpuOnly)?,
             params: *params,
-            radiance,
+            radiance: variant.radiance,
             grid: if grid {
                 Some(PathGrid::new(ctx)?)
             } else {
@@ -202,7 +265,7 @@ impl RecordPass {
         })
     }
 
-    /// Whether the gathers share a radiance grid ([`RecordPass::with_options`]).
+    /// Whether the gathers share a radiance grid ([`RecordVariant::path_grid`]).
     pub fn path_grid(&self) -> bool {
         self.grid.is_some()
     }
@@ -224,173 +287,36 @@ impl RecordPass {
         &self.params
     }
 
-    /// Whether the pass projects radiance coefficients ([`RecordPass::with_radiance`]).
+    /// Whether the pass projects radiance coefficients ([`RecordVariant::radiance`]).
     pub fn radiance(&self) -> bool {
         self.radiance
     }
 
-    /// As [`RecordPass::record`], and (when built [`RecordPass::with_radiance`]) record `r`
-    /// also writes its `RECORD_RADIANCE_VEC4S` vec4 of radiance coefficients and their
-    /// gradients at `radiance[r·48..]` when `radiance` holds them.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_with_radiance(
-        &self,
-        rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        requests: &Buffer,
-        counters: &Buffer,
-        records: &Buffer,
-        radiance: &Buffer,
-        level: u32,
-        sub_frame: u32,
-        seed: u32,
-    ) -> Result<()> {
-        let io = Io {
-            requests,
-            counters,
-            records,
-            samples: &self.no_samples,
-            radiance,
-        };
-        self.record_pixels(rec, scene, gbuffer, &io, level, sub_frame, seed)
-    }
-
-    /// Records computing the pending batch in a pass named `records`: request `i` of `requests`
-    /// (`i < min(requested, request_capacity)` of `counters`) becomes record `batch_first + i` of
-    /// `records`;
-    /// one workgroup per request, dispatched from `counters`' indirect arguments (which must be
-    /// visible to indirect reads). `level` and `sub_frame` are stored in the record's `info`;
-    /// `seed` selects the jitter ([`record_seed`]).
-    #[allow(clippy::too_many_arguments)]
+    /// Records the dispatch of `inputs.job` in a pass named `records`: one workgroup per
+    /// request, dispatched from the counters' indirect arguments.
     pub fn record(
         &self,
         rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        requests: &Buffer,
-        counters: &Buffer,
-        records: &Buffer,
-        level: u32,
-        sub_frame: u32,
-        seed: u32,
+        inputs: &RecordInputs<'_>,
+        outputs: &RecordOutputs<'_>,
     ) -> Result<()> {
-        self.record_with_samples(
-            rec,
-            scene,
-            gbuffer,
-            requests,
-            counters,
-            records,
-            level,
-            sub_frame,
-            seed,
-            &self.no_samples,
-            None,
-        )
-    }
-
-    /// Records refreshing records in place (temporal caching, docs/temporal.md §3.5): request
-    /// `i` of `requests` (`i < min(requested, request_capacity)`, dispatched from `counters`) is a record
-    /// index; that record is computed again at its own point, normal and footprint, with its own
-    /// pixel, level and sub-frame, and the pass seed [`creation_seed`]`(frame_seed, sub-frame)`,
-    /// so under unchanged lighting its irradiance and gradients come out bit for bit as they were
-    /// (its radius comes back before neighbour clamping). Rejected records are left as they are.
-    /// With `radiance` (and a pass built [`RecordPass::with_radiance`]) the record's radiance
-    /// block is computed again too, at the same index of `radiance`. `gbuffer` is bound but not
-    /// read.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_refresh(
-        &self,
-        rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        requests: &Buffer,
-        counters: &Buffer,
-        records: &Buffer,
-        radiance: Option<&Buffer>,
-        frame_seed: u32,
-    ) -> Result<()> {
-        let io = Io {
-            requests,
-            counters,
-            records,
-            samples: &self.no_samples,
-            radiance: radiance.unwrap_or(&self.no_radiance),
+        let (level, sub_frame, seed, source) = match inputs.job {
+            RecordJob::Create {
+                level,
+                sub_frame,
+                seed,
+            } => (level, sub_frame, seed, RecordSource::Pixels),
+            RecordJob::Refresh { frame_seed } => (0, 0, frame_seed, RecordSource::Records),
         };
-        self.record_io(
-            rec,
-            scene,
-            gbuffer,
-            &io,
-            0,
-            0,
-            frame_seed,
-            RecordSource::Records,
-        )
-    }
-
-    /// As [`RecordPass::record`], and request `i` also writes the samples of its strata,
-    /// `(L_jk.rgb, r_jk)` as `[f32; 4]`, at `samples[i·M·N + j·N + k]`, when `samples` holds at
-    /// least `(i + 1)·M·N` of them (for tests and diagnostics); with `radiance`, as
-    /// [`RecordPass::record_with_radiance`].
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_with_samples(
-        &self,
-        rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        requests: &Buffer,
-        counters: &Buffer,
-        records: &Buffer,
-        level: u32,
-        sub_frame: u32,
-        seed: u32,
-        samples: &Buffer,
-        radiance: Option<&Buffer>,
-    ) -> Result<()> {
-        let io = Io {
-            requests,
-            counters,
-            records,
-            samples,
-            radiance: radiance.unwrap_or(&self.no_radiance),
-        };
-        self.record_pixels(rec, scene, gbuffer, &io, level, sub_frame, seed)
-    }
-
-    /// [`RecordPass::record_io`] for requests of pixels.
-    #[allow(clippy::too_many_arguments)]
-    fn record_pixels(
-        &self,
-        rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        io: &Io<'_>,
-        level: u32,
-        sub_frame: u32,
-        seed: u32,
-    ) -> Result<()> {
-        let source = RecordSource::Pixels;
-        self.record_io(rec, scene, gbuffer, io, level, sub_frame, seed, source)
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn record_io(
-        &self,
-        rec: &mut Recorder,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        io: &Io<'_>,
-        level: u32,
-        sub_frame: u32,
-        seed: u32,
-        source: RecordSource,
-    ) -> Result<()> {
         if level > 0xffff || sub_frame > 0xffff {
             return Err(Error::Invalid(format!(
                 "record level {level} / sub-frame {sub_frame}: both must fit 16 bits"
             )));
+        }
+        if outputs.radiance.is_some() && !self.radiance {
+            return Err(Error::Invalid(
+                "the record pass was made without radiance coefficients to write".into(),
+            ));
         }
         let p = &self.params;
         let push = RecordPush {
@@ -410,34 +336,36 @@ impl RecordPass {
             // New records and refreshes alike (docs/temporal.md §3.8).
             grid_epoch: self.grid.as_ref().map_or(0, |g| g.next_epoch()),
         };
+        let gbuffer = inputs.gbuffer;
         for image in gbuffer.images() {
             rec.use_image(image, ImageUse::ComputeStorage);
         }
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
         rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
-        let mut bindings = scene.bindings();
+        let mut bindings = inputs.scene.bindings();
         bindings.extend(gbuffer.bindings());
+        let grid = |f: fn(&PathGrid) -> &Buffer| self.grid.as_ref().map_or(&self.no_samples, f);
         bindings.extend([
-            (b::REQUESTS, Resource::Buffer(io.requests)),
-            (b::COUNTERS, Resource::Buffer(io.counters)),
-            (b::RECORDS, Resource::Buffer(io.records)),
+            (b::REQUESTS, Resource::Buffer(inputs.requests)),
+            (b::COUNTERS, Resource::Buffer(inputs.counters)),
+            (b::RECORDS, Resource::Buffer(outputs.records)),
             (b::RAY_COUNT, Resource::Buffer(&self.rays)),
-            (b::SAMPLES, Resource::Buffer(io.samples)),
-            (b::RADIANCE, Resource::Buffer(io.radiance)),
             (
-                b::PATH_GRID,
-                Resource::Buffer(self.grid.as_ref().map_or(&self.no_samples, |g| &g.keys)),
+                b::SAMPLES,
+                Resource::Buffer(outputs.samples.unwrap_or(&self.no_samples)),
             ),
             (
-                b::PATH_GRID_SUMS,
-                Resource::Buffer(self.grid.as_ref().map_or(&self.no_samples, |g| &g.sums)),
+                b::RADIANCE,
+                Resource::Buffer(outputs.radiance.unwrap_or(&self.no_radiance)),
             ),
+            (b::PATH_GRID, Resource::Buffer(grid(|g| &g.keys))),
+            (b::PATH_GRID_SUMS, Resource::Buffer(grid(|g| &g.sums))),
         ]);
         rec.pass("records", |rec| {
             rec.bind_pipeline(&self.pipeline);
             rec.push_bindings(&bindings);
             rec.push_constants(&push);
-            rec.dispatch_indirect(io.counters, DISPATCH_OFFSET);
+            rec.dispatch_indirect(inputs.counters, DISPATCH_OFFSET);
         });
         rec.barrier(Access::COMPUTE_WRITE, Access::ALL.union(Access::HOST_READ));
         Ok(())

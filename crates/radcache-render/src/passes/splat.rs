@@ -101,6 +101,43 @@ impl std::fmt::Debug for SplatPass {
     }
 }
 
+/// What a splat reads: the scene's frame constants, the G-buffer's samples, and the records with
+/// their counters (the draw's indirect arguments) and last-use marks.
+#[derive(Debug, Clone, Copy)]
+pub struct SplatInputs<'a> {
+    /// The scene.
+    pub scene: &'a GpuScene,
+    /// The samples the records are splatted at.
+    pub gbuffer: &'a GBuffer,
+    /// The records.
+    pub state: &'a IcState,
+}
+
+/// One splat draw: its profiler scope, the records it covers, what it draws and its weights.
+#[derive(Debug, Clone, Copy)]
+pub struct SplatDraw<'a> {
+    /// The profiler scope (e.g. `splat`).
+    pub name: &'a str,
+    /// The records splatted.
+    pub scope: SplatScope,
+    /// The targets drawn.
+    pub output: SplatOutput,
+    /// The weights (creation or final).
+    pub weights: &'a SplatWeights,
+}
+
+impl<'a> SplatDraw<'a> {
+    /// Every record with `weights`, counting the records per pixel too, in the scope `splat`.
+    pub fn all(weights: &'a SplatWeights) -> SplatDraw<'a> {
+        SplatDraw {
+            name: "splat",
+            scope: SplatScope::All,
+            output: SplatOutput::IrradianceAndCount,
+            weights,
+        }
+    }
+}
+
 impl SplatPass {
     /// Compiles the pass and allocates the `width × height` accumulation target.
     pub fn new(ctx: &Context, shaders: &ShaderCompiler, width: u32, height: u32) -> Result<Self> {
@@ -159,39 +196,28 @@ impl SplatPass {
         })
     }
 
-    /// Records splatting the records of `scope` with `weights`, in a profiler scope named `name`
-    /// (e.g. `splat`), counting the records per pixel too ([`SplatOutput::IrradianceAndCount`]).
-    #[allow(clippy::too_many_arguments)]
+    /// Records splatting the records of `draw.scope` with `draw.weights` into the pass's
+    /// targets, in a profiler scope named `draw.name`, drawing `draw.output`; the count target is
+    /// left as it is unless the output draws it. [`SplatOutput::Coverage`] gives the same Σ w in
+    /// the target's alpha as the others, with zero in its colour (hole selection reads Σ w
+    /// alone), so its fragments skip the irradiance's extrapolation.
     pub fn record(
         &self,
         rec: &mut Recorder,
-        name: &str,
-        scope: SplatScope,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        state: &IcState,
-        weights: &SplatWeights,
+        inputs: &SplatInputs<'_>,
+        draw: &SplatDraw<'_>,
     ) -> Result<()> {
-        let output = SplatOutput::IrradianceAndCount;
-        self.record_output(output, rec, name, scope, scene, gbuffer, state, weights)
-    }
-
-    /// As [`SplatPass::record`], drawing `output`; the count target is left as it is unless
-    /// `output` draws it. [`SplatOutput::Coverage`] gives the same Σ w in the target's alpha as
-    /// the others, with zero in its colour (hole selection reads Σ w alone), so its fragments
-    /// skip the irradiance's extrapolation.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_output(
-        &self,
-        output: SplatOutput,
-        rec: &mut Recorder,
-        name: &str,
-        scope: SplatScope,
-        scene: &GpuScene,
-        gbuffer: &GBuffer,
-        state: &IcState,
-        weights: &SplatWeights,
-    ) -> Result<()> {
+        let SplatInputs {
+            scene,
+            gbuffer,
+            state,
+        } = *inputs;
+        let SplatDraw {
+            name,
+            scope,
+            output,
+            weights,
+        } = *draw;
         let pipeline = match output {
             SplatOutput::Irradiance => &self.irradiance,
             SplatOutput::IrradianceAndCount => &self.counted,

@@ -20,17 +20,17 @@
 //! the whole lifespan (docs/temporal.md §3.4) measured worse: a difference of two evaluations
 //! carries the noise of the paths that diverge between the two scenes.
 //!
-//! [`crate::IcRenderer`] drives it: [`TemporalPass::record_advance`] at the start of a frame (it
+//! [`crate::IcRenderer`] drives it: [`TemporalJob::Advance`] at the start of a frame (it
 //! also re-clamps kept records' radii when the camera moved), the cache's hole filling, then
-//! [`TemporalPass::record_adopt`] for the frame's new records, the look-ahead
-//! ([`TemporalPass::record_shift`], the record pass on [`TemporalPass::lookahead`],
-//! [`TemporalPass::record_finish`]) with the scene at the next frame's time, and
-//! [`TemporalPass::record_keep_instances`] at the end.
+//! [`TemporalJob::Adopt`] for the frame's new records, the look-ahead
+//! ([`TemporalJob::Shift`], the record pass on [`TemporalPass::lookahead`],
+//! [`TemporalJob::Finish`]) with the scene at the next frame's time, and
+//! [`TemporalJob::KeepInstances`] at the end.
 //!
 //! Radiance records (docs/radiance-caching.md §8) keep their SH coefficients in
 //! `IcState::radiance` and are evaluated ahead with the irradiance: the adopt step copies the
 //! blocks to [`TemporalPass::lookahead_radiance`], the look-ahead's record pass writes the listed
-//! records' new blocks there, and [`TemporalPass::record_promote_radiance`] copies them back
+//! records' new blocks there, and [`TemporalJob::PromoteRadiance`] copies them back
 //! after the frame's shading, so the next frame shows them. The coefficients get no rate (a
 //! record shows its last evaluation, not an extrapolation: the lifespan, from the irradiance's
 //! change, already bounds how stale it gets), and since they are in world space a kept record on
@@ -99,7 +99,7 @@ pub struct TemporalPass {
     /// Their radiance blocks (same indices), with lifespans in a cache with radiance blocks.
     pub lookahead_radiance: Option<Buffer>,
     /// Records whose look-ahead radiance blocks go to the cache after this frame's shading
-    /// ([`TemporalPass::record_promote_radiance`]); 0 = none pending.
+    /// ([`TemporalJob::PromoteRadiance`]); 0 = none pending.
     promote: u32,
     previous: Buffer,
     /// Two vec4 per moving instance: bounding sphere (centre, radius) at the scene's current
@@ -117,6 +117,80 @@ impl std::fmt::Debug for TemporalPass {
             .field("capacity", &self.capacity)
             .finish_non_exhaustive()
     }
+}
+
+/// What the temporal pass works on: the scene (its instances now, and their previous
+/// transforms kept by [`TemporalJob::KeepInstances`]) and the cache's records.
+#[derive(Debug, Clone, Copy)]
+pub struct TemporalInputs<'a> {
+    /// The scene, at the time the step needs (the frame's, or the next frame's for
+    /// [`TemporalJob::Shift`]).
+    pub scene: &'a GpuScene,
+    /// The records, their temporal states and counters.
+    pub state: &'a IcState,
+}
+
+/// One step of a frame's temporal bookkeeping, in the frame's order.
+#[derive(Debug, Clone, Copy)]
+pub enum TemporalJob<'a> {
+    /// Empties the list, then, over the `records` kept from earlier frames: with `lifespans`
+    /// (the scene, the frame's time, the parameters), moves every record with its instance and
+    /// extrapolates it to `frame`, or lists it when it expired (its lifespan ended, or the
+    /// moving instances' cover of it changed by more than `a_t`); with `reclamp` (the camera
+    /// moved), clamps every radius to the parameters' [R⁻, R⁺] at the record's pixel footprint
+    /// in the current view. The scene and view must be the frame's; the neighbour grid must be
+    /// rebuilt afterwards.
+    Advance {
+        /// The frame.
+        frame: u32,
+        /// Records kept.
+        records: u32,
+        /// The scene, the frame's time and the parameters, where records carry lifespans.
+        lifespans: Option<(&'a Scene, f32, &'a IcParams)>,
+        /// The parameters, where the camera moved.
+        reclamp: Option<&'a IcParams>,
+    },
+    /// Lists the records `first .. records` (created this frame) after the expired ones and
+    /// makes every listed record born at `frame` (at the scene's current time); `listed` is the
+    /// list's length afterwards (expired + new, at most the capacity). Then copies the records
+    /// (and their radiance blocks, when both the cache and the pass have them) to the look-ahead
+    /// buffers.
+    Adopt {
+        /// The frame.
+        frame: u32,
+        /// The first record created this frame.
+        first: u32,
+        /// The records.
+        records: u32,
+        /// The list's length afterwards.
+        listed: u32,
+    },
+    /// Moves the listed look-ahead records to the instances' current transforms (the scene must
+    /// be at the next frame's time).
+    Shift {
+        /// The list's length.
+        listed: u32,
+    },
+    /// The rate and lifespan of every listed record from its known value and its look-ahead
+    /// value, which becomes its known value for frame `frame + 1`, and its cover by the moving
+    /// instances of `next` (the scene, at the next frame's time).
+    Finish {
+        /// The frame.
+        frame: u32,
+        /// The list's length.
+        listed: u32,
+        /// The lifespans' parameters.
+        lifespans: Lifespans,
+        /// The scene and the next frame's time.
+        next: (&'a Scene, f32),
+    },
+    /// Copies the radiance blocks the look-ahead computed (and the unlisted records' unchanged
+    /// ones) back to the cache, once the frame's shading has read the current ones; nothing when
+    /// no look-ahead is pending.
+    PromoteRadiance,
+    /// Keeps the scene's current instances as the previous frame's (the next advance rotates
+    /// gradients by the change since).
+    KeepInstances,
 }
 
 /// Temporal accuracy and largest lifespan of the cache's parameters.
@@ -227,16 +301,15 @@ impl TemporalPass {
         })
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn dispatch(
         &self,
         rec: &mut Recorder,
-        scene: &GpuScene,
-        state: &IcState,
+        io: &TemporalInputs<'_>,
         mode: Mode,
         push: TemporalPush,
         invocations: u32,
     ) -> Result<()> {
+        let (scene, state) = (io.scene, io.state);
         let mut bindings = scene.bindings();
         bindings.extend([
             (b::COUNTERS, Resource::Buffer(&state.counters)),
@@ -266,6 +339,45 @@ impl TemporalPass {
             Access::ALL.union(Access::INDIRECT).union(Access::HOST_READ),
         );
         Ok(())
+    }
+
+    /// Records one step of the frame's temporal bookkeeping ([`TemporalJob`]) over `io`'s
+    /// records.
+    pub fn record(
+        &mut self,
+        rec: &mut Recorder,
+        io: &TemporalInputs<'_>,
+        job: TemporalJob<'_>,
+    ) -> Result<()> {
+        match job {
+            TemporalJob::Advance {
+                frame,
+                records,
+                lifespans,
+                reclamp,
+            } => self.record_advance(rec, io, frame, records, lifespans, reclamp),
+            TemporalJob::Adopt {
+                frame,
+                first,
+                records,
+                listed,
+            } => self.record_adopt(rec, io, frame, first, records, listed),
+            TemporalJob::PromoteRadiance => {
+                self.record_promote_radiance(rec, io.state);
+                Ok(())
+            }
+            TemporalJob::Shift { listed } => self.record_shift(rec, io, listed),
+            TemporalJob::Finish {
+                frame,
+                listed,
+                lifespans,
+                next,
+            } => self.record_finish(rec, io, frame, listed, lifespans, next),
+            TemporalJob::KeepInstances => {
+                self.record_keep_instances(rec, io.scene);
+                Ok(())
+            }
+        }
     }
 
     fn push(frame: u32) -> TemporalPush {
@@ -317,19 +429,17 @@ impl TemporalPass {
     /// (the camera moved), clamping every radius to `params`' [R⁻, R⁺] at the record's pixel
     /// footprint in the current view. The scene and view must be the frame's; the neighbour grid
     /// must be rebuilt afterwards.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_advance(
+    fn record_advance(
         &mut self,
         rec: &mut Recorder,
-        scene: &GpuScene,
-        state: &IcState,
+        io: &TemporalInputs<'_>,
         frame: u32,
         records: u32,
         lifespans: Option<(&Scene, f32, &IcParams)>,
         reclamp: Option<&IcParams>,
     ) -> Result<()> {
         let push = Self::push(frame);
-        self.dispatch(rec, scene, state, Mode::Begin, push, 1)?;
+        self.dispatch(rec, io, Mode::Begin, push, 1)?;
         if records > 0 && (lifespans.is_some() || reclamp.is_some()) {
             let mut push = TemporalPush {
                 has_previous: u32::from(self.has_previous),
@@ -346,7 +456,7 @@ impl TemporalPass {
                 push.max_px = p.max_spacing_px;
                 push.v_scale = p.validity_scale();
             }
-            self.dispatch(rec, scene, state, Mode::Advance, push, records)?;
+            self.dispatch(rec, io, Mode::Advance, push, records)?;
         }
         Ok(())
     }
@@ -356,12 +466,10 @@ impl TemporalPass {
     /// the list's length afterwards (expired + new, at most the capacity). Then copies the
     /// records (and their radiance blocks, when both the cache and the pass have them) to the
     /// look-ahead buffers.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_adopt(
+    fn record_adopt(
         &mut self,
         rec: &mut Recorder,
-        scene: &GpuScene,
-        state: &IcState,
+        io: &TemporalInputs<'_>,
         frame: u32,
         first: u32,
         records: u32,
@@ -372,9 +480,10 @@ impl TemporalPass {
             ..Self::push(frame)
         };
         if records > first {
-            self.dispatch(rec, scene, state, Mode::Append, push, records - first)?;
+            self.dispatch(rec, io, Mode::Append, push, records - first)?;
         }
-        self.dispatch(rec, scene, state, Mode::Adopt, push, listed)?;
+        self.dispatch(rec, io, Mode::Adopt, push, listed)?;
+        let state = io.state;
         let bytes = u64::from(records) * std::mem::size_of::<GpuRecord>() as u64;
         if bytes > 0 {
             rec.barrier(Access::ALL_WRITES, Access::TRANSFER_READ);
@@ -395,7 +504,7 @@ impl TemporalPass {
     /// Records copying the radiance blocks the look-ahead computed (and the unlisted records'
     /// unchanged ones) back to the cache, once the frame's shading has read the current ones;
     /// nothing when no look-ahead is pending.
-    pub fn record_promote_radiance(&mut self, rec: &mut Recorder, state: &IcState) {
+    fn record_promote_radiance(&mut self, rec: &mut Recorder, state: &IcState) {
         if let (Some(from), Some(to)) = (&self.lookahead_radiance, &state.radiance) {
             if self.promote > 0 {
                 let bytes = u64::from(self.promote) * RADIANCE_BYTES_PER_RECORD;
@@ -409,25 +518,17 @@ impl TemporalPass {
 
     /// Records moving the listed look-ahead records to the instances' current transforms (the
     /// scene must be at the next frame's time).
-    pub fn record_shift(
-        &self,
-        rec: &mut Recorder,
-        scene: &GpuScene,
-        state: &IcState,
-        listed: u32,
-    ) -> Result<()> {
-        self.dispatch(rec, scene, state, Mode::Shift, Self::push(0), listed)
+    fn record_shift(&self, rec: &mut Recorder, io: &TemporalInputs<'_>, listed: u32) -> Result<()> {
+        self.dispatch(rec, io, Mode::Shift, Self::push(0), listed)
     }
 
     /// Records the rate and lifespan of every listed record from its known value and its
     /// look-ahead value, which becomes its known value for frame `frame + 1`, and its cover by
     /// the moving instances of `next` (the scene, at the next frame's time).
-    #[allow(clippy::too_many_arguments)]
-    pub fn record_finish(
+    fn record_finish(
         &mut self,
         rec: &mut Recorder,
-        scene: &GpuScene,
-        state: &IcState,
+        io: &TemporalInputs<'_>,
         frame: u32,
         listed: u32,
         lifespans: Lifespans,
@@ -439,12 +540,12 @@ impl TemporalPass {
             max_age: lifespans.max_age,
             ..Self::push(frame)
         };
-        self.dispatch(rec, scene, state, Mode::Finish, push, listed)
+        self.dispatch(rec, io, Mode::Finish, push, listed)
     }
 
     /// Records keeping the scene's current instances as the previous frame's (the next advance
     /// rotates gradients by the change since).
-    pub fn record_keep_instances(&mut self, rec: &mut Recorder, scene: &GpuScene) {
+    fn record_keep_instances(&mut self, rec: &mut Recorder, scene: &GpuScene) {
         let (buffer, count) = scene.instances();
         let bytes = u64::from(count) * std::mem::size_of::<GpuInstance>() as u64;
         if bytes > 0 {

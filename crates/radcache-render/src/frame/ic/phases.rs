@@ -14,12 +14,12 @@ use crate::error::Result;
 use crate::frame::clock::FrameClock;
 use crate::frame::path::{FrameOutput, Progress};
 use crate::frame::settings::{sub_frame_jitter, IcSettings, IcStats, SplatMode};
-use crate::passes::composite::CentreSamples;
-use crate::passes::direct::{CompositeSubFrame, CompositeTargets};
+use crate::passes::composite::{CentreSamples, CompositeInputs};
+use crate::passes::direct::{CompositeSubFrame, CompositeTargets, DirectInputs, DirectOutputs};
 use crate::passes::holes::HoleSelection;
-use crate::passes::record::creation_seed;
-use crate::passes::splat::{SplatOutput, SplatScope, SplatWeights};
-use crate::passes::temporal::expires_at;
+use crate::passes::record::{creation_seed, RecordInputs, RecordJob, RecordOutputs};
+use crate::passes::splat::{SplatDraw, SplatInputs, SplatOutput, SplatScope, SplatWeights};
+use crate::passes::temporal::{expires_at, TemporalInputs, TemporalJob};
 use crate::scene::GpuScene;
 
 /// Most passes of the cache phase over the sub-frames (see [`IcRenderer::cache_phase`]).
@@ -155,7 +155,17 @@ impl IcRenderer {
                 let reclamp = view_changed.then_some(&self.params);
                 let lifespans = temporal.then_some((scene, settings.time, &self.params));
                 let kept = run.kept;
-                t.record_advance(&mut rec, gpu, &self.state, now, kept, lifespans, reclamp)?;
+                let io = TemporalInputs {
+                    scene: gpu,
+                    state: &self.state,
+                };
+                let job = TemporalJob::Advance {
+                    frame: now,
+                    records: kept,
+                    lifespans,
+                    reclamp,
+                };
+                t.record(&mut rec, &io, job)?;
             }
         }
         self.neighbours
@@ -252,11 +262,18 @@ impl IcRenderer {
                 SplatScope::LastBatch
             };
             let (gbuffer, state) = (&self.gbuffer, &self.state);
-            let (coverage, weights) = (SplatOutput::Coverage, &creation_weights);
-            let name = "splat.coverage";
-            self.splat.record_output(
-                coverage, &mut rec, name, scope, gpu, gbuffer, state, weights,
-            )?;
+            let inputs = SplatInputs {
+                scene: gpu,
+                gbuffer,
+                state,
+            };
+            let draw = SplatDraw {
+                name: "splat.coverage",
+                scope,
+                output: SplatOutput::Coverage,
+                weights: &creation_weights,
+            };
+            self.splat.record(&mut rec, &inputs, &draw)?;
             let selection_mode = HoleSelection::Request {
                 spacing: self.params.level_spacing_px(level),
                 threshold: creation.coverage_threshold(),
@@ -277,16 +294,22 @@ impl IcRenderer {
             }
             let creation_start = Instant::now();
             let mut rec = ctx.begin("ic.create")?;
-            let (requests, counters) = (&state.requests, &state.counters);
-            let records = &state.records;
-            match &state.radiance {
-                Some(radiance) => self.records.record_with_radiance(
-                    &mut rec, gpu, gbuffer, requests, counters, records, radiance, level, k, seed,
-                )?,
-                None => self.records.record(
-                    &mut rec, gpu, gbuffer, requests, counters, records, level, k, seed,
-                )?,
-            }
+            let inputs = RecordInputs {
+                scene: gpu,
+                gbuffer,
+                requests: &state.requests,
+                counters: &state.counters,
+                job: RecordJob::Create {
+                    level,
+                    sub_frame: k,
+                    seed,
+                },
+            };
+            let outputs = RecordOutputs {
+                radiance: state.radiance.as_ref(),
+                ..RecordOutputs::records(&state.records)
+            };
+            self.records.record(&mut rec, &inputs, &outputs)?;
             self.state.record_end_batch(&mut rec)?;
             self.neighbours
                 .record(&mut rec, &self.state, gpu.scene_scale())?;
@@ -338,27 +361,25 @@ impl IcRenderer {
         // samples loaded; docs/cache-frame.md §6.5) but for the debug AOVs; sub-frame 0 writes
         // the direct image for the composite after the splat.
         let composited = centre == CentreSamples::Match && !debug;
-        if self.splat_mode == SplatMode::Once {
-            let targets = CompositeTargets {
-                composite: &self.composite,
-                splat: &self.splat,
-                glossy,
-            };
-            let sub_frame = composited.then_some(CompositeSubFrame { jitter });
-            let (samples, seed) = (settings.direct_samples, settings.seed);
-            self.direct
-                .record_composited(&mut rec, gpu, gbuffer, samples, k, seed, targets, sub_frame)?;
-        } else {
-            self.direct.record_glossy(
-                &mut rec,
-                gpu,
-                gbuffer,
-                settings.direct_samples,
-                k,
-                settings.seed,
-                glossy,
-            )?;
-        }
+        let inputs = DirectInputs {
+            scene: gpu,
+            gbuffer,
+            samples: settings.direct_samples,
+            sub_frame: k,
+            seed: settings.seed,
+            glossy,
+        };
+        let outputs = match self.splat_mode {
+            SplatMode::Once => DirectOutputs::Composited {
+                targets: CompositeTargets {
+                    composite: &self.composite,
+                    splat: &self.splat,
+                },
+                sub_frame: composited.then_some(CompositeSubFrame { jitter }),
+            },
+            SplatMode::PerSubFrame => DirectOutputs::Image,
+        };
+        self.direct.record(&mut rec, &inputs, &outputs)?;
         if splats {
             // The records per pixel only for the debug AOVs (a second blended target).
             let output = if settings.debug_aovs {
@@ -366,16 +387,16 @@ impl IcRenderer {
             } else {
                 SplatOutput::Irradiance
             };
-            self.splat.record_output(
-                output,
-                &mut rec,
-                "splat",
-                SplatScope::All,
-                gpu,
+            let inputs = SplatInputs {
+                scene: gpu,
                 gbuffer,
                 state,
-                &final_weights,
-            )?;
+            };
+            let draw = SplatDraw {
+                output,
+                ..SplatDraw::all(&final_weights)
+            };
+            self.splat.record(&mut rec, &inputs, &draw)?;
             if let Some(g) = glossy {
                 g.record(&mut rec, gpu, gbuffer, state, &final_weights)?;
             }
@@ -389,16 +410,16 @@ impl IcRenderer {
             )?;
         }
         if !composited {
-            self.composite.record_glossy(
-                &mut rec,
-                gpu,
+            let inputs = CompositeInputs {
+                scene: gpu,
                 gbuffer,
-                &self.splat,
+                splat: &self.splat,
                 glossy,
                 jitter,
                 centre,
                 debug,
-            )?;
+            };
+            self.composite.record(&mut rec, &inputs)?;
         }
         run.clock.submit(ctx, rec)?;
         run.add_rays("direct", self.direct.rays()?);
@@ -431,8 +452,12 @@ impl IcRenderer {
             .as_mut()
             .filter(|_| settings.time_step_s > 0.0)
         {
-            t.record_keep_instances(&mut rec, gpu);
-            t.record_promote_radiance(&mut rec, &self.state);
+            let io = TemporalInputs {
+                scene: gpu,
+                state: &self.state,
+            };
+            t.record(&mut rec, &io, TemporalJob::KeepInstances)?;
+            t.record(&mut rec, &io, TemporalJob::PromoteRadiance)?;
         }
         run.clock.submit(ctx, rec)?;
         run.add_rays("emission", self.emission.rays()?);

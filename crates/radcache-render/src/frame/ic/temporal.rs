@@ -7,7 +7,8 @@ use radcache_vk::Context;
 use super::{FrameRun, IcRenderer};
 use crate::error::{Error, Result};
 use crate::frame::settings::{IcSettings, IcStats};
-use crate::passes::temporal::{Lifespans, TemporalPass};
+use crate::passes::record::{RecordInputs, RecordJob, RecordOutputs};
+use crate::passes::temporal::{Lifespans, TemporalInputs, TemporalJob, TemporalPass};
 use crate::scene::GpuScene;
 
 impl IcRenderer {
@@ -45,7 +46,17 @@ impl IcRenderer {
             .min(self.state.record_capacity());
         let frame = self.frames;
         let mut rec = ctx.begin("ic.adopt")?;
-        t.record_adopt(&mut rec, gpu, &self.state, frame, first, count, listed)?;
+        let io = TemporalInputs {
+            scene: gpu,
+            state: &self.state,
+        };
+        let job = TemporalJob::Adopt {
+            frame,
+            first,
+            records: count,
+            listed,
+        };
+        t.record(&mut rec, &io, job)?;
         clock.submit(ctx, rec)?;
         if listed == 0 {
             clock.lap("lookahead");
@@ -56,23 +67,37 @@ impl IcRenderer {
         gpu.set_view(view, w, h, settings.frame, settings.seed)?;
         let mut rec = ctx.begin("ic.lookahead")?;
         gpu.record_update(ctx, &mut rec)?;
-        t.record_shift(&mut rec, gpu, &self.state, listed)?;
-        self.records.record_refresh(
-            &mut rec,
-            gpu,
-            &self.gbuffer,
-            &t.list,
-            &t.list_counters,
-            &t.lookahead,
-            t.lookahead_radiance.as_ref(),
-            settings.seed,
-        )?;
+        let io = TemporalInputs {
+            scene: gpu,
+            state: &self.state,
+        };
+        t.record(&mut rec, &io, TemporalJob::Shift { listed })?;
+        let inputs = RecordInputs {
+            scene: gpu,
+            gbuffer: &self.gbuffer,
+            requests: &t.list,
+            counters: &t.list_counters,
+            job: RecordJob::Refresh {
+                frame_seed: settings.seed,
+            },
+        };
+        let outputs = RecordOutputs {
+            radiance: t.lookahead_radiance.as_ref(),
+            ..RecordOutputs::records(&t.lookahead)
+        };
+        self.records.record(&mut rec, &inputs, &outputs)?;
         let lifespans = Lifespans {
             accuracy: self.params.temporal_accuracy,
             max_age: self.params.max_age_frames,
         };
         let next = (scene, settings.time + settings.time_step_s);
-        t.record_finish(&mut rec, gpu, &self.state, frame, listed, lifespans, next)?;
+        let job = TemporalJob::Finish {
+            frame,
+            listed,
+            lifespans,
+            next,
+        };
+        t.record(&mut rec, &io, job)?;
         clock.submit(ctx, rec)?;
         let rays = self.records.rays()?;
         stats.lookahead_rays += rays;

@@ -1,6 +1,7 @@
 //! Bookkeeping of the cache's counters (`shaders/passes/ic_counters.comp`): one invocation that
 //! moves `IcCounters` from one step of the frame to the next (reset, begin level, begin batch,
-//! end batch), so the host never reads a count to size the next dispatch or draw.
+//! end batch), so the host never reads a count to size the next dispatch or draw. It lives with
+//! the state ([`super::IcState`] owns it and its buffer), not among the frame's passes.
 //!
 //! Reads and writes: the `IcCounters` buffer (`bindings::ic_counters::COUNTERS`).
 

@@ -1,8 +1,9 @@
 //! The irradiance cache's GPU state: the record buffer, the request list, the neighbour grid, the
 //! records' temporal state, their radiance blocks (where the scene has glossy lobes from the
 //! cache) and the counters with the indirect arguments (`IcCounters`), which the
-//! bookkeeping pass ([`crate::passes::ic_counters`]) keeps consistent on the GPU, so the host never
-//! reads a count to size a dispatch or a draw.
+//! bookkeeping pass ([`ic_counters`], owned here with the buffer it keeps) keeps consistent on
+//! the GPU, so the host never reads a count to size a dispatch or a draw. The passes below the
+//! frame take this state; the state takes no pass.
 
 use bytemuck::Zeroable;
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, GpuRecordTemporal, IcCounters};
@@ -11,7 +12,9 @@ use radcache_vk::{
 };
 
 use crate::error::{Error, Result};
-use crate::passes::ic_counters::{CounterStep, IcCountersPass};
+use ic_counters::{CounterStep, IcCountersPass};
+
+pub mod ic_counters;
 
 pub use radcache_cache::cache_file::{RadianceBlock, RADIANCE_BYTES_PER_RECORD};
 pub use radcache_shared::consts::{GRID_LEVELS, GRID_SLOTS};
@@ -44,7 +47,7 @@ pub struct IcState {
     /// in; 0 = never.
     pub last_used: Buffer,
     /// `GpuRecordTemporal[record_capacity]`: each record's temporal state (temporal caching,
-    /// `crate::temporal`).
+    /// `crate::passes::temporal`).
     pub temporal: Buffer,
     /// `RadianceBlock[record_capacity]`: each record's radiance coefficients and their
     /// gradients (docs/radiance-caching.md §7.2; the record pass writes them, the glossy splat
