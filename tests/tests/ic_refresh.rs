@@ -76,7 +76,7 @@ fn a_refreshed_record_reproduces_its_value() {
         seed: SEED,
         // Holes filled at both sub-frames' jitters, so that records carry either seed.
         splat: SplatMode::PerSubFrame,
-        // Full gather paths (`--path-grid off`): with the radiance grid a record's value also
+        // Full gather paths (`--set path_grid=off`): with the radiance grid a record's value also
         // depends on the cells other paths filled, and a refresh reproduces it only to within
         // their noise (docs/temporal.md §3.5, §3.8; tests/ic_path_grid_frames.rs).
         path_grid: PathGridMode::Off,

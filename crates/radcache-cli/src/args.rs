@@ -99,6 +99,11 @@ pub struct RenderArgs {
     /// Rendering method.
     #[arg(long, value_enum, default_value_t = Method::Ic)]
     pub(crate) method: Method,
+    /// Take the configuration an EXR was rendered with (its `radcache.extra.config`: method,
+    /// resolution, seed, the cache's quality, overrides and technique switches); options given
+    /// after this one override it.
+    #[arg(long, value_name = "FILE.exr")]
+    pub(crate) config_from: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) ic: IcArgs,
     /// Samples per pixel (path tracer).

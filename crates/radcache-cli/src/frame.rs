@@ -35,6 +35,9 @@ pub struct FrameSetup<'a> {
     pub sequence: bool,
     /// Seconds per frame when records need lifespans (moving geometry or lights), else 0.
     pub time_step_s: f32,
+    /// The render's configuration as command-line arguments ([`config_args`]), in every EXR's
+    /// metadata (`radcache.extra.config`) and the stats.
+    pub config: String,
 }
 
 impl std::fmt::Debug for FrameSetup<'_> {
@@ -169,24 +172,48 @@ pub fn render(
 /// without temporal caching: the caller sets those).
 pub fn ic_settings(ic: &IcArgs, size: (u32, u32), seed: u32) -> Result<IcSettings> {
     let defaults = IcSettings::preset(ic.preset());
-    Ok(IcSettings {
+    let mut settings = IcSettings {
         width: size.0,
         height: size.1,
         params: ic.params()?,
         sub_frames: ic.sub_frames.unwrap_or(defaults.sub_frames).max(1),
         direct_samples: ic.direct_samples.unwrap_or(defaults.direct_samples).max(1),
-        sky: ic.sky_light(),
-        glossy: ic.glossy_light(),
-        glossy_spacing: ic.glossy_spacing(),
-        emitters: ic.emitter_light(),
-        emitter_shadows: ic.emitter_shadows(),
         anti_aliasing: ic.anti_aliasing()?,
-        splat: ic.splat_mode(),
-        path_grid: ic.path_grid_mode(),
-        specular_paths: ic.specular_paths(),
         seed,
         ..defaults
-    })
+    };
+    ic.apply_sets(&mut settings)?;
+    Ok(settings)
+}
+
+/// The configuration a render of `args` at `size` was made with, as the command-line
+/// arguments that give it again (`radcache render --config-from`): the method, the size, the
+/// seed and, for the cache, its options with every technique switch resolved
+/// ([`IcArgs::config_args`]).
+pub fn config_args(args: &RenderArgs, size: (u32, u32)) -> Result<Vec<String>> {
+    let mut out = vec![
+        "--method".to_string(),
+        args.method.name().to_string(),
+        "--resolution".to_string(),
+        format!("{}x{}", size.0, size.1),
+        "--seed".to_string(),
+        args.seed.to_string(),
+    ];
+    match args.method {
+        Method::Ic => {
+            let settings = ic_settings(&args.ic, size, args.seed)?;
+            out.extend(args.ic.config_args(&settings));
+        }
+        Method::Path => {
+            if let Some(spp) = args.spp {
+                out.extend(["--spp".to_string(), spp.to_string()]);
+            }
+            if let Some(t) = args.time_budget {
+                out.extend(["--time-budget".to_string(), t.to_string()]);
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// The frame's image with its AOV and debug layers.
@@ -240,8 +267,12 @@ pub fn metadata(setup: &FrameSetup<'_>, r: &Rendered, frame: u32, time: f32) -> 
     meta.extra.insert("time".into(), time.to_string());
     meta.extra
         .insert("device".into(), setup.ctx.info().name.clone());
+    meta.extra.insert(CONFIG_KEY.into(), setup.config.clone());
     meta
 }
+
+/// The metadata key of the render's configuration (`radcache.extra.config` in an EXR).
+pub const CONFIG_KEY: &str = "config";
 
 /// The PNG previews' exposure and tone curve.
 pub fn png_options(args: &RenderArgs) -> PngOptions {

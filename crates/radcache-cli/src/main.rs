@@ -35,7 +35,8 @@ use clap::{Parser, Subcommand};
 #[command(
     name = "radcache",
     version,
-    about = "Irradiance-caching renderer for glTF scenes"
+    about = "Irradiance-caching renderer for glTF scenes",
+    args_override_self = true
 )]
 struct Cli {
     #[command(subcommand)]
@@ -80,9 +81,62 @@ fn error_text(e: &anyhow::Error) -> String {
     text
 }
 
+/// The command line with `render --config-from F.exr` replaced by the configuration stored in
+/// `F.exr` followed by the rest of the arguments (so that they override it); an error for a
+/// removed technique flag ([`args::ic::removed_flag`]).
+fn expand_args(args: Vec<String>) -> anyhow::Result<Vec<String>> {
+    if let Some(message) = args::ic::removed_flag(&args) {
+        anyhow::bail!(message);
+    }
+    let Some(i) = args
+        .iter()
+        .position(|a| a == "--config-from" || a.starts_with("--config-from="))
+    else {
+        return Ok(args);
+    };
+    let (path, end) = match args[i].split_once('=') {
+        Some((_, p)) => (p.to_string(), i + 1),
+        None => match args.get(i + 1) {
+            Some(p) => (p.clone(), i + 2),
+            None => anyhow::bail!("--config-from needs an EXR file"),
+        },
+    };
+    let config = read_config(std::path::Path::new(&path))?;
+    let Some(render) = args.iter().position(|a| a == "render") else {
+        anyhow::bail!("--config-from is an option of `radcache render`");
+    };
+    let mut out: Vec<String> = args[..=render].to_vec();
+    out.extend(config.split_whitespace().map(str::to_string));
+    out.extend(args[render + 1..i].iter().cloned());
+    out.extend(args[end..].iter().cloned());
+    Ok(out)
+}
+
+/// The configuration stored in an EXR rendered by radcache.
+fn read_config(path: &std::path::Path) -> anyhow::Result<String> {
+    use anyhow::Context as _;
+    let (_, meta) = radcache_image::read_exr(path)
+        .with_context(|| format!("--config-from {}", path.display()))?;
+    meta.extra.get(frame::CONFIG_KEY).cloned().with_context(|| {
+        format!(
+            "--config-from {}: the file holds no radcache configuration (radcache.extra.{}): \
+             not rendered by this version of radcache",
+            path.display(),
+            frame::CONFIG_KEY
+        )
+    })
+}
+
 fn main() -> ExitCode {
     progress::init_logger();
-    let cli = Cli::parse();
+    let argv = match expand_args(std::env::args().collect()) {
+        Ok(argv) => argv,
+        Err(e) => {
+            eprintln!("error: {}", error_text(&e));
+            return ExitCode::FAILURE;
+        }
+    };
+    let cli = Cli::parse_from(argv);
     let result = match cli.command {
         Command::Render(args) => render::run(&args),
         Command::Info(args) => info::run(&args),

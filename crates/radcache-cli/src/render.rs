@@ -22,6 +22,10 @@ use crate::progress::WarmUp;
 use crate::sequence::{Action, ContactSheet, FrameArgs, Sequence, SequenceProgress};
 
 pub fn run(args: &RenderArgs) -> Result<ExitCode> {
+    if args.ic.set_help() {
+        crate::output::emit(&crate::args::ic::set_help_text())?;
+        return Ok(ExitCode::SUCCESS);
+    }
     let budget = match (args.spp, args.time_budget) {
         (_, Some(s)) if !(s.is_finite() && s > 0.0) => bail!("--time-budget must be positive"),
         (_, Some(s)) => Budget::Seconds(s),
@@ -116,6 +120,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         temporal,
         sequence: multi_frame,
         time_step_s,
+        config: frame::config_args(args, size)?.join(" "),
     };
     let stop = interrupt_flag(sequence.frames.len() > 1);
     let mut progress = SequenceProgress::new(sequence.frames.len(), args.quiet);
@@ -257,6 +262,7 @@ fn write_stats(
         "resolution": [setup.size.0, setup.size.1],
         "temporal": setup.temporal,
         "time_step_s": setup.time_step_s,
+        "config": setup.config,
         // Host seconds outside the frames; "write" sums the frames' `write_s`.
         "cpu_s": {"scene_load": load_s, "upload": upload_s, "write": write_s},
         "pipelines": frame::pipelines_entry(setup),

@@ -30,7 +30,7 @@ pub use frame::clock::{Span, Track};
 pub use frame::ic::{render_ic, IcRenderer};
 pub use frame::path::{render_path, Budget, FrameOutput, PathSettings, Progress};
 pub use frame::settings::{
-    sub_frame_jitter, AntiAliasing, ConfigChange, IcDebug, IcSettings, IcStats,
+    sub_frame_jitter, AntiAliasing, ConfigChange, IcDebug, IcSettings, IcStats, TechniqueHelp,
 };
 pub use passes::aov::{render_aovs, AovPass, Aovs};
 pub use passes::composite::{CentreSamples, CompositeInputs, CompositePass, CompositeVariant};

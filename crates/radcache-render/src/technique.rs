@@ -146,3 +146,112 @@ impl SkyLight {
         (self == SkyLight::Records && constant_env).then_some(("IC_SKY_IN_RECORDS", "1"))
     }
 }
+
+/// A technique switch as `radcache render --set KEY=VALUE` names it: its values' names, one
+/// line on what it chooses, and its default (the type's `Default`). The key is the
+/// [`crate::IcSettings`] field that holds it.
+pub trait Technique: Copy + Default + PartialEq + 'static {
+    /// One line on what the switch chooses.
+    const HELP: &'static str;
+    /// Every value with its name, the default's among them.
+    const VALUES: &'static [(&'static str, Self)];
+
+    /// The value's name.
+    fn name(self) -> &'static str {
+        Self::VALUES
+            .iter()
+            .find(|(_, v)| *v == self)
+            .map_or("?", |(n, _)| n)
+    }
+
+    /// The value named `name`.
+    fn parse(name: &str) -> Option<Self> {
+        Self::VALUES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, v)| v)
+    }
+}
+
+impl Technique for SpecularPaths {
+    const HELP: &'static str =
+        "whose paths a pixel's specular lobe takes its indirect light from (docs/materials.md §10)";
+    const VALUES: &'static [(&'static str, Self)] =
+        &[("pooled", Self::Pooled), ("per-pixel", Self::PerPixel)];
+}
+
+impl Technique for SplatMode {
+    const HELP: &'static str = "how often the records are splatted (docs/cache-frame.md §6.5)";
+    const VALUES: &'static [(&'static str, Self)] =
+        &[("once", Self::Once), ("per-sub-frame", Self::PerSubFrame)];
+}
+
+impl Technique for PathGridMode {
+    const HELP: &'static str =
+        "whether the records' gather paths share a radiance grid (docs/cache-frame.md §4.1)";
+    const VALUES: &'static [(&'static str, Self)] = &[("on", Self::On), ("off", Self::Off)];
+}
+
+impl Technique for GlossySpacing {
+    const HELP: &'static str =
+        "how records for glossy lobes are spaced (docs/radiance-caching.md §9)";
+    const VALUES: &'static [(&'static str, Self)] =
+        &[("lobe", Self::Lobe), ("irradiance", Self::Irradiance)];
+}
+
+impl Technique for GlossyLight {
+    const HELP: &'static str =
+        "where glossy lobes take their indirect light from (docs/radiance-caching.md §6)";
+    const VALUES: &'static [(&'static str, Self)] = &[
+        ("records", Self::Records),
+        ("records-no-gradients", Self::RecordsWithoutGradients),
+        ("paths", Self::Paths),
+    ];
+}
+
+impl Technique for EmitterLight {
+    const HELP: &'static str =
+        "how the direct pass estimates emissive triangles' light (docs/cache-frame.md §2.2)";
+    const VALUES: &'static [(&'static str, Self)] =
+        &[("analytic", Self::Analytic), ("sampled", Self::Sampled)];
+}
+
+impl Technique for EmitterShadows {
+    const HELP: &'static str =
+        "how many shadow rays the lights cast after sub-frame 0 (docs/cache-frame.md §8.2)";
+    const VALUES: &'static [(&'static str, Self)] =
+        &[("adaptive", Self::Adaptive), ("fixed", Self::Fixed)];
+}
+
+impl Technique for SkyLight {
+    const HELP: &'static str =
+        "where a constant environment's light enters the frame (docs/cache-frame.md §8.3)";
+    const VALUES: &'static [(&'static str, Self)] =
+        &[("records", Self::Records), ("direct", Self::Direct)];
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check<T: Technique + std::fmt::Debug>() {
+        assert!(T::VALUES.iter().any(|&(_, v)| v == T::default()));
+        for &(name, value) in T::VALUES {
+            assert_eq!(T::parse(name), Some(value));
+            assert_eq!(value.name(), name);
+        }
+        assert_eq!(T::parse("no-such-value"), None);
+    }
+
+    #[test]
+    fn every_value_is_named_once_and_parses_back() {
+        check::<SpecularPaths>();
+        check::<SplatMode>();
+        check::<PathGridMode>();
+        check::<GlossySpacing>();
+        check::<GlossyLight>();
+        check::<EmitterLight>();
+        check::<EmitterShadows>();
+        check::<SkyLight>();
+    }
+}

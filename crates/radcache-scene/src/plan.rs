@@ -320,7 +320,7 @@ impl fmt::Display for ScenePlan {
         let env = match self.environment {
             EnvironmentKind::None => "none",
             EnvironmentKind::Constant => {
-                "constant (cache frames: its light gathered by the records, unless `--sky direct`)"
+                "constant (cache frames: its light gathered by the records, unless `--set sky=direct`)"
             }
             EnvironmentKind::Map => "map",
         };

@@ -17,7 +17,7 @@
 //! share is a lower bound), set against the raw incoherent ray-query rate in the same scene (the
 //! scene's triangles, rays from random surface points, measured in the same run). Beside the
 //! defaults, the frame at 256² with the direct light of before the closed-form emitters and the
-//! sky through the records (`--emitters sampled --sky direct`; case suffix `_sampled_light`), and
+//! sky through the records (`--set emitters=sampled --set sky=direct`; case suffix `_sampled_light`), and
 //! with adaptive anti-aliasing (suffix `_aa`; `_aa_no_path_grid` with full gather paths instead
 //! of the radiance grid, docs/cache-frame.md §4.1), and splatting at
 //! every sub-frame instead of once per frame (suffixes `_splat_per_sub_frame` and
@@ -70,18 +70,18 @@ use super::harness::{Bench, Figure};
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Variant {
     Plain,
-    /// `--emitters sampled --sky direct`.
+    /// `--set emitters=sampled --set sky=direct`.
     SampledLight,
     /// Adaptive anti-aliasing with the preset's target.
     Aa,
-    /// Adaptive anti-aliasing and full gather paths (`--path-grid off`).
+    /// Adaptive anti-aliasing and full gather paths (`--set path_grid=off`).
     AaNoPathGrid,
-    /// A splat at every sub-frame (`--splat per-sub-frame`).
+    /// A splat at every sub-frame (`--set splat=per-sub-frame`).
     SplatPerSubFrame,
     /// Adaptive anti-aliasing and a splat at every sub-frame.
     AaSplatPerSubFrame,
     /// A quarter of the direct samples as emitter shadow rays at every pixel and sub-frame
-    /// (`--emitter-shadows fixed`; scenes whose emitters are taken in closed form).
+    /// (`--set emitter_shadows=fixed`; scenes whose emitters are taken in closed form).
     FixedShadows,
     /// The preset's strata at every level (`--fine-strata` = `--strata`, `--strata-falloff off`).
     UniformStrata,

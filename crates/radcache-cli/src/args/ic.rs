@@ -4,10 +4,7 @@
 use anyhow::{bail, Context as _, Result};
 use clap::{Args, ValueEnum};
 use radcache_cache::{ErrorControl, IcParams, Preset, WeightKind};
-use radcache_render::{
-    AntiAliasing, EmitterLight, EmitterShadows, GlossyLight, GlossySpacing, PathGridMode, SkyLight,
-    SpecularPaths, SplatMode,
-};
+use radcache_render::{AntiAliasing, IcSettings};
 
 /// Cache quality preset.
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,82 +28,6 @@ pub enum Weight {
     Ward,
 }
 
-/// Where a constant environment's light (a sky) enters a cache frame.
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Sky {
-    /// Through the records (default): the sky's irradiance is interpolated with the indirect
-    /// light and the direct pass casts no ray for it.
-    Records,
-    /// Sampled by the direct pass at every pixel.
-    Direct,
-}
-
-/// How the direct pass estimates the light of emissive triangles.
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Emitters {
-    /// The unshadowed light in closed form, its shadows sampled (default; where the plan allows:
-    /// a few untextured emitters, see `radcache info`).
-    Analytic,
-    /// Light and BSDF sampling with MIS.
-    Sampled,
-}
-
-/// How many shadow rays the closed-form emitters' light casts after the first sub-frame.
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum EmitterShadowsArg {
-    /// After the first sub-frame, a quarter of the direct samples in penumbrae (as the
-    /// sub-frames so far saw them), one ray where the emitters were wholly visible or wholly
-    /// hidden, none (and no punctual light's shadow ray) where the pixel's whole 3×3
-    /// neighbourhood saw the same in the first sub-frame (default; docs/cache-frame.md §8.2).
-    Adaptive,
-    /// A quarter of the direct samples at every pixel, every punctual light's shadow ray at
-    /// every sub-frame.
-    Fixed,
-}
-
-/// Where glossy lobes take their indirect light from in a cache frame.
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Glossy {
-    /// Radiance records for lobes of roughness ≥ 0.6 (default; where the plan has such
-    /// materials, see `radcache info`), sharper lobes path traced per pixel.
-    Records,
-    /// As `records`, each record's coefficients constant over its zone (no gradients): for
-    /// measuring what the gradients bring.
-    RecordsNoGradients,
-    /// Every lobe's indirect light path traced per pixel.
-    Paths,
-}
-
-/// How records for glossy lobes from the cache are spaced (docs/radiance-caching.md §9).
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum GlossySpacingArg {
-    /// Also by the glossy gradient limit: density follows the incoming radiance's directional
-    /// detail (default).
-    Lobe,
-    /// By the irradiance's rule alone, as every other record.
-    Irradiance,
-}
-
-/// How often a cache frame splats its records (docs/cache-frame.md §6.5).
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Splat {
-    /// Once per frame at the pixel centres; the other sub-frames interpolate each sample's
-    /// cached light between the nearest centres that match it (default).
-    Once,
-    /// At every sub-frame's own samples (one splat and one hole-filling pass per sub-frame).
-    PerSubFrame,
-}
-
-/// Whether the gathers of new records share a radiance grid (docs/cache-frame.md §4.1).
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PathGridArg {
-    /// Where every material is Lambertian, a gather path ends at a vertex whose grid cell holds
-    /// enough continuations with their mean (default).
-    On,
-    /// Every gather path continues to its end.
-    Off,
-}
-
 /// Whether the fine strata fall off below the first level that takes them
 /// (docs/irradiance-cache.md §2.8).
 #[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -115,15 +36,6 @@ pub enum StrataFalloffArg {
     On,
     /// Every level from the first takes them whole (draft's and high's).
     Off,
-}
-
-/// Whose paths a pixel's specular lobe takes its indirect light from (docs/materials.md §10).
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SpecularPathsArg {
-    /// Its own and those of its 3×3 neighbours whose lobes overlap its own (default).
-    Pooled,
-    /// Its own alone.
-    PerPixel,
 }
 
 /// What adaptive anti-aliasing's added sub-frames shade (docs/cache-frame.md §7.1, §7.2).
@@ -205,31 +117,50 @@ pub struct IcArgs {
     /// Direct-lighting samples per pixel and sub-frame (`--method ic`; one ray each); default 16.
     #[arg(long)]
     pub direct_samples: Option<u32>,
-    /// Where a constant environment's light (a sky) enters the frame (`--method ic`).
-    #[arg(long, value_enum, default_value_t = Sky::Records)]
-    pub sky: Sky,
-    /// How the direct pass estimates the light of emissive triangles (`--method ic`).
-    #[arg(long, value_enum, default_value_t = Emitters::Analytic)]
-    pub emitters: Emitters,
-    /// How many shadow rays the closed-form emitters cast after the first sub-frame
-    /// (`--method ic`, `--emitters analytic`).
-    #[arg(long, value_enum, default_value_t = EmitterShadowsArg::Adaptive)]
-    pub emitter_shadows: EmitterShadowsArg,
-    /// Where glossy lobes take their indirect light from (`--method ic`).
-    #[arg(long, value_enum, default_value_t = Glossy::Records)]
-    pub glossy: Glossy,
-    /// How records for glossy lobes from the cache are spaced (`--method ic`).
-    #[arg(long, value_enum, default_value_t = GlossySpacingArg::Lobe)]
-    pub glossy_spacing: GlossySpacingArg,
-    /// How often the records are splatted (`--method ic`).
-    #[arg(long, value_enum, default_value_t = Splat::Once)]
-    pub splat: Splat,
-    /// Whether the records' gather paths share a radiance grid (`--method ic`).
-    #[arg(long, value_enum, default_value_t = PathGridArg::On)]
-    pub path_grid: PathGridArg,
-    /// Whose paths a pixel's specular lobe takes its indirect light from (`--method ic`).
-    #[arg(long, value_enum, default_value_t = SpecularPathsArg::Pooled)]
-    pub specular_paths: SpecularPathsArg,
+    /// A technique switch, `KEY=VALUE` (repeatable; `--set help` lists every key with its
+    /// values and default).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+}
+
+/// `radcache render --set help`: every technique switch with its values, default and one line.
+pub fn set_help_text() -> String {
+    let mut s = String::from(
+        "Technique switches of the cache (`--set KEY=VALUE`, repeatable; the default first):\n",
+    );
+    for t in IcSettings::technique_help() {
+        let others: Vec<&str> = t
+            .values
+            .iter()
+            .copied()
+            .filter(|v| *v != t.default)
+            .collect();
+        s.push_str(&format!(
+            "  {:<16} {} (or {}): {}\n",
+            t.key,
+            t.default,
+            others.join(", "),
+            t.help
+        ));
+    }
+    s
+}
+
+/// The error for a technique flag that `--set` replaced (`--sky direct` is now
+/// `--set sky=direct`), if `args` holds one.
+pub fn removed_flag(args: &[String]) -> Option<String> {
+    args.iter().find_map(|arg| {
+        let flag = arg.split_once('=').map_or(arg.as_str(), |(f, _)| f);
+        IcSettings::TECHNIQUES
+            .iter()
+            .find(|key| flag == format!("--{}", key.replace('_', "-")))
+            .map(|key| {
+                format!(
+                    "`{flag}` was replaced by `--set {key}=VALUE` (`radcache render --set help` \
+                     lists the switches)"
+                )
+            })
+    })
 }
 
 fn pair<T: std::str::FromStr>(text: &str, sep: char, flag: &str) -> Result<(T, T)> {
@@ -276,69 +207,70 @@ impl IcArgs {
         }))
     }
 
-    /// How the emitters' direct light is estimated.
-    pub fn emitter_light(&self) -> EmitterLight {
-        match self.emitters {
-            Emitters::Analytic => EmitterLight::Analytic,
-            Emitters::Sampled => EmitterLight::Sampled,
-        }
+    /// Whether `--set help` was asked for.
+    pub fn set_help(&self) -> bool {
+        self.set.iter().any(|s| s == "help")
     }
 
-    /// How many shadow rays the closed-form emitters cast after the first sub-frame.
-    pub fn emitter_shadows(&self) -> EmitterShadows {
-        match self.emitter_shadows {
-            EmitterShadowsArg::Adaptive => EmitterShadows::Adaptive,
-            EmitterShadowsArg::Fixed => EmitterShadows::Fixed,
+    /// Applies every `--set KEY=VALUE` to `settings`, in order (a later one wins).
+    pub fn apply_sets(&self, settings: &mut IcSettings) -> Result<()> {
+        for text in &self.set {
+            let (key, value) = text
+                .split_once('=')
+                .with_context(|| format!("--set {text:?}: expected KEY=VALUE (`--set help`)"))?;
+            settings
+                .set_technique(key.trim(), value.trim())
+                .map_err(|e| anyhow::anyhow!("--set {text}: {e}"))?;
         }
+        Ok(())
     }
 
-    /// Where glossy lobes' indirect light comes from.
-    pub fn glossy_light(&self) -> GlossyLight {
-        match self.glossy {
-            Glossy::Records => GlossyLight::Records,
-            Glossy::RecordsNoGradients => GlossyLight::RecordsWithoutGradients,
-            Glossy::Paths => GlossyLight::Paths,
+    /// The cache options as command-line arguments that give the same configuration: the
+    /// quality, every override given, and every technique switch of `settings` (the resolved
+    /// ones) as `--set`.
+    pub fn config_args(&self, settings: &IcSettings) -> Vec<String> {
+        fn name<T: ValueEnum>(v: T) -> String {
+            v.to_possible_value()
+                .map_or_else(String::new, |p| p.get_name().to_string())
         }
-    }
-
-    /// How often the records are splatted.
-    pub fn splat_mode(&self) -> SplatMode {
-        match self.splat {
-            Splat::Once => SplatMode::Once,
-            Splat::PerSubFrame => SplatMode::PerSubFrame,
+        let mut out = vec!["--quality".to_string(), name(self.quality)];
+        let mut push = |flag: &str, value: Option<String>| {
+            if let Some(v) = value {
+                out.push(flag.to_string());
+                out.push(v);
+            }
+        };
+        push("--weight", self.weight.map(name));
+        push("--error-control", self.error_control.map(name));
+        push("--accuracy", self.accuracy.map(|v| v.to_string()));
+        push("--strata", self.strata.clone());
+        push("--fine-strata", self.fine_strata.clone());
+        push("--strata-falloff", self.strata_falloff.map(name));
+        push("--spacing", self.spacing.clone());
+        push(
+            "--hole-threshold",
+            self.hole_threshold.map(|v| v.to_string()),
+        );
+        push(
+            "--temporal-accuracy",
+            self.temporal_accuracy.map(|v| v.to_string()),
+        );
+        push("--max-age", self.max_age.map(|v| v.to_string()));
+        push("--sub-frames", self.sub_frames.map(|v| v.to_string()));
+        push("--aa-target", self.aa_target.map(|v| v.to_string()));
+        push(
+            "--max-sub-frames",
+            self.max_sub_frames.map(|v| v.to_string()),
+        );
+        push("--aa-scope", Some(name(self.aa_scope)));
+        push(
+            "--direct-samples",
+            self.direct_samples.map(|v| v.to_string()),
+        );
+        for (key, value) in settings.techniques() {
+            push("--set", Some(format!("{key}={value}")));
         }
-    }
-
-    /// Whether the gathers share a radiance grid.
-    pub fn path_grid_mode(&self) -> PathGridMode {
-        match self.path_grid {
-            PathGridArg::On => PathGridMode::On,
-            PathGridArg::Off => PathGridMode::Off,
-        }
-    }
-
-    /// Whose paths the specular lobes take.
-    pub fn specular_paths(&self) -> SpecularPaths {
-        match self.specular_paths {
-            SpecularPathsArg::Pooled => SpecularPaths::Pooled,
-            SpecularPathsArg::PerPixel => SpecularPaths::PerPixel,
-        }
-    }
-
-    /// How records for glossy lobes are spaced.
-    pub fn glossy_spacing(&self) -> GlossySpacing {
-        match self.glossy_spacing {
-            GlossySpacingArg::Lobe => GlossySpacing::Lobe,
-            GlossySpacingArg::Irradiance => GlossySpacing::Irradiance,
-        }
-    }
-
-    /// Where the sky's light goes.
-    pub fn sky_light(&self) -> SkyLight {
-        match self.sky {
-            Sky::Records => SkyLight::Records,
-            Sky::Direct => SkyLight::Direct,
-        }
+        out
     }
 
     /// The cache parameters: the preset with the overrides applied, checked.

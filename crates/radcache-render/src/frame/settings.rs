@@ -10,6 +10,8 @@ use std::collections::BTreeMap;
 
 use radcache_cache::{IcParams, Preset};
 
+use crate::technique::Technique;
+
 pub use crate::technique::{
     EmitterLight, EmitterShadows, GlossyLight, GlossySpacing, PathGridMode, SkyLight,
     SpecularPaths, SplatMode,
@@ -24,6 +26,7 @@ macro_rules! settings_struct {
         $(#[$meta:meta])*
         pub struct $name:ident {
             config { $( $(#[$cmeta:meta])* $cfield:ident : $cty:ty, )* }
+            techniques { $( $(#[$tmeta:meta])* $tfield:ident : $tty:ty, )* }
             per_frame { $( $(#[$fmeta:meta])* $ffield:ident : $fty:ty, )* }
         }
     ) => {
@@ -31,12 +34,18 @@ macro_rules! settings_struct {
         #[derive(Debug, Clone, PartialEq)]
         pub struct $name {
             $( $(#[$cmeta])* pub $cfield: $cty, )*
+            $( $(#[$tmeta])* pub $tfield: $tty, )*
             $( $(#[$fmeta])* pub $ffield: $fty, )*
         }
 
         impl $name {
-            /// The fields that make the renderer: fixed for its lifetime.
-            pub const CONFIG_FIELDS: &'static [&'static str] = &[$(stringify!($cfield)),*];
+            /// The fields that make the renderer (the technique switches among them): fixed for
+            /// its lifetime.
+            pub const CONFIG_FIELDS: &'static [&'static str] =
+                &[$(stringify!($cfield),)* $(stringify!($tfield)),*];
+            /// The technique switches: `config` fields that `radcache render --set KEY=VALUE`
+            /// sets by their field name ([`Technique`]).
+            pub const TECHNIQUES: &'static [&'static str] = &[$(stringify!($tfield)),*];
             /// The fields that may change from frame to frame.
             pub const FRAME_FIELDS: &'static [&'static str] = &[$(stringify!($ffield)),*];
 
@@ -52,10 +61,80 @@ macro_rules! settings_struct {
                         });
                     }
                 )*
+                $(
+                    if self.$tfield != made_with.$tfield {
+                        return Some(ConfigChange {
+                            field: stringify!($tfield),
+                            made_with: made_with.$tfield.name().to_string(),
+                            requested: self.$tfield.name().to_string(),
+                        });
+                    }
+                )*
                 None
+            }
+
+            /// Sets the technique switch `key` to the value named `value`; the error names
+            /// the keys or the values there are.
+            pub fn set_technique(&mut self, key: &str, value: &str) -> Result<(), String> {
+                $(
+                    if key == stringify!($tfield) {
+                        return match <$tty as Technique>::parse(value) {
+                            Some(v) => {
+                                self.$tfield = v;
+                                Ok(())
+                            }
+                            None => Err(format!(
+                                "`{key}` has no value `{value}`: one of {}",
+                                names(<$tty as Technique>::VALUES)
+                            )),
+                        };
+                    }
+                )*
+                Err(format!(
+                    "no technique switch `{key}`: one of {}",
+                    Self::TECHNIQUES.join(", ")
+                ))
+            }
+
+            /// Every technique switch with the name of its value in `self`.
+            pub fn techniques(&self) -> Vec<(&'static str, &'static str)> {
+                vec![$((stringify!($tfield), self.$tfield.name())),*]
+            }
+
+            /// Every technique switch: its key, one line on what it chooses, its default and
+            /// its values.
+            pub fn technique_help() -> Vec<TechniqueHelp> {
+                vec![$(TechniqueHelp {
+                    key: stringify!($tfield),
+                    help: <$tty as Technique>::HELP,
+                    default: <$tty>::default().name(),
+                    values: <$tty as Technique>::VALUES.iter().map(|&(n, _)| n).collect(),
+                }),*]
             }
         }
     };
+}
+
+/// The names of `values`, comma-separated.
+fn names<T>(values: &[(&'static str, T)]) -> String {
+    values
+        .iter()
+        .map(|(n, _)| *n)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// One technique switch for `radcache render --set help` ([`IcSettings::technique_help`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TechniqueHelp {
+    /// The key (the `IcSettings` field).
+    pub key: &'static str,
+    /// One line on what it chooses.
+    pub help: &'static str,
+    /// The default value's name.
+    pub default: &'static str,
+    /// Every value's name.
+    pub values: Vec<&'static str>,
 }
 
 /// A `config` field of [`IcSettings`] that a frame asked to change ([`IcSettings::config_change`]).
@@ -81,11 +160,14 @@ impl std::fmt::Display for ConfigChange {
 }
 
 settings_struct! {
-    /// Settings of one frame rendered with the cache. Those under `config` make the renderer
-    /// ([`crate::IcRenderer::new`] builds its passes, shader variants and buffers from them) and
-    /// cannot change between its frames: a frame asking for another value is refused with an
-    /// error naming the field ([`IcSettings::config_change`]). Those under `per_frame` may
-    /// differ from frame to frame.
+    /// Settings of one frame rendered with the cache. Those under `config` and `techniques`
+    /// make the renderer ([`crate::IcRenderer::new`] builds its passes, shader variants and
+    /// buffers from them) and cannot change between its frames: a frame asking for another
+    /// value is refused with an error naming the field ([`IcSettings::config_change`]). The
+    /// `techniques` are the switches `radcache render --set KEY=VALUE` sets by field name
+    /// ([`IcSettings::set_technique`]; a new one is an enum in `technique.rs` with its
+    /// [`Technique`] names, a field here, and the pass that uses it). Those under `per_frame`
+    /// may differ from frame to frame.
     pub struct IcSettings {
         config {
             /// Image width in pixels.
@@ -105,6 +187,12 @@ settings_struct! {
             /// and lifespans (`crate::passes::temporal`). 0 (the default) for a single frame or a scene whose
             /// lighting does not change.
             time_step_s: f32,
+            /// Adaptive anti-aliasing ([`AntiAliasing`]): more sub-frames after the first `sub_frames`
+            /// until the image's sampling error is estimated small enough. `None` (the default) shades
+            /// exactly `sub_frames`.
+            anti_aliasing: Option<AntiAliasing>,
+        }
+        techniques {
             /// Where a constant environment's light (a sky) enters the frame: through the records
             /// (the default) or the direct pass.
             sky: SkyLight,
@@ -117,10 +205,6 @@ settings_struct! {
             glossy: GlossyLight,
             /// How records for glossy lobes from the cache are spaced.
             glossy_spacing: GlossySpacing,
-            /// Adaptive anti-aliasing ([`AntiAliasing`]): more sub-frames after the first `sub_frames`
-            /// until the image's sampling error is estimated small enough. `None` (the default) shades
-            /// exactly `sub_frames`.
-            anti_aliasing: Option<AntiAliasing>,
             /// How often the records are splatted: once per frame (the default) or at every
             /// sub-frame.
             splat: SplatMode,

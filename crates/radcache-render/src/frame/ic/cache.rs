@@ -68,7 +68,7 @@ impl IcRenderer {
         }
         if cache.sky != self.sky_in_records {
             return Err(Error::Invalid(format!(
-                "the cache's records {} the sky's light, the renderer's {} (`--sky {}`)",
+                "the cache's records {} the sky's light, the renderer's {} (`--set sky={}`)",
                 if cache.sky { "hold" } else { "do not hold" },
                 if self.sky_in_records {
                     "must"
