@@ -70,6 +70,10 @@ pub struct ConvergenceArgs {
     /// Scene time of frame 1 (default: the animation's first key, else 0).
     #[arg(long)]
     start_time: Option<f32>,
+    /// A technique switch of every cache point, `KEY=VALUE` as `radcache render --set`
+    /// (repeatable; a ladder's own choice, the glossy ladder's, comes after it).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
     /// No progress lines.
     #[arg(long, short)]
     quiet: bool,
@@ -114,6 +118,8 @@ pub fn run(args: &ConvergenceArgs) -> Result<ExitCode> {
     if max_spp == 0 || !max_spp.is_power_of_two() {
         bail!("--max-spp must be a power of two (1, 2, 4, …), got {max_spp}");
     }
+    // The switches are checked before anything is rendered.
+    crate::args::ic::apply_sets(&args.set, &mut radcache_render::IcSettings::default())?;
     if args.reference_spp == 0 {
         bail!("--reference-spp must be at least 1");
     }
@@ -174,6 +180,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<ExitCode> {
         size,
         frame,
         time,
+        sets: &args.set,
     };
     let say = |text: String| {
         if !args.quiet {

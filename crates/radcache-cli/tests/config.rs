@@ -93,6 +93,28 @@ fn bad_switches_and_removed_flags_are_one_clear_error() {
         &["no technique switch `skies`", "specular_paths"],
     );
     assert_error(&render(&["--set", "sky"]), &["--set \"sky\"", "KEY=VALUE"]);
+    // The same switches reach `convergence` and `cache build`, checked before any work.
+    let dir = fresh_dir("config", "others");
+    let out = radcache(&[
+        "convergence",
+        &scene,
+        "-o",
+        &text(&dir),
+        "--set",
+        "splat=twice",
+    ]);
+    assert_error(&out, &["--set splat=twice", "once, per-sub-frame"]);
+    let cache = text(&dir.join("c.rcache"));
+    let out = radcache(&[
+        "cache",
+        "build",
+        &scene,
+        "-o",
+        &cache,
+        "--set",
+        "glossy=mirror",
+    ]);
+    assert_error(&out, &["--set glossy=mirror", "records-no-gradients"]);
     let missing = fresh_dir("config", "missing").join("none.exr");
     assert_error(
         &render(&["--config-from", &text(&missing)]),

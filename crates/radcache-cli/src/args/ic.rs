@@ -123,6 +123,19 @@ pub struct IcArgs {
     pub set: Vec<String>,
 }
 
+/// Applies every `--set KEY=VALUE` of `sets` to `settings`, in order (a later one wins).
+pub fn apply_sets(sets: &[String], settings: &mut IcSettings) -> Result<()> {
+    for text in sets {
+        let (key, value) = text
+            .split_once('=')
+            .with_context(|| format!("--set {text:?}: expected KEY=VALUE (`--set help`)"))?;
+        settings
+            .set_technique(key.trim(), value.trim())
+            .map_err(|e| anyhow::anyhow!("--set {text}: {e}"))?;
+    }
+    Ok(())
+}
+
 /// `radcache render --set help`: every technique switch with its values, default and one line.
 pub fn set_help_text() -> String {
     let mut s = String::from(
@@ -212,17 +225,9 @@ impl IcArgs {
         self.set.iter().any(|s| s == "help")
     }
 
-    /// Applies every `--set KEY=VALUE` to `settings`, in order (a later one wins).
+    /// Applies every `--set KEY=VALUE` to `settings` ([`apply_sets`]).
     pub fn apply_sets(&self, settings: &mut IcSettings) -> Result<()> {
-        for text in &self.set {
-            let (key, value) = text
-                .split_once('=')
-                .with_context(|| format!("--set {text:?}: expected KEY=VALUE (`--set help`)"))?;
-            settings
-                .set_technique(key.trim(), value.trim())
-                .map_err(|e| anyhow::anyhow!("--set {text}: {e}"))?;
-        }
-        Ok(())
+        apply_sets(&self.set, settings)
     }
 
     /// The cache options as command-line arguments that give the same configuration: the

@@ -241,6 +241,8 @@ pub struct Bench<'a> {
     pub frame: u32,
     /// Scene time of the frame, s.
     pub time: f32,
+    /// The technique switches of every cache point (`--set KEY=VALUE`).
+    pub sets: &'a [String],
 }
 
 impl std::fmt::Debug for Bench<'_> {
@@ -270,7 +272,7 @@ impl Bench<'_> {
     /// compilation (the compiler caches by source and defines; the cache's parameters are push
     /// constants, so one warm-up covers every point).
     pub fn warm_up(&self, gpu: &mut GpuScene) -> Result<()> {
-        let ic = IcSettings {
+        let mut ic = IcSettings {
             width: 16,
             height: 16,
             params: IcParams::draft(),
@@ -279,6 +281,7 @@ impl Bench<'_> {
             time: self.time,
             ..IcSettings::default()
         };
+        crate::args::ic::apply_sets(self.sets, &mut ic)?;
         render_ic(self.ctx, self.shaders, self.scene, gpu, &ic, &mut |_| {})
             .context("warm-up frame of the cache")?;
         if self.scene.plan().radiance_cache() {
@@ -336,16 +339,17 @@ impl Bench<'_> {
 
     /// Renders and measures one cache point.
     pub fn ic(&self, gpu: &mut GpuScene, reference: &Image, case: &IcCase) -> Result<Point> {
-        let settings = IcSettings {
+        let mut settings = IcSettings {
             width: self.size.0,
             height: self.size.1,
             params: case.params,
             seed: IC_SEED,
             frame: self.frame,
             time: self.time,
-            glossy: case.glossy,
             ..IcSettings::preset(case.preset)
         };
+        crate::args::ic::apply_sets(self.sets, &mut settings)?;
+        settings.glossy = case.glossy;
         let (out, stats) = render_ic(
             self.ctx,
             self.shaders,
