@@ -261,11 +261,10 @@ Material material_at(uint m, TexCoords uv) {
 
 #ifdef HAS_ALPHA
 #include "hash.glsl"
+#include "../shared/constants.glsl"
 
-// The alpha test of a material (GpuMaterial.textures.w; crates/radcache-render/src/scene/pack.rs).
-const int ALPHA_NONE = 0;
-const int ALPHA_MASK = 1;
-const int ALPHA_BLEND = 2;
+// The alpha test of a material (GpuMaterial.textures.w; crates/radcache-render/src/scene/pack.rs):
+// ALPHA_NONE, ALPHA_MASK or ALPHA_BLEND (constants.glsl, from radcache_shared::consts).
 
 // Alpha of material `mat` at uv: base colour factor alpha × base colour texture alpha (bilinear,
 // at the base colour reference's coordinates).

@@ -26,6 +26,7 @@
 #include "../common/path.glsl"
 #include "../common/gbuffer.glsl"
 #include "../shared/push.glsl"
+#include "../shared/constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 #include "../common/dispatch.glsl"
@@ -34,32 +35,31 @@ layout(push_constant) uniform Push { DirectPush pc; };
 
 layout(binding = B_DIRECT_RAY_COUNT, std430) buffer RayCount { uint ray_count; };
 // With pc.adaptive_shadows, SHADOW_WORDS words a pixel (docs/cache-frame.md §8.2), from
-// i = SHADOW_WORDS × the pixel's index: i, what its neighbourhood saw of the emitters in this
-// frame's sub-frames so far (written at sub-frame 0, raised to a penumbra by later ones); i + 1,
-// what sub-frame 0 saw, frozen for the later sub-frames to compare with the neighbours': the
-// emitters' word (bits 0–1, SHADOW_NONE where the pixel was no surface) and the visibility of
-// punctual lights 0 … REUSED_LIGHTS − 1 (bit 2 + i set where light i's shadow ray was
-// unoccluded); i + 2, the distance from the camera of sub-frame 0's sample (its float bits),
-// which tells a later sample on another surface; with HAS_ANALYTIC_EMITTERS, i + 3, sub-frame
-// 0's shading normal (octahedral, packSnorm2x16), and i + 4 … i + 6, the emitters' unshadowed
-// irradiance there (float bits), taken again by later samples on that surface
-// (`first_unshadowed`).
+// i = SHADOW_WORDS × the pixel's index (the words' indices SHADOW_WORD_* and counts
+// SHADOW_WORDS_* come from constants.glsl, radcache_shared::consts): i + SHADOW_WORD_SEEN, what
+// its neighbourhood saw of the emitters in this frame's sub-frames so far (written at sub-frame
+// 0, raised to a penumbra by later ones); i + SHADOW_WORD_FROZEN, what sub-frame 0 saw, frozen
+// for the later sub-frames to compare with the neighbours': the emitters' word (bits 0–1,
+// SHADOW_NONE where the pixel was no surface) and the visibility of punctual lights 0 …
+// REUSED_LIGHTS − 1 (bit 2 + i set where light i's shadow ray was unoccluded);
+// i + SHADOW_WORD_DISTANCE, the distance from the camera of sub-frame 0's sample (its float
+// bits), which tells a later sample on another surface; with HAS_ANALYTIC_EMITTERS,
+// i + SHADOW_WORD_NORMAL, sub-frame 0's shading normal (octahedral, packSnorm2x16), and
+// i + SHADOW_WORD_UNSHADOWED … + 2, the emitters' unshadowed irradiance there (float bits), taken
+// again by later samples on that surface (`first_unshadowed`).
 layout(binding = B_DIRECT_SHADOWS, std430) buffer Shadows { uint shadows[]; };
 #ifdef HAS_ANALYTIC_EMITTERS
-const uint SHADOW_WORDS = 7u;
+const uint SHADOW_WORDS = SHADOW_WORDS_ANALYTIC;
 #else
-const uint SHADOW_WORDS = 3u;
+const uint SHADOW_WORDS = SHADOW_WORDS_SAMPLED;
 #endif
-// What a pixel's neighbourhood saw of the emitters (the values of the first word).
-const uint SHADOW_HIDDEN = 0u;
-const uint SHADOW_LIT = 1u;
-const uint SHADOW_PENUMBRA = 2u;
-const uint SHADOW_NONE = 3u;
+// What a pixel's neighbourhood saw of the emitters (the values of its SHADOW_WORD_SEEN word):
+// SHADOW_HIDDEN, SHADOW_LIT, SHADOW_PENUMBRA, SHADOW_NONE (radcache_shared::consts::ShadowClass).
 const uint REUSED_LIGHTS = 29u;
-// The punctual lights' bits of the frozen word, and its bit 31: sub-frame 0's samples of the
-// pixel's 3×3 neighbourhood did not all lie on the pixel's surface (no reuse at the pixel).
+// The punctual lights' bits of the frozen word, and its bit 31, SHADOW_EDGE (constants.glsl):
+// sub-frame 0's samples of the pixel's 3×3 neighbourhood did not all lie on the pixel's surface
+// (no reuse at the pixel).
 const uint PUNCTUAL_BITS = ((1u << REUSED_LIGHTS) - 1u) << 2;
-const uint SHADOW_EDGE = 1u << 31;
 
 // After sub-frame 0 (pc.adaptive_shadows): which of sub-frame 0's answers this pixel's sample
 // may take without a ray. Sub-frame 0's samples of the pixel and of its 3×3 neighbours (inside
@@ -73,7 +73,8 @@ const uint SHADOW_EDGE = 1u << 31;
 // the jitter moved onto another object; what is reused is a pixel deep inside light or shadow
 // on one surface, whose jittered samples, within half a pixel of its centre, see what nine
 // samples around them saw (a shadow finer than the pixel grid can be missed).
-// The linear index of `pixel` (its word triple in `shadows`, its sample sequences' seed).
+// The linear index of `pixel` (its SHADOW_WORDS words in `shadows` start at SHADOW_WORDS × it;
+// its sample sequences' seed).
 uint pixel_index(ivec2 pixel) {
     return uint(pixel.y) * frame.resolution.x + uint(pixel.x);
 }
@@ -138,9 +139,10 @@ Reuse shadow_reuse(GSample g, ivec2 pixel) {
         return r;
     }
     uint index = pixel_index(pixel);
-    uint own = shadows[SHADOW_WORDS * index + 1u];
+    uint base = SHADOW_WORDS * index;
+    uint own = shadows[base + SHADOW_WORD_FROZEN];
     r.frozen = own;
-    float first_distance = uintBitsToFloat(shadows[SHADOW_WORDS * index + 2u]);
+    float first_distance = uintBitsToFloat(shadows[base + SHADOW_WORD_DISTANCE]);
     r.on_first = (own & 3u) != SHADOW_NONE && same_surface_as_first(g, first_distance);
     if (!r.on_first || (own & SHADOW_EDGE) != 0u) {
         return r;
@@ -153,7 +155,7 @@ Reuse shadow_reuse(GSample g, ivec2 pixel) {
             if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(frame.resolution.xy)))) {
                 continue;
             }
-            uint n = shadows[SHADOW_WORDS * pixel_index(q) + 1u];
+            uint n = shadows[SHADOW_WORDS * pixel_index(q) + SHADOW_WORD_FROZEN];
             bool surface = (n & 3u) != SHADOW_NONE;
             r.punctual = r.punctual && surface && ((n ^ own) & PUNCTUAL_BITS) == 0u;
             r.emitters = r.emitters && surface && (n & 3u) == (own & 3u);
@@ -260,19 +262,20 @@ const float FIRST_NORMAL_COS = 0.99995;
 vec3 first_unshadowed(GSample g, uint index, vec3 origin, Reuse reuse) {
     uint base = SHADOW_WORDS * index;
     if (pc.adaptive_shadows != 0u && reuse.on_first) {
-        vec3 n = from_octahedral(unpackSnorm2x16(shadows[base + 3u]));
+        vec3 n = from_octahedral(unpackSnorm2x16(shadows[base + SHADOW_WORD_NORMAL]));
         if (dot(n, g.normal) >= FIRST_NORMAL_COS) {
-            return vec3(uintBitsToFloat(shadows[base + 4u]), uintBitsToFloat(shadows[base + 5u]),
-                        uintBitsToFloat(shadows[base + 6u]));
+            return vec3(uintBitsToFloat(shadows[base + SHADOW_WORD_UNSHADOWED]),
+                        uintBitsToFloat(shadows[base + (SHADOW_WORD_UNSHADOWED + 1u)]),
+                        uintBitsToFloat(shadows[base + (SHADOW_WORD_UNSHADOWED + 2u)]));
         }
     }
     vec3 e = analytic_emitter_irradiance(origin, g.normal);
     if (pc.adaptive_shadows != 0u && pc.sub_frame == 0u) {
         // Read by later sub-frames only (other dispatches).
-        shadows[base + 3u] = packSnorm2x16(octahedral(g.normal));
-        shadows[base + 4u] = floatBitsToUint(e.r);
-        shadows[base + 5u] = floatBitsToUint(e.g);
-        shadows[base + 6u] = floatBitsToUint(e.b);
+        shadows[base + SHADOW_WORD_NORMAL] = packSnorm2x16(octahedral(g.normal));
+        shadows[base + SHADOW_WORD_UNSHADOWED] = floatBitsToUint(e.r);
+        shadows[base + (SHADOW_WORD_UNSHADOWED + 1u)] = floatBitsToUint(e.g);
+        shadows[base + (SHADOW_WORD_UNSHADOWED + 2u)] = floatBitsToUint(e.b);
     }
     return e;
 }
@@ -320,7 +323,7 @@ PixelLight pixel_light(GSample g, ivec2 pixel) {
     // (`shadow_reuse`; docs/cache-frame.md §8.2). Sub-frame k's samples start at
     // k × n_emitters of the sequence either way.
     if (pc.adaptive_shadows != 0u && pc.sub_frame > 0u) {
-        light.seen = shadows[SHADOW_WORDS * index];
+        light.seen = shadows[SHADOW_WORDS * index + SHADOW_WORD_SEEN];
     }
     uint n_shadow = light.seen == SHADOW_PENUMBRA ? n_emitters : (reuse.emitters ? 0u : 1u);
     light.reused = n_shadow == 0u;
@@ -479,9 +482,9 @@ void main() {
         if (inside) {
             uint index = pixel_index(pixel);
             if (pc.sub_frame == 0u) {
-                shadows[SHADOW_WORDS * index] = frozen_class;
+                shadows[SHADOW_WORDS * index + SHADOW_WORD_SEEN] = frozen_class;
             } else if (mark) {
-                shadows[SHADOW_WORDS * index] = SHADOW_PENUMBRA;
+                shadows[SHADOW_WORDS * index + SHADOW_WORD_SEEN] = SHADOW_PENUMBRA;
             }
         }
     }
@@ -492,8 +495,9 @@ void main() {
         bool classed = g.surface && light.closed_form;
         uint index = pixel_index(pixel);
         uint edge = classed && !neighbourhood_on_one_surface(g, pixel) ? SHADOW_EDGE : 0u;
-        shadows[SHADOW_WORDS * index + 1u] = classed ? frozen_class | light.punctual_seen | edge : SHADOW_NONE;
-        shadows[SHADOW_WORDS * index + 2u] = floatBitsToUint(length(frame.camera_position.xyz - g.position));
+        uint base = SHADOW_WORDS * index;
+        shadows[base + SHADOW_WORD_FROZEN] = classed ? frozen_class | light.punctual_seen | edge : SHADOW_NONE;
+        shadows[base + SHADOW_WORD_DISTANCE] = floatBitsToUint(length(frame.camera_position.xyz - g.position));
     }
     if (!inside) {
         return;

@@ -107,4 +107,22 @@ const uint SH_TWIN_GLOSSY = 1u;
 const uint SH_TWIN_WEIGHTS = 2u;
 const uint SH_TWIN_BASIS_ONE = 3u;
 
+const int ALPHA_NONE = 0;
+const int ALPHA_MASK = 1;
+const int ALPHA_BLEND = 2;
+
+const uint SHADOW_WORD_SEEN = 0u;
+const uint SHADOW_WORD_FROZEN = 1u;
+const uint SHADOW_WORD_DISTANCE = 2u;
+const uint SHADOW_WORD_NORMAL = 3u;
+const uint SHADOW_WORD_UNSHADOWED = 4u;
+const uint SHADOW_WORDS_ANALYTIC = 7u;
+const uint SHADOW_WORDS_SAMPLED = 3u;
+const uint SHADOW_EDGE = 2147483648u;
+
+const uint SHADOW_HIDDEN = 0u;
+const uint SHADOW_LIT = 1u;
+const uint SHADOW_PENUMBRA = 2u;
+const uint SHADOW_NONE = 3u;
+
 #endif

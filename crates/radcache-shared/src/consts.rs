@@ -291,6 +291,73 @@ gpu_consts! {
     pub const GLOSSY_ROUGHNESS_MIN: f32 = 0.6;
 }
 
+gpu_consts! {
+    /// The alpha tests of a material, `GpuMaterial::textures.w` (an `ivec4`, hence `int`;
+    /// `radcache-render`'s `scene/pack.rs` writes them, `shaders/common/scene.glsl` reads them).
+    fn scene_glsl;
+    /// No alpha test: every point is there (opaque, or an untextured alpha that keeps every point).
+    pub const ALPHA_NONE: i32 = 0;
+    /// glTF `MASK`: a point is there when its alpha is at least the material's cutoff.
+    pub const ALPHA_MASK: i32 = 1;
+    /// glTF `BLEND`: a point is there with probability alpha (a hashed uniform number below it).
+    pub const ALPHA_BLEND: i32 = 2;
+}
+
+gpu_consts! {
+    /// The words of the direct pass's adaptive shadow buffer (`shaders/passes/direct.comp`,
+    /// docs/cache-frame.md §8.2): `SHADOW_WORDS_ANALYTIC` words a pixel with emitters in closed
+    /// form (`HAS_ANALYTIC_EMITTERS`), `SHADOW_WORDS_SAMPLED` without, from word
+    /// `SHADOW_WORDS × the pixel's index`; `SHADOW_WORD_*` is a word's index within a pixel's.
+    fn direct_shadows_glsl;
+    /// What the pixel's neighbourhood saw of the emitters in this frame's sub-frames so far (a
+    /// [`ShadowClass`]; written at sub-frame 0, raised to a penumbra by later ones).
+    pub const SHADOW_WORD_SEEN: u32 = 0;
+    /// What sub-frame 0 saw, frozen for the later sub-frames to compare with the neighbours':
+    /// the emitters' [`ShadowClass`] (bits 0–1, `SHADOW_NONE` where the pixel was no surface),
+    /// the visibility of the reused punctual lights (bit 2 + i set where light i's shadow ray was
+    /// unoccluded) and [`SHADOW_EDGE`].
+    pub const SHADOW_WORD_FROZEN: u32 = 1;
+    /// The distance from the camera of sub-frame 0's sample (its float bits), which tells a later
+    /// sample on another surface.
+    pub const SHADOW_WORD_DISTANCE: u32 = 2;
+    /// With emitters in closed form: sub-frame 0's shading normal (octahedral, `packSnorm2x16`).
+    pub const SHADOW_WORD_NORMAL: u32 = 3;
+    /// With emitters in closed form: the first of three words (r, g, b; float bits) holding the
+    /// emitters' unshadowed irradiance at sub-frame 0's sample, taken again by later samples on
+    /// that surface.
+    pub const SHADOW_WORD_UNSHADOWED: u32 = 4;
+    /// Words a pixel with emitters in closed form: up to the unshadowed irradiance's three.
+    pub const SHADOW_WORDS_ANALYTIC: u32 = 7;
+    /// Words a pixel without emitters in closed form: up to the distance.
+    pub const SHADOW_WORDS_SAMPLED: u32 = 3;
+    /// Bit 31 of the frozen word: sub-frame 0's samples of the pixel's 3×3 neighbourhood did not
+    /// all lie on the pixel's surface (no reuse at the pixel).
+    pub const SHADOW_EDGE: u32 = 1 << 31;
+}
+
+const _: () = assert!(SHADOW_WORDS_SAMPLED == SHADOW_WORD_DISTANCE + 1);
+const _: () = assert!(SHADOW_WORDS_ANALYTIC == SHADOW_WORD_UNSHADOWED + 3);
+const _: () = assert!(SHADOW_WORD_NORMAL >= SHADOW_WORDS_SAMPLED);
+
+gpu_enum! {
+    /// What a pixel's neighbourhood saw of the emitters in the direct pass's adaptive shadows
+    /// (`shaders/passes/direct.comp`): the values of a pixel's [`SHADOW_WORD_SEEN`] and of bits
+    /// 0–1 of its [`SHADOW_WORD_FROZEN`].
+    pub enum ShadowClass("SHADOW") {
+        /// Every emitter sample was occluded.
+        Hidden = 0,
+        /// Every emitter sample was unoccluded.
+        Lit = 1,
+        /// Some were and some were not (or unknown): every sample is kept.
+        Penumbra = 2,
+        /// No class: the pixel held no surface (or its emitters are sampled in its MIS).
+        None = 3,
+    }
+}
+
+// The classes fit bits 0–1 of the frozen word.
+const _: () = assert!(ShadowClass::None as u32 <= 3);
+
 gpu_enum! {
     /// The steps of the cache's counter bookkeeping (`shaders/passes/ic_counters.comp`).
     pub enum CounterStep("COUNTERS") {
@@ -413,6 +480,9 @@ pub fn generated_glsl() -> String {
         BrdfTwinMode::glsl(),
         glossy_glsl(),
         ShTwinMode::glsl(),
+        scene_glsl(),
+        direct_shadows_glsl(),
+        ShadowClass::glsl(),
     ] {
         s.push_str(&part);
         s.push('\n');

@@ -55,7 +55,7 @@ gpu_struct! {
         /// Emitted radiance (rgb, factor × strength) and double-sidedness (w: 1 or 0).
         pub emission: [f32; 4] => "vec4",
         /// Texture indices: base colour, emissive, metallic-roughness (−1 for none); the alpha
-        /// test (w): 0 none (opaque), 1 MASK, 2 BLEND (`ALPHA_*` in shaders/common/scene.glsl).
+        /// test (w): 0 none (opaque), 1 MASK, 2 BLEND (`ALPHA_*` in `radcache_shared::consts`).
         pub textures: [i32; 4] => "ivec4",
         /// Metallic, roughness, luminance of the mean emitted radiance (texture mean included; the
         /// emitter sampling table is built from it, so light-sampling pdfs use it), index of

@@ -292,7 +292,7 @@ impl DirectPass {
 
     /// Gives a pass whose emitters' light is in closed form, or whose scene has punctual
     /// lights, spend its shadow rays where they are needed ([`crate::EmitterShadows::Adaptive`]),
-    /// for images of `pixels` pixels (12 bytes each, 28 with emitters in closed form): sub-frame
+    /// for images of `pixels` pixels ([`DirectPass::shadow_bytes`] each): sub-frame
     /// 0 casts every pixel's rays (a quarter of the samples toward the emitters, one per
     /// punctual light) and stores what its 3×3 neighbourhood saw of the emitters (lit, hidden,
     /// or a penumbra, dilated by the neighbourhood), what it saw of each punctual light, whether
@@ -320,13 +320,16 @@ impl DirectPass {
     }
 
     /// Bytes a pixel of the adaptive shadows' buffer: `SHADOW_WORDS` words of `direct.comp`,
-    /// seven with emitters in closed form, three without.
+    /// [`radcache_shared::consts::SHADOW_WORDS_ANALYTIC`] with emitters in closed form,
+    /// [`radcache_shared::consts::SHADOW_WORDS_SAMPLED`] without.
     fn shadow_bytes(&self) -> u64 {
-        if self.analytic {
-            28
+        use radcache_shared::consts::{SHADOW_WORDS_ANALYTIC, SHADOW_WORDS_SAMPLED};
+        let words = if self.analytic {
+            SHADOW_WORDS_ANALYTIC
         } else {
-            12
-        }
+            SHADOW_WORDS_SAMPLED
+        };
+        4 * u64::from(words)
     }
 
     /// Records `inputs.samples` estimates per pixel for sub-frame `inputs.sub_frame` of the

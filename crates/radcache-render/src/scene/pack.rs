@@ -2,6 +2,7 @@
 
 use glam::Vec3;
 use radcache_scene::{AlphaMode, Material, Scene, TextureRef, WrapMode};
+use radcache_shared::consts::{ALPHA_BLEND, ALPHA_MASK, ALPHA_NONE};
 use radcache_shared::gpu::{GpuMaterial, GpuMesh, GpuTexture, GpuUvMap, GpuVertex};
 
 /// Geometry of every mesh in shared buffers.
@@ -70,16 +71,16 @@ pub(crate) fn pack_geometry(scene: &Scene, normal_maps: bool, texcoord1: bool) -
     }
 }
 
-/// The alpha test of `m` in `GpuMaterial::textures.w`: 0 none (every point there: opaque, or an
-/// untextured alpha that keeps every point), 1 MASK, 2 BLEND.
+/// The alpha test of `m` in `GpuMaterial::textures.w`: [`ALPHA_NONE`] (every point there:
+/// opaque, or an untextured alpha that keeps every point), [`ALPHA_MASK`] or [`ALPHA_BLEND`].
 fn alpha_test(m: &Material) -> i32 {
     if !m.has_alpha() {
-        return 0;
+        return ALPHA_NONE;
     }
     match m.alpha_mode {
-        AlphaMode::Opaque => 0,
-        AlphaMode::Mask => 1,
-        AlphaMode::Blend => 2,
+        AlphaMode::Opaque => ALPHA_NONE,
+        AlphaMode::Mask => ALPHA_MASK,
+        AlphaMode::Blend => ALPHA_BLEND,
     }
 }
 
