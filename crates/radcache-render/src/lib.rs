@@ -53,7 +53,9 @@ pub use passes::record::{
 };
 pub use passes::splat::{SplatDraw, SplatInputs, SplatOutput, SplatPass, SplatScope, SplatWeights};
 pub use passes::splat_glossy::GlossySplatPass;
-pub use passes::temporal::{expires_at, Lifespans, TemporalInputs, TemporalJob, TemporalPass};
+pub use passes::temporal::{
+    expires_at, Lifespans, TemporalInputs, TemporalJob, TemporalPass, TemporalVariant,
+};
 pub use scene::env_map::{gpu_alias, texel_solid_angle, EnvMap};
 pub use scene::upload::vulkan_clip_from_view;
 pub use scene::{GpuScene, UploadStats, REFITS_PER_REBUILD};

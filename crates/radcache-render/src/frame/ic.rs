@@ -25,7 +25,7 @@ use crate::passes::neighbours::NeighbourPass;
 use crate::passes::record::{RecordPass, RecordVariant};
 use crate::passes::splat::SplatPass;
 use crate::passes::splat_glossy::GlossySplatPass;
-use crate::passes::temporal::TemporalPass;
+use crate::passes::temporal::{TemporalPass, TemporalVariant};
 use crate::scene::GpuScene;
 use crate::state::IcState;
 
@@ -173,10 +173,12 @@ impl IcRenderer {
             emission: EmissionPass::new(ctx, shaders, gpu)?,
             state: IcState::with_radiance(ctx, shaders, capacity, w * h, radiance)?,
             temporal: if temporal {
-                let lifespans = settings.time_step_s > 0.0;
-                Some(TemporalPass::with_radiance(
-                    ctx, shaders, gpu, capacity, lifespans, radiance,
-                )?)
+                let variant = TemporalVariant {
+                    record_capacity: capacity,
+                    lifespans: settings.time_step_s > 0.0,
+                    radiance,
+                };
+                Some(TemporalPass::new(ctx, shaders, gpu, &variant)?)
             } else {
                 None
             },

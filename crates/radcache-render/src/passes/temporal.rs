@@ -202,29 +202,31 @@ pub struct Lifespans {
     pub max_age: f32,
 }
 
+/// What the temporal pass is made for: its buffers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TemporalVariant {
+    /// Records of the cache.
+    pub record_capacity: u32,
+    /// Records carry lifespans (a scene whose lighting changes): the look-ahead copy of the
+    /// records is allocated.
+    pub lifespans: bool,
+    /// With `lifespans`, the cache has radiance blocks: their look-ahead copy too.
+    pub radiance: bool,
+}
+
 impl TemporalPass {
-    /// Compiles the pass for `record_capacity` records of `scene`; the look-ahead copy of the
-    /// records is allocated only with `lifespans` (a scene whose lighting changes).
+    /// Compiles the pass for `scene` and allocates its buffers for `variant`.
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
-        record_capacity: u32,
-        lifespans: bool,
+        variant: &TemporalVariant,
     ) -> Result<TemporalPass> {
-        Self::with_radiance(ctx, shaders, scene, record_capacity, lifespans, false)
-    }
-
-    /// As [`TemporalPass::new`]; with `lifespans` and `radiance` (the cache has radiance
-    /// blocks) also the look-ahead copy of the blocks.
-    pub fn with_radiance(
-        ctx: &Context,
-        shaders: &ShaderCompiler,
-        scene: &GpuScene,
-        record_capacity: u32,
-        lifespans: bool,
-        radiance: bool,
-    ) -> Result<TemporalPass> {
+        let TemporalVariant {
+            record_capacity,
+            lifespans,
+            radiance,
+        } = *variant;
         let spirv = shaders.compile("passes/temporal.comp", &scene.defines())?;
         let pipeline = Pipeline::compute(
             ctx,

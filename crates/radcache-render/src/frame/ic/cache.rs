@@ -10,7 +10,7 @@ use radcache_vk::{Context, ShaderCompiler};
 
 use super::IcRenderer;
 use crate::error::{Error, Result};
-use crate::passes::temporal::TemporalPass;
+use crate::passes::temporal::{TemporalPass, TemporalVariant};
 use crate::scene::GpuScene;
 
 impl IcRenderer {
@@ -87,10 +87,12 @@ impl IcRenderer {
         }
         let radiance = self.glossy.is_some();
         if self.temporal.is_none() {
-            let capacity = self.state.record_capacity();
-            self.temporal = Some(TemporalPass::with_radiance(
-                ctx, shaders, gpu, capacity, false, radiance,
-            )?);
+            let variant = TemporalVariant {
+                record_capacity: self.state.record_capacity(),
+                lifespans: false,
+                radiance,
+            };
+            self.temporal = Some(TemporalPass::new(ctx, shaders, gpu, &variant)?);
         }
         let marks: Vec<u32> = cache
             .last_used
