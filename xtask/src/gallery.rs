@@ -2,7 +2,7 @@
 //! in the repository) rendered with the irradiance cache under a uniform environment, each next to
 //! its path-traced reference, with the cache frame's error against it; the frames are tiled into
 //! `docs/gallery.png` (a contact sheet: per model, the cache frame then the reference) for the
-//! README.
+//! design notes (docs/design.md).
 //!
 //! Options: `--size N` (square images, default 192), `--spp N` (reference samples per pixel,
 //! default 1024), `--models a,b` (default: every model below that exists), `--out FILE`.

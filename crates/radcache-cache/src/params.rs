@@ -19,77 +19,19 @@
 //! | `temporal_accuracy` (`a_t`) | 0.1 | 0.05 | 0.02 | docs/temporal.md §3.3 |
 //! | `max_age_frames` (`Δt_max`) | 8 | 30 | 15 | docs/temporal.md §3.3; draft measured (below) |
 //!
-//! Draft's `Δt_max` of 20 frames was measured with `cargo xtask bench temporal` (animated scene,
-//! 60 frames at 256²): 60 frames gave 9.3 % of a per-frame rebuild's record rays but 3.9× its
-//! image error (own relMSE 5.8e-3 against 1.5e-3: records whose first one-frame change was small
-//! lived 60 frames while the objects moved nearer); 20 gives 13.3 % and 2.9e-3. With the
-//! motion-aware expiry (a record also expires when moving objects' cover of its hemisphere changed
-//! by more than `a_t`; `temporal.comp`) 20 gives 14.4 % and 2.6e-3; draft with the default's
-//! `a_t = 0.05` and `Δt_max = 60` gave 16.3 % and 4.5e-3 (records living 60 frames go stale in
-//! ways neither their one-frame rate nor the moving cover sees). Since records take the radius of
-//! each evaluation and are listed the frame before their lifespan ends (2026-12-05), 5 frames
-//! give the per-frame rebuild's error (own relMSE 1.45e-3 against 1.46e-3, less flicker) with 26 %
-//! of its record rays and 48 % of all its rays; 8 frames 18 % and 1.54e-3; 20 frames about 2.6e-3
-//! (docs/temporal.md §5). Since kept records gather through the radiance grid kept over frames
-//! (2026-12-06, docs/temporal.md §3.8), their error is below the rebuild's and draft's `Δt_max`
-//! is 8: `cargo xtask bench temporal --max-age 5|8` gave own relMSE 8.93e-4 and 9.55e-4 against
-//! the rebuild's 1.139e-3, with 16.9 % and 11.4 % of its record rays, and kept frames of 52.8 %
-//! and 49.5 % of its time.
-//!
-//! Draft trades accuracy for speed (2.25× fewer rays at the coarse levels, bigger zones, fewer
-//! refreshes); high halves the ray noise (4× rays), shrinks zones and refreshes more often. On
-//! lavapipe (≈0.3 Mrays/s for incoherent gather rays, measured) the default's 432 rays per record
-//! is the dominant cost, so `draft` is the preset for tests and previews.
-//!
-//! The default R⁻ of 4 px (§8.2) was measured on the Cornell box at 256² against its 2048-spp
-//! reference (`tests/refs/`): 2, 3 and 4 px gave the same relMSE (2.49e-4, 2.51e-4, 2.54e-4) with
-//! 8,720, 6,544 and 5,209 records; the records clamped to R⁻ sit along edges and in corners, where
-//! the finest creation levels otherwise put one per pixel or two. `high` keeps 1.5 px for scenes
-//! with fine geometric detail.
-//!
-//! The default κ of 0.75 (§8.2; Mitsuba renders with κ = 1 × its `qualityAdjustment` 0.5 after
-//! the overture, which our coarse-to-fine creation at κ/0.7 plays the part of) was measured on
-//! 2026-12-05 against Mitsuba's 8192-spp references (`radcache render --accuracy 1/κ`, 256²,
-//! each timed on its second run): on the courtyard κ = 0.5 left the undersides of ledges and
-//! cornices 4 % too dark on average and up to 20 % in bands (zones as wide as the gradient
-//! limit `E/|∇E|` allows, over an irradiance that halves across them: the ground's sunlit and
-//! shaded patches seen from below); κ = 0.75 gave relMSE 8.13e-4 against 1.07e-3, block RMSE
-//! 2.39e-3 against 3.41e-3, FLIP 0.0278 against 0.0325, with 7,150 records against 5,284 (7.27
-//! M record rays against 5.83 M) and 10–25 % more time; κ = 1 relMSE 8.36e-4 and block RMSE
-//! 2.32e-3 with 8,505 records (8.17 M rays). Halving the gradient limit instead (R ≤
-//! E/(2|∇E|), κ = 0.5) mended the undersides with 10 % more records but gained less (9.20e-4,
-//! block 2.83e-3), and the Hessian rule at κ = 0.75 gave 8.40e-4 and 2.55e-3.
-//! On the Cornell box κ = 0.75 costs 8 % more time for 2 % less relMSE and 8 % less block RMSE
-//! (2.72 s against 2.54 s; 2.48e-4 against 2.53e-4; 1.26e-3 against 1.37e-3). The earlier
-//! default of 0.5 was chosen on the Cornell box alone (κ = 1 gave relMSE 2.14e-4 in 7.3 s, 0.75
-//! 2.16e-4 in 6.4 s, 0.5 2.31e-4 in 4.8 s, a frame three times slower than today's). `draft` keeps
-//! 0.75 too, its R⁺ of 32 px making its zones the widest.
-
-//!
-//! The default's 12×36 strata (432 rays; the course's offline 16×48 until 2026-12-05) were
-//! measured at equal wall time against Mitsuba 3 (`cargo xtask bench peer`, one run each, the
-//! ratios within each run): the relMSE ratio Mitsuba/radcache went from 11.1 to 14.4 on the
-//! Cornell box, 3.33 to 3.69 on the courtyard and 2.92 to 3.25 on `metal_spheres`; the 8×8-block
-//! RMSE ratio radcache/Mitsuba from 0.95 to 0.93 on the courtyard and 1.14 to 1.08 on
-//! `metal_spheres` (0.31 to 0.35 on the Cornell box); FLIP from 0.996 to 0.98 on the courtyard.
-//! On the Cornell box alone (`radcache render --seed 1|2`, 256²) 12×36 cut the record rays by
-//! 34 % and the frame by about 25 % for relMSE +6 % and block RMSE +9 %. Each record is noisier,
-//! but the frame is cheaper by more than its error grows (docs/cache-frame.md §7.1).
-//!
-//! The default's fine strata (§2.8) were measured at 256² against the references (`radcache
-//! render --seed S`, the Cornell box's seeds 1–3; the courtyard with the CLI's adaptive
-//! anti-aliasing): 8×24 at the levels of spacing 4, 2 and 1 px cut the courtyard's record rays
-//! from 14.1 M to 5.8 M (−59 %) for relMSE 1.426e-3 against 1.337e-3 (+7 %; block RMSE +1.5 %),
-//! and the Cornell box's by 26 % for +2–4 %. 8×24 from spacing 2 px only cut 39 % for +3 %;
-//! 4×12 from 2 px, 6×18 from 4 px and 8×24 at every level (the draft's strata) lost 17–23 %.
-//!
-//! The default's strata falloff (§2.8; 2026-12-06, once the radiance grid and adaptive
-//! anti-aliasing had made the frame's other costs smaller) was measured on the courtyard at 256²
-//! with the CLI's defaults, seeds 0, 2 and 3 (`radcache render … --seed S [--strata-falloff
-//! off]`, own relMSE net of the reference's noise): record rays −27 % (4.03 M → 2.98 M at seed
-//! 0) for own relMSE +8 to +9 % and block RMSE +1 to +4 %; on the Cornell box −7 % for +3 %.
-//! Steeper splits cost more error than they save: 6×18 already at 4 px and 4×12 at 1 px gave
-//! 2.65 M rays and +14 % (block RMSE +7 %), 4×12 at every fine level 2.01 M and +53 %.
+//! Why each default is what it is, in a sentence each (the measurements behind them, with their
+//! commands, are in `bench/history.md`, *IcParams presets*):
+//! - draft trades accuracy for speed (fewer rays, bigger zones, fewer refreshes) and is the
+//!   preset of tests and previews: on lavapipe the rays per record are the dominant cost;
+//! - the default R⁻ of 4 px gave the Cornell box the relMSE of 2 px with 40 % fewer records;
+//! - the default κ of 0.75 mends the too-dark bands that κ = 0.5's wide zones leave under the
+//!   courtyard's ledges (relMSE −24 %, block RMSE −30 % for 10–25 % more time);
+//! - 12×36 strata rather than the course's 16×48 make the frame cheaper by more than its error
+//!   grows (docs/cache-frame.md §7.1), and the fine 8×24 strata at the levels no wider than R⁻
+//!   cut the courtyard's record rays by 59 % for 7 % more relMSE;
+//! - the default's strata falloff cuts another 27 % of the courtyard's record rays for 8–9 %;
+//! - draft's `Δt_max` of 8 frames keeps the kept records' error below a per-frame rebuild's
+//!   with about a ninth of its record rays (docs/temporal.md §5).
 
 use crate::radius::radius_bounds;
 use crate::weight::{coverage_threshold, validity_scale, weight_unit, WeightKind};

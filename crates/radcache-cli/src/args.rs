@@ -22,7 +22,7 @@ pub fn shader_root() -> PathBuf {
 /// Environment overrides shared by `render` and `info`.
 #[derive(Args, Debug, Clone)]
 pub struct EnvArgs {
-    /// Equirectangular EXR environment map (+Y up; see the README for the convention).
+    /// Equirectangular EXR environment map (+Y up; see docs/design.md for the convention).
     #[arg(long, value_name = "FILE.exr")]
     pub env_map: Option<PathBuf>,
     /// Constant environment radiance, linear RGB W/(sr·m²), e.g. `0.5,0.6,0.8`.

@@ -169,7 +169,7 @@ pub fn run(args: &ConvergenceArgs) -> Result<ExitCode> {
 
     let ctx = Context::new()?;
     let device = ctx.info().name.clone();
-    // Compiled shaders are kept beside the pipeline cache (README "Design notes / pipeline cache").
+    // Compiled shaders are kept beside the pipeline cache (docs/design.md, "Pipeline cache").
     let spirv_dir = radcache_vk::pipeline_cache_dir_from_env();
     let shaders = ShaderCompiler::new(shader_root())?.with_disk_cache(spirv_dir.as_deref());
     let mut gpu = GpuScene::new(&ctx, &scene, env_map.as_ref())?;

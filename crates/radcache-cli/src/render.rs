@@ -68,7 +68,7 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let size = image_size(args.resolution.as_deref(), &view)?;
 
     let ctx = Context::new()?;
-    // Compiled shaders are kept beside the pipeline cache (README "Design notes / pipeline cache").
+    // Compiled shaders are kept beside the pipeline cache (docs/design.md, "Pipeline cache").
     let spirv_dir = radcache_vk::pipeline_cache_dir_from_env();
     let shaders = ShaderCompiler::new(shader_root())?.with_disk_cache(spirv_dir.as_deref());
     let t_upload = Instant::now();

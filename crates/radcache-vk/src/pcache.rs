@@ -10,7 +10,7 @@
 //! honest on drivers whose cache is a stub: lavapipe (Mesa 25) reports `VALID` feedback but never
 //! a hit, and its `vkGetPipelineCacheData` returns only the 32-byte Vulkan header, so on lavapipe
 //! every pipeline counts as compiled from scratch, as it is (its compile cost is JIT work at the
-//! first dispatch, which Mesa's own shader disk cache persists; README "Design notes / pipeline
+//! first dispatch, which Mesa's own shader disk cache persists; docs/design.md, "Pipeline
 //! cache").
 //!
 //! **Saving.** The file is read once when the context is created and written (atomically: a

@@ -5,7 +5,7 @@
 //! GPU timestamps count from the first timestamp of each submission; the submission's span is
 //! placed at the host time just before `vkQueueSubmit` (the GPU cannot start earlier), so the
 //! two tracks line up to within the submission latency. On lavapipe, compute work that follows
-//! draws in one submission can run outside its timestamps (README, noticed issues); the host
+//! draws in one submission can run outside its timestamps (docs/design.md, "Profiling"); the host
 //! phases are exact wall times.
 
 use std::collections::BTreeMap;
