@@ -83,6 +83,21 @@ fn the_field_lists_cover_distinct_fields() {
     for &name in IcSettings::FRAME_FIELDS {
         assert_eq!(varied(&b, name).config_change(&b), None, "{name}");
     }
+    // A renderer made with adaptive anti-aliasing may shade a frame without it, or with another
+    // target (its composite has the moments); one made without may not take it on.
+    let with_aa = varied(&b, "anti_aliasing");
+    let aa = with_aa.anti_aliasing.unwrap();
+    let other_target = IcSettings {
+        anti_aliasing: Some(AntiAliasing {
+            target: aa.target * 2.0,
+            ..aa
+        }),
+        ..with_aa.clone()
+    };
+    assert_eq!(b.config_change(&with_aa), None);
+    assert_eq!(other_target.config_change(&with_aa), None);
+    let refused = with_aa.config_change(&b).unwrap();
+    assert_eq!(refused.field, "anti_aliasing");
 }
 
 #[test]

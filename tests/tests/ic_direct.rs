@@ -71,13 +71,7 @@ fn direct_light_matches_a_point_light_and_a_constant_sky() {
             (!point).then_some(sky),
         );
         let gpu = Gpu::new(&scene, None, (32, 24));
-        let direct = DirectPass::new(
-            &gpu.ctx,
-            &gpu.shaders,
-            &gpu.scene,
-            &DirectVariant::new(sky_light, EmitterLight::Sampled),
-        )
-        .unwrap();
+        let direct = direct_pass(&gpu, sky_light, EmitterLight::Sampled).unwrap();
         let in_records = sky_light == SkyLight::Records;
         let samples = 4;
         let scopes = gpu.render([0.1, 0.2], Some((&direct, samples, 7)));
@@ -139,15 +133,18 @@ fn direct_light_is_unbiased_on_the_cornell_box() {
     gpu.end();
 }
 
+/// The direct pass for `gpu`'s scene, writing the direct image.
+fn direct_pass(
+    gpu: &Gpu,
+    sky: SkyLight,
+    emitters: EmitterLight,
+) -> radcache_render::Result<DirectPass> {
+    let variant = DirectVariant::new(sky, emitters);
+    DirectPass::new(&gpu.ctx, &gpu.shaders, &gpu.scene, &variant)
+}
+
 fn direct_agrees_with_the_cpu(gpu: &Gpu, g: &GRead, cpu: &[DVec3], emitters: EmitterLight) {
-    let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
-    let direct = DirectPass::new(
-        ctx,
-        shaders,
-        &gpu.scene,
-        &DirectVariant::new(SkyLight::Direct, emitters),
-    )
-    .unwrap();
+    let direct = direct_pass(gpu, SkyLight::Direct, emitters).unwrap();
     let mut runs = Vec::new();
     for (samples, seed) in [(4, 11), (256, 12)] {
         gpu.render([0.0; 2], Some((&direct, samples, seed)));
@@ -185,15 +182,8 @@ fn closed_form_emitters_in_a_specular_scene_agree_with_sampling() {
     let gpu = Gpu::new(&scene, None, (32, 32));
     gpu.render([0.0; 2], None);
     let g = gpu.read_gbuffer();
-    let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
     let run = |emitters: EmitterLight, samples: u32, seed: u32| -> (Vec<DVec3>, u64) {
-        let direct = DirectPass::new(
-            ctx,
-            shaders,
-            &gpu.scene,
-            &DirectVariant::new(SkyLight::Direct, emitters),
-        )
-        .unwrap();
+        let direct = direct_pass(&gpu, SkyLight::Direct, emitters).unwrap();
         gpu.render([0.0; 2], Some((&direct, samples, seed)));
         let out = gpu.read(&gpu.gbuffer.direct).into_iter().map(xyz).collect();
         (out, direct.rays().unwrap())
@@ -238,14 +228,7 @@ fn direct_light_in_the_furnace_is_albedo_times_emission() {
     let gpu = Gpu::new(&scene, None, (16, 16));
     // Every direction sees an emitting wall: irradiance π·Le, direct ρ/π · π·Le = ρ·Le.
     let expected = f64::from(albedo * le);
-    let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
-    let sampled = DirectPass::new(
-        ctx,
-        shaders,
-        &gpu.scene,
-        &DirectVariant::new(SkyLight::Direct, EmitterLight::Sampled),
-    );
-    let sampled = sampled.unwrap();
+    let sampled = direct_pass(&gpu, SkyLight::Direct, EmitterLight::Sampled).unwrap();
     gpu.render([0.0; 2], Some((&sampled, 4, 3)));
     let out = gpu.read(&gpu.gbuffer.direct);
     for c in 0..3 {
@@ -261,12 +244,7 @@ fn direct_light_in_the_furnace_is_albedo_times_emission() {
     // horizon, the receiver's own wall wholly below it) sum to π, and every light sample is
     // visible, so every pixel is exact, without noise.
     assert!(scene.plan().analytic_emitters, "{:?}", scene.plan());
-    let analytic = DirectPass::new(
-        ctx,
-        shaders,
-        &gpu.scene,
-        &DirectVariant::new(SkyLight::Direct, EmitterLight::Analytic),
-    );
+    let analytic = direct_pass(&gpu, SkyLight::Direct, EmitterLight::Analytic);
     let analytic = analytic.unwrap();
     gpu.render([0.0; 2], Some((&analytic, 4, 3)));
     let position = gpu.read(&gpu.gbuffer.position);
@@ -315,13 +293,7 @@ fn composite_sums_direct_indirect_emission_and_environment() {
     let (w, h) = (40, 32);
     let gpu = Gpu::new(&scene, Some(&map), (w, h));
     let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
-    let direct = DirectPass::new(
-        ctx,
-        shaders,
-        &gpu.scene,
-        &DirectVariant::new(SkyLight::Direct, EmitterLight::Sampled),
-    )
-    .unwrap();
+    let direct = direct_pass(&gpu, SkyLight::Direct, EmitterLight::Sampled).unwrap();
     let splat = SplatPass::new(ctx, shaders, w, h).unwrap();
     let variant = CompositeVariant::new(w, h);
     let composite = CompositePass::new(ctx, shaders, &gpu.scene, &variant).unwrap();

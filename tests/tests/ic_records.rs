@@ -318,38 +318,14 @@ fn cornell_records_agree_with_an_independent_estimate() {
     )
     .unwrap();
     let c = counters(0, k, k, 64);
-    let a = run(
-        &mut f,
-        &pass_a,
-        &Batch::new(&points, &requests, c),
-        create(11, 1, 0),
-    );
-    let again = run(
-        &mut f,
-        &pass_a,
-        &Batch::new(&points, &requests, c),
-        create(11, 1, 0),
-    );
-    let b = run(
-        &mut f,
-        &pass_b,
-        &Batch::new(&points, &requests, c),
-        create(12, 3, 2),
-    );
+    let batch = Batch::new(&points, &requests, c);
+    let a = run(&mut f, &pass_a, &batch, create(11, 1, 0));
+    let again = run(&mut f, &pass_a, &batch, create(11, 1, 0));
+    let b = run(&mut f, &pass_b, &batch, create(12, 3, 2));
     // The default's coarse levels gather 12×36 strata, its first fine one (spacing ≤ R⁻) 8×24,
     // each finer one half the rays (IcParams::strata_falloff): 4×12 two levels on.
-    let coarse = run(
-        &mut f,
-        &pass_b,
-        &Batch::new(&points, &requests, c),
-        create(13, 2, 2),
-    );
-    let finest = run(
-        &mut f,
-        &pass_b,
-        &Batch::new(&points, &requests, c),
-        create(14, 5, 2),
-    );
+    let coarse = run(&mut f, &pass_b, &batch, create(13, 2, 2));
+    let finest = run(&mut f, &pass_b, &batch, create(14, 5, 2));
     assert_eq!(fine.fine_level(), 3);
     assert_eq!(fine.strata_at(2, false), (12, 36));
     assert_eq!(fine.strata_at(3, false), (8, 24));

@@ -29,7 +29,8 @@
 //! - 12×36 strata rather than the course's 16×48 make the frame cheaper by more than its error
 //!   grows (docs/cache-frame.md §7.1), and the fine 8×24 strata at the levels no wider than R⁻
 //!   cut the courtyard's record rays by 59 % for 7 % more relMSE;
-//! - the default's strata falloff cuts another 27 % of the courtyard's record rays for 8–9 %;
+//! - the default's strata falloff cuts another 27 % of the courtyard's record rays for 8–9 % more
+//!   own relMSE;
 //! - draft's `Δt_max` of 8 frames keeps the kept records' error below a per-frame rebuild's
 //!   with about a ninth of its record rays (docs/temporal.md §5).
 

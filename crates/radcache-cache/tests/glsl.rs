@@ -2,8 +2,9 @@
 //! (`docs/irradiance-cache.md`: every formula has a Rust reference in this crate and a GLSL twin of
 //! the same name):
 //! * every top-level `pub fn` of `src/` has a GLSL function of the same name and vice versa, with
-//!   the same arity once Rust's `[Vec3; 3]` arguments count as three `vec3` and tuple/struct
-//!   results as `out` parameters (value comparison on the GPU is the lead's `radcache-tests`);
+//!   the same arity once Rust's `[Vec3; 3]` arguments count as three `vec3`, a `WeightRecord` as
+//!   its three values and a `HessianCell` as its twelve, and tuple/struct results as `out`
+//!   parameters (value comparison on the GPU is the lead's `radcache-tests`);
 //! * every `pub const` scalar of the crate has the same value in GLSL;
 //! * the file compiles with `glslangValidator` (Vulkan 1.2 target; `scripts/setup.sh` installs
 //!   it with `glslang-tools`): a machine without the tool fails the test.
@@ -53,7 +54,15 @@ fn rust_arity(args: &str, ret: &str) -> usize {
         .collect();
     let mut n = args
         .iter()
-        .map(|a| if a.contains("[Vec3; 3]") { 3 } else { 1 })
+        .map(|a| {
+            if a.contains("[Vec3; 3]") || a.contains("WeightRecord") {
+                3 // three vec3, or a record's p_i, n_i, r_i
+            } else if a.contains("HessianCell") {
+                12 // the cell's vertices, luminances and flags, in order
+            } else {
+                1
+            }
+        })
         .sum::<usize>();
     let ret = ret.trim();
     if ret.starts_with('(') {

@@ -25,7 +25,7 @@ macro_rules! settings_struct {
     (
         $(#[$meta:meta])*
         pub struct $name:ident {
-            config { $( $(#[$cmeta:meta])* $cfield:ident : $cty:ty, )* }
+            config { $( $(#[$cmeta:meta])* $cfield:ident : $cty:ty $(=> $may:path)?, )* }
             techniques { $( $(#[$tmeta:meta])* $tfield:ident : $tty:ty, )* }
             per_frame { $( $(#[$fmeta:meta])* $ffield:ident : $fty:ty, )* }
         }
@@ -53,7 +53,7 @@ macro_rules! settings_struct {
             /// values as text (`made_with`'s first); `None` where every one is the same.
             pub fn config_change(&self, made_with: &$name) -> Option<ConfigChange> {
                 $(
-                    if self.$cfield != made_with.$cfield {
+                    if !settings_struct!(@may made_with.$cfield, self.$cfield $(, $may)?) {
                         return Some(ConfigChange {
                             field: stringify!($cfield),
                             made_with: format!("{:?}", made_with.$cfield),
@@ -113,6 +113,19 @@ macro_rules! settings_struct {
             }
         }
     };
+    (@may $made:expr, $asked:expr) => {
+        $made == $asked
+    };
+    (@may $made:expr, $asked:expr, $may:path) => {
+        $may(&$made, &$asked)
+    };
+}
+
+/// A renderer made with adaptive anti-aliasing (the composite sums the moments it needs) may
+/// render a frame with another target or none (a warm-up frame); one made without may not take
+/// it on.
+fn anti_aliasing_may_become(made: &Option<AntiAliasing>, asked: &Option<AntiAliasing>) -> bool {
+    made.is_some() || asked.is_none()
 }
 
 /// The names of `values`, comma-separated.
@@ -189,8 +202,9 @@ settings_struct! {
             time_step_s: f32,
             /// Adaptive anti-aliasing ([`AntiAliasing`]): more sub-frames after the first `sub_frames`
             /// until the image's sampling error is estimated small enough. `None` (the default) shades
-            /// exactly `sub_frames`.
-            anti_aliasing: Option<AntiAliasing>,
+            /// exactly `sub_frames`. A renderer made with it renders frames with another target or
+            /// none too (warm-up frames); one made without refuses it.
+            anti_aliasing: Option<AntiAliasing> => anti_aliasing_may_become,
         }
         techniques {
             /// Where a constant environment's light (a sky) enters the frame: through the records
