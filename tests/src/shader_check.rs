@@ -1,11 +1,13 @@
 //! Compiles every entry shader under `shaders/` with the run-time compiler's options and validates
-//! the SPIR-V with `spirv-val --target-env vulkan1.3`. Used by the `shaders` test and by
-//! `cargo xtask shaders`.
+//! the SPIR-V with `spirv-val --target-env vulkan1.3`, without defines and as every pass compiles
+//! them for each of its variants ([`radcache_render::passes::every_shader_module`]). Used by the
+//! `shaders` test and by `cargo xtask shaders`.
 
 use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::Command;
 
+use radcache_render::scene::features::ShaderModule;
 use radcache_vk::{ShaderCompiler, ShaderStage};
 
 /// The outcome for one shader.
@@ -77,42 +79,122 @@ pub fn has_spirv_val() -> bool {
     Command::new("spirv-val").arg("--version").output().is_ok()
 }
 
-/// Compiles and validates every entry shader under `root`; SPIR-V files go to `out_dir`.
+/// Compiles `path` with `defines`, writes the SPIR-V to `spv` and, with `validate`, checks it
+/// with `spirv-val`.
+fn check_one(
+    compiler: &ShaderCompiler,
+    path: &str,
+    defines: &[(&str, &str)],
+    spv: &Path,
+    validate: bool,
+) -> std::io::Result<ShaderCheck> {
+    let mut check = ShaderCheck {
+        path: path.to_string(),
+        error: None,
+        words: 0,
+    };
+    match compiler.compile(path, defines) {
+        Err(e) => check.error = Some(e.to_string()),
+        Ok(spirv) => {
+            check.words = spirv.len();
+            std::fs::write(spv, bytemuck::cast_slice::<u32, u8>(&spirv))?;
+            if validate {
+                let out = Command::new("spirv-val")
+                    .args(["--target-env", "vulkan1.3"])
+                    .arg(spv)
+                    .output()?;
+                if !out.status.success() {
+                    check.error = Some(format!(
+                        "spirv-val: {}{}",
+                        String::from_utf8_lossy(&out.stdout),
+                        String::from_utf8_lossy(&out.stderr)
+                    ));
+                }
+            }
+        }
+    }
+    Ok(check)
+}
+
+/// Compiles and validates every entry shader under `root` without defines; SPIR-V files go to
+/// `out_dir`.
 pub fn check_all(root: &Path, out_dir: &Path, validate: bool) -> std::io::Result<Vec<ShaderCheck>> {
     let paths = entry_shaders(root)?;
     std::fs::create_dir_all(out_dir)?;
     let compiler = ShaderCompiler::new(root).map_err(std::io::Error::other)?;
     let mut results = Vec::new();
     for path in paths {
-        let mut check = ShaderCheck {
-            path: path.clone(),
-            error: None,
-            words: 0,
-        };
-        match compiler.compile(&path, &[]) {
-            Err(e) => check.error = Some(e.to_string()),
-            Ok(spirv) => {
-                check.words = spirv.len();
-                let spv = out_dir.join(format!("{}.spv", path.replace('/', "_")));
-                std::fs::write(&spv, bytemuck::cast_slice::<u32, u8>(&spirv))?;
-                if validate {
-                    let out = Command::new("spirv-val")
-                        .args(["--target-env", "vulkan1.3"])
-                        .arg(&spv)
-                        .output()?;
-                    if !out.status.success() {
-                        check.error = Some(format!(
-                            "spirv-val: {}{}",
-                            String::from_utf8_lossy(&out.stdout),
-                            String::from_utf8_lossy(&out.stderr)
-                        ));
-                    }
-                }
-            }
-        }
-        results.push(check);
+        let spv = out_dir.join(format!("{}.spv", path.replace('/', "_")));
+        results.push(check_one(&compiler, &path, &[], &spv, validate)?);
     }
     Ok(results)
+}
+
+/// The name a module goes by in reports: its path and defines (`passes/direct.comp
+/// [HAS_SPECULAR DIRECT_COMPOSITE]`).
+pub fn module_name(module: &ShaderModule) -> String {
+    let defines: Vec<String> = module
+        .defines
+        .iter()
+        .map(|&(d, v)| {
+            if v == "1" {
+                d.to_string()
+            } else {
+                format!("{d}={v}")
+            }
+        })
+        .collect();
+    format!("{} [{}]", module.path, defines.join(" "))
+}
+
+/// Compiles and validates every module of `modules` (shaders under `root` with their defines)
+/// on as many threads as the machine has cores, calling `progress` after each; SPIR-V files go
+/// to `out_dir`, numbered in order. The results are in the order of `modules`, each one's path
+/// its [`module_name`].
+pub fn check_modules(
+    root: &Path,
+    out_dir: &Path,
+    validate: bool,
+    modules: &[ShaderModule],
+    progress: impl Fn(&ShaderCheck) + Sync,
+) -> std::io::Result<Vec<ShaderCheck>> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Mutex;
+
+    std::fs::create_dir_all(out_dir)?;
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let next = AtomicUsize::new(0);
+    let done: Mutex<Vec<Option<ShaderCheck>>> = Mutex::new(vec![None; modules.len()]);
+    let work = || -> std::io::Result<()> {
+        let compiler = ShaderCompiler::new(root).map_err(std::io::Error::other)?;
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            let Some(module) = modules.get(i) else {
+                return Ok(());
+            };
+            let stem = module.path.replace('/', "_");
+            let spv = out_dir.join(format!("{stem}.{i:03}.spv"));
+            let mut check = check_one(&compiler, module.path, &module.defines, &spv, validate)?;
+            check.path = module_name(module);
+            progress(&check);
+            done.lock().unwrap_or_else(|p| p.into_inner())[i] = Some(check);
+        }
+    };
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..workers.min(modules.len()))
+            .map(|_| scope.spawn(work))
+            .collect();
+        handles.into_iter().try_for_each(|h| {
+            h.join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+        })
+    })?;
+    Ok(done
+        .into_inner()
+        .unwrap_or_else(|p| p.into_inner())
+        .into_iter()
+        .flatten()
+        .collect())
 }
 
 #[cfg(test)]

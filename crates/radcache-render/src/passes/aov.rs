@@ -8,6 +8,7 @@ use radcache_vk::{
 
 use crate::bindings::aov as b;
 use crate::error::Result;
+use crate::scene::features::{SceneFeatures, ShaderModule};
 use crate::scene::GpuScene;
 
 /// The shader, relative to `shaders/`.
@@ -44,6 +45,11 @@ impl std::fmt::Debug for AovPass {
 }
 
 impl AovPass {
+    /// The shader module the pass compiles for a scene with `features`.
+    pub(crate) fn modules(features: &SceneFeatures) -> Vec<ShaderModule> {
+        vec![ShaderModule::new(SHADER, features.material_defines())]
+    }
+
     /// Compiles the pass for `scene`'s materials (the alpha test where the plan has it) and
     /// allocates its outputs.
     pub fn new(
@@ -53,7 +59,7 @@ impl AovPass {
         width: u32,
         height: u32,
     ) -> Result<AovPass> {
-        let spirv = shaders.compile(SHADER, &scene.material_defines())?;
+        let spirv = Self::modules(&scene.features())[0].compile(shaders)?;
         let bindings = b::layout();
         let pipeline = Pipeline::compute(ctx, "aov", &spirv, &bindings, 0)?;
         let pixels = u64::from(width) * u64::from(height);

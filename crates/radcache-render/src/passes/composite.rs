@@ -23,6 +23,7 @@ use crate::error::Result;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::splat::SplatPass;
 use crate::passes::splat_glossy::GlossySplatPass;
+use crate::scene::features::{SceneFeatures, ShaderModule};
 use crate::scene::GpuScene;
 
 radcache_shared::gpu_struct! {
@@ -169,6 +170,21 @@ impl<'a> CompositeInputs<'a> {
 }
 
 impl CompositePass {
+    /// The shader module the pass compiles for a scene with `features` and `variant`.
+    pub(crate) fn modules(
+        features: &SceneFeatures,
+        variant: &CompositeVariant,
+    ) -> Vec<ShaderModule> {
+        let mut defines = features.defines();
+        if variant.radiance {
+            defines.push(("HAS_RADIANCE_CACHE", "1"));
+        }
+        if variant.moments {
+            defines.push(("IC_AA_MOMENTS", "1"));
+        }
+        vec![ShaderModule::new("passes/composite.comp", defines)]
+    }
+
     /// Compiles the pass for `scene`'s plan and `variant`, and allocates its accumulators.
     pub fn new(
         ctx: &Context,
@@ -179,18 +195,12 @@ impl CompositePass {
         let CompositeVariant {
             width,
             height,
-            radiance,
             moments,
             centres,
+            ..
         } = *variant;
-        let mut defines = scene.defines();
-        if radiance {
-            defines.push(("HAS_RADIANCE_CACHE", "1"));
-        }
-        if moments {
-            defines.push(("IC_AA_MOMENTS", "1"));
-        }
-        let spirv = shaders.compile("passes/composite.comp", &defines)?;
+        let module = &Self::modules(&scene.features(), variant)[0];
+        let spirv = module.compile(shaders)?;
         let pipeline = Pipeline::compute(
             ctx,
             "composite",

@@ -20,6 +20,7 @@ use crate::passes::composite::CompositePass;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::splat::SplatPass;
 use crate::passes::splat_glossy::GlossySplatPass;
+use crate::scene::features::{SceneFeatures, ShaderModule};
 use crate::scene::GpuScene;
 use crate::technique::{EmitterLight, SkyLight, SpecularPaths};
 
@@ -102,6 +103,12 @@ pub struct DirectVariant {
 }
 
 impl DirectVariant {
+    /// Whether the pass takes the emitters' light in closed form in a scene whose plan allows
+    /// it (`analytic_allowed`).
+    fn analytic(&self, analytic_allowed: bool) -> bool {
+        self.emitters.define(analytic_allowed).is_some()
+    }
+
     /// Writing the direct image, every shadow ray at every sub-frame, no radiance records, the
     /// specular paths pooled.
     pub fn new(sky: SkyLight, emitters: EmitterLight) -> DirectVariant {
@@ -214,6 +221,23 @@ impl std::fmt::Debug for DirectPass {
 }
 
 impl DirectPass {
+    /// The shader module the pass compiles for a scene with `features` and `variant`.
+    pub(crate) fn modules(features: &SceneFeatures, variant: &DirectVariant) -> Vec<ShaderModule> {
+        let mut defines = features.defines();
+        defines.extend(variant.sky.define(features.env_constant));
+        defines.extend(variant.emitters.define(features.analytic_emitters));
+        if variant.radiance {
+            defines.push(("HAS_RADIANCE_CACHE", "1"));
+        }
+        if let Some(DirectCompositing { moments }) = variant.composite {
+            defines.push(("DIRECT_COMPOSITE", "1"));
+            if moments {
+                defines.push(("IC_AA_MOMENTS", "1"));
+            }
+        }
+        vec![ShaderModule::new("passes/direct.comp", defines)]
+    }
+
     /// Compiles the pass for `scene`'s plan and `variant`.
     pub fn new(
         ctx: &Context,
@@ -222,27 +246,13 @@ impl DirectPass {
         variant: &DirectVariant,
     ) -> Result<DirectPass> {
         let DirectVariant {
-            sky,
-            emitters,
-            radiance,
             composite,
             shadows,
             specular_paths,
+            ..
         } = *variant;
-        let mut defines = scene.defines();
-        defines.extend(sky.define(scene.has_constant_environment()));
-        let analytic = emitters.define(scene.plan().analytic_emitters);
-        defines.extend(analytic);
-        if radiance {
-            defines.push(("HAS_RADIANCE_CACHE", "1"));
-        }
-        if let Some(DirectCompositing { moments }) = composite {
-            defines.push(("DIRECT_COMPOSITE", "1"));
-            if moments {
-                defines.push(("IC_AA_MOMENTS", "1"));
-            }
-        }
-        let spirv = shaders.compile("passes/direct.comp", &defines)?;
+        let module = &Self::modules(&scene.features(), variant)[0];
+        let spirv = module.compile(shaders)?;
         let layout = match composite {
             Some(_) => direct_composite_layout(),
             None => b::layout(),
@@ -278,7 +288,7 @@ impl DirectPass {
             pipeline,
             rays,
             placeholder,
-            analytic: analytic.is_some(),
+            analytic: variant.analytic(scene.plan().analytic_emitters),
             punctual: scene.plan().has_punctual_lights(),
             shadows: None,
             specular_pool: specular_paths == SpecularPaths::Pooled,

@@ -13,6 +13,7 @@ use radcache_vk::{
 use crate::bindings::emission as b;
 use crate::error::Result;
 use crate::passes::composite::CompositePass;
+use crate::scene::features::{SceneFeatures, ShaderModule};
 use crate::scene::GpuScene;
 
 /// The emission pipeline and its ray counter.
@@ -28,9 +29,17 @@ impl std::fmt::Debug for EmissionPass {
 }
 
 impl EmissionPass {
+    /// The shader module the pass compiles for a scene with `features`.
+    pub(crate) fn modules(features: &SceneFeatures) -> Vec<ShaderModule> {
+        vec![ShaderModule::new(
+            "passes/emission.comp",
+            features.defines(),
+        )]
+    }
+
     /// Compiles the pass.
     pub fn new(ctx: &Context, shaders: &ShaderCompiler, scene: &GpuScene) -> Result<EmissionPass> {
-        let spirv = shaders.compile("passes/emission.comp", &scene.defines())?;
+        let spirv = Self::modules(&scene.features())[0].compile(shaders)?;
         let pipeline = Pipeline::compute(ctx, "emission", &spirv, &b::layout(), 0)?;
         let rays = Buffer::new(
             ctx,

@@ -27,6 +27,7 @@ use radcache_vk::{
 
 use crate::bindings::SCENE;
 use crate::error::Result;
+use crate::scene::features::{SceneFeatures, ShaderModule};
 use crate::scene::GpuScene;
 
 mod images;
@@ -71,6 +72,23 @@ impl GBufferPass {
         Self::with_method(ctx, shaders, scene, scene.plan().traced_gbuffer)
     }
 
+    /// The shader modules the pass compiles for a scene with `features`, `traced` or
+    /// rasterized: the traced G-buffer's compute shader; or the repair's compute shader and
+    /// the rasterizer's vertex and fragment shaders.
+    pub(crate) fn modules(features: &SceneFeatures, traced: bool) -> Vec<ShaderModule> {
+        let defines = features.material_defines();
+        if traced {
+            return vec![ShaderModule::new("passes/gbuffer.comp", defines)];
+        }
+        let mut repair = defines.clone();
+        repair.push(("GBUFFER_REPAIR", "1"));
+        vec![
+            ShaderModule::new("passes/gbuffer.comp", repair),
+            ShaderModule::new("passes/gbuffer.vert", defines.clone()),
+            ShaderModule::new("passes/gbuffer.frag", defines),
+        ]
+    }
+
     /// As [`GBufferPass::new`], traced or rasterized as `traced` says whatever the plan.
     pub fn with_method(
         ctx: &Context,
@@ -78,9 +96,9 @@ impl GBufferPass {
         scene: &GpuScene,
         traced: bool,
     ) -> Result<GBufferPass> {
-        let defines = scene.material_defines();
-        let compute = |name: &str, defines: &[(&str, &str)]| -> Result<Pipeline> {
-            let spirv = shaders.compile("passes/gbuffer.comp", defines)?;
+        let modules = Self::modules(&scene.features(), traced);
+        let compute = |name: &str, module: &ShaderModule| -> Result<Pipeline> {
+            let spirv = module.compile(shaders)?;
             Ok(Pipeline::compute(
                 ctx,
                 name,
@@ -91,15 +109,13 @@ impl GBufferPass {
         };
         if traced {
             return Ok(GBufferPass {
-                pipeline: compute("gbuffer", &defines)?,
+                pipeline: compute("gbuffer", &modules[0])?,
                 repair: None,
             });
         }
-        let mut repair_defines = defines.clone();
-        repair_defines.push(("GBUFFER_REPAIR", "1"));
-        let repair = compute("gbuffer.repair", &repair_defines)?;
-        let vertex = shaders.compile("passes/gbuffer.vert", &defines)?;
-        let fragment = shaders.compile("passes/gbuffer.frag", &defines)?;
+        let repair = compute("gbuffer.repair", &modules[0])?;
+        let vertex = modules[1].compile(shaders)?;
+        let fragment = modules[2].compile(shaders)?;
         let pipeline = Pipeline::graphics(
             ctx,
             &GraphicsDesc {

@@ -11,6 +11,7 @@ use crate::bindings::holes as b;
 use crate::error::Result;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::splat::SplatPass;
+use crate::scene::features::ShaderModule;
 use crate::state::IcState;
 
 /// What a selection does.
@@ -56,9 +57,14 @@ impl std::fmt::Debug for HolePass {
 }
 
 impl HolePass {
+    /// The shader module the pass compiles.
+    pub(crate) fn modules() -> Vec<ShaderModule> {
+        vec![ShaderModule::plain("passes/holes.comp")]
+    }
+
     /// Compiles the pass.
     pub fn new(ctx: &Context, shaders: &ShaderCompiler) -> Result<HolePass> {
-        let spirv = shaders.compile("passes/holes.comp", &[])?;
+        let spirv = Self::modules()[0].compile(shaders)?;
         let bindings = b::layout();
         let pipeline = Pipeline::compute(
             ctx,

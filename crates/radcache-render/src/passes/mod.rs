@@ -16,6 +16,92 @@ pub mod splat;
 pub mod splat_glossy;
 pub mod temporal;
 
+use crate::scene::features::{SceneFeatures, ShaderModule};
+
+/// Every shader module a pass can compile: each pass's modules for every variant the frame can
+/// make it with, in scenes of every feature set of [`SceneFeatures::coverage`] (a pass is made
+/// with radiance only in scenes with [`SceneFeatures::radiance_cache`]), each distinct module
+/// once (sorted). `cargo xtask shaders` compiles and validates them all.
+pub fn every_shader_module() -> Vec<ShaderModule> {
+    use radcache_cache::{ErrorControl, IcParams};
+
+    use crate::technique::{EmitterLight, GlossySpacing, PathGridMode, SkyLight, Technique};
+    let bools = [false, true];
+    fn values<T: Technique>() -> impl Iterator<Item = T> {
+        T::VALUES.iter().map(|&(_, v)| v)
+    }
+    let mut directs = Vec::new();
+    for sky in values::<SkyLight>() {
+        for emitters in values::<EmitterLight>() {
+            for radiance in bools {
+                for composite in [None, Some(false), Some(true)] {
+                    directs.push(direct::DirectVariant {
+                        radiance,
+                        composite: composite.map(|moments| direct::DirectCompositing { moments }),
+                        ..direct::DirectVariant::new(sky, emitters)
+                    });
+                }
+            }
+        }
+    }
+    let mut records = Vec::new();
+    for error_control in [ErrorControl::SplitSphere, ErrorControl::Hessian] {
+        for sky in values::<SkyLight>() {
+            for radiance in bools {
+                for glossy_spacing in values::<GlossySpacing>() {
+                    for path_grid in values::<PathGridMode>() {
+                        let params = IcParams {
+                            error_control,
+                            ..IcParams::default()
+                        };
+                        records.push(record::RecordVariant {
+                            radiance,
+                            glossy_spacing,
+                            path_grid,
+                            ..record::RecordVariant::new(params, sky)
+                        });
+                    }
+                }
+            }
+        }
+    }
+    let mut modules = std::collections::BTreeSet::new();
+    for features in SceneFeatures::coverage() {
+        let f = &features;
+        let made = |radiance: bool| !radiance || f.radiance_cache;
+        let directs = directs.iter().filter(|v| made(v.radiance));
+        modules.extend(directs.flat_map(|v| direct::DirectPass::modules(f, v)));
+        let records = records.iter().filter(|v| made(v.radiance));
+        modules.extend(records.flat_map(|v| record::RecordPass::modules(f, v)));
+        for (radiance, moments) in [(false, false), (false, true), (true, false), (true, true)] {
+            if !made(radiance) {
+                continue;
+            }
+            let variant = composite::CompositeVariant {
+                radiance,
+                moments,
+                ..composite::CompositeVariant::new(1, 1)
+            };
+            modules.extend(composite::CompositePass::modules(f, &variant));
+        }
+        for traced in bools {
+            modules.extend(gbuffer::GBufferPass::modules(f, traced));
+        }
+        modules.extend(temporal::TemporalPass::modules(f));
+        modules.extend(emission::EmissionPass::modules(f));
+        modules.extend(aov::AovPass::modules(f));
+        modules.extend(path_trace::PathTracer::modules(f));
+    }
+    for gradients in bools {
+        modules.extend(splat_glossy::GlossySplatPass::modules(gradients));
+    }
+    modules.extend(splat::SplatPass::modules());
+    modules.extend(holes::HolePass::modules());
+    modules.extend(neighbours::NeighbourPass::modules());
+    modules.extend(crate::state::ic_counters::IcCountersPass::modules());
+    modules.into_iter().collect()
+}
+
 /// `shaders/shared/push.glsl`: every pass's push-constant struct, declared once in its pass
 /// file. A shader declares its block as `layout(push_constant) uniform Push { XPush pc; };`.
 pub fn push_constants_glsl() -> String {

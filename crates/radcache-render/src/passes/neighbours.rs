@@ -9,6 +9,7 @@ use radcache_vk::{vk, Access, Context, Pipeline, Recorder, Resource, ShaderCompi
 
 use crate::bindings::neighbours as b;
 use crate::error::Result;
+use crate::scene::features::ShaderModule;
 use crate::state::IcState;
 
 radcache_shared::gpu_struct! {
@@ -49,9 +50,14 @@ pub fn grid_level_max(scene_scale: f32) -> i32 {
 }
 
 impl NeighbourPass {
+    /// The shader module the pass compiles.
+    pub(crate) fn modules() -> Vec<ShaderModule> {
+        vec![ShaderModule::plain("passes/neighbours.comp")]
+    }
+
     /// Compiles the pass.
     pub fn new(ctx: &Context, shaders: &ShaderCompiler) -> Result<NeighbourPass> {
-        let spirv = shaders.compile("passes/neighbours.comp", &[])?;
+        let spirv = Self::modules()[0].compile(shaders)?;
         let bindings = b::layout();
         let pipeline = Pipeline::compute(
             ctx,

@@ -14,6 +14,7 @@ use radcache_vk::{
 
 use crate::bindings::path_trace as b;
 use crate::error::Result;
+use crate::scene::features::{SceneFeatures, ShaderModule};
 use crate::scene::GpuScene;
 
 /// The shader, relative to `shaders/`.
@@ -53,6 +54,11 @@ impl std::fmt::Debug for PathTracer {
 }
 
 impl PathTracer {
+    /// The shader module the pass compiles for a scene with `features`.
+    pub(crate) fn modules(features: &SceneFeatures) -> Vec<ShaderModule> {
+        vec![ShaderModule::new(SHADER, features.defines())]
+    }
+
     /// Width and height of the accumulators.
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)
@@ -66,7 +72,7 @@ impl PathTracer {
         width: u32,
         height: u32,
     ) -> Result<PathTracer> {
-        let spirv = shaders.compile(SHADER, &scene.defines())?;
+        let spirv = Self::modules(&scene.features())[0].compile(shaders)?;
         let bindings = b::layout();
         let pipeline = Pipeline::compute(
             ctx,

@@ -34,6 +34,7 @@ use radcache_vk::{
 use crate::bindings::record as b;
 use crate::error::{Error, Result};
 use crate::passes::gbuffer::GBuffer;
+use crate::scene::features::{SceneFeatures, ShaderModule};
 use crate::scene::GpuScene;
 use crate::technique::{GlossySpacing, PathGridMode, SkyLight};
 use radcache_shared::consts::RecordSource;
@@ -112,14 +113,19 @@ impl RecordVariant {
         }
     }
 
-    /// The shader's defines for `scene`'s plan, and whether the gathers share a grid.
-    fn defines(&self, scene: &GpuScene) -> (Vec<(&'static str, &'static str)>, bool) {
-        let mut defines = scene.defines();
-        defines.extend(self.sky.define(scene.has_constant_environment()));
+    /// The gathers share a grid in a scene with `features`.
+    fn grid(&self, features: &SceneFeatures) -> bool {
+        self.path_grid == PathGridMode::On && features.path_grid
+    }
+
+    /// The shader's defines for a scene with `features`.
+    fn defines(&self, features: &SceneFeatures) -> Vec<(&'static str, &'static str)> {
+        let mut defines = features.defines();
+        defines.extend(self.sky.define(features.env_constant));
         if self.params.error_control == ErrorControl::Hessian {
             defines.push(("IC_HESSIAN", "1"));
         }
-        if scene.plan().closed_form_gathers {
+        if features.closed_form_gathers {
             // The emitters' light at each gather vertex in closed form less a one-sample
             // estimate of its hidden part (`shaders/common/path.glsl`).
             defines.push(("PATH_CLOSED_FORM_EMITTERS", "1"));
@@ -130,11 +136,10 @@ impl RecordVariant {
                 defines.push(("GLOSSY_DENSITY", "1"));
             }
         }
-        let grid = self.path_grid == PathGridMode::On && scene.plan().path_grid();
-        if grid {
+        if self.grid(features) {
             defines.push(("PATH_GRID", "1"));
         }
-        (defines, grid)
+        defines
     }
 }
 
@@ -209,6 +214,11 @@ impl<'a> RecordOutputs<'a> {
 }
 
 impl RecordPass {
+    /// The shader module the pass compiles for a scene with `features` and `variant`.
+    pub(crate) fn modules(features: &SceneFeatures, variant: &RecordVariant) -> Vec<ShaderModule> {
+        vec![ShaderModule::new(SHADER, variant.defines(features))]
+    }
+
     /// Compiles the pass for `scene`'s plan and `variant`.
     pub fn new(
         ctx: &Context,
@@ -228,8 +238,10 @@ impl RecordPass {
                 )));
             }
         }
-        let (defines, grid) = variant.defines(scene);
-        let spirv = shaders.compile(SHADER, &defines)?;
+        let features = scene.features();
+        let grid = variant.grid(&features);
+        let module = &Self::modules(&features, variant)[0];
+        let spirv = module.compile(shaders)?;
         let pipeline = Pipeline::compute(
             ctx,
             "records",

@@ -12,6 +12,7 @@ use radcache_vk::{
 use crate::bindings::{splat as b, FRAME};
 use crate::error::Result;
 use crate::passes::gbuffer::GBuffer;
+use crate::scene::features::ShaderModule;
 use crate::scene::GpuScene;
 use crate::state::IcState;
 
@@ -139,14 +140,27 @@ impl<'a> SplatDraw<'a> {
 }
 
 impl SplatPass {
+    /// The shader modules the pass compiles: the vertex shader, and the fragment shader for
+    /// irradiance, irradiance and count, and coverage.
+    pub(crate) fn modules() -> Vec<ShaderModule> {
+        vec![
+            ShaderModule::plain("passes/splat.vert"),
+            ShaderModule::plain("passes/splat.frag"),
+            ShaderModule::new("passes/splat.frag", vec![("SPLAT_COUNT", "1")]),
+            ShaderModule::new("passes/splat.frag", vec![("SPLAT_COVERAGE", "1")]),
+        ]
+    }
+
     /// Compiles the pass and allocates the `width × height` accumulation target.
     pub fn new(ctx: &Context, shaders: &ShaderCompiler, width: u32, height: u32) -> Result<Self> {
-        let vertex = shaders.compile("passes/splat.vert", &[])?;
+        let [vertex, irradiance, counted, coverage] =
+            <[ShaderModule; 4]>::try_from(Self::modules()).expect("four splat modules");
+        let vertex = vertex.compile(shaders)?;
         let bindings = b::layout();
         let format = vk::Format::R32G32B32A32_SFLOAT;
-        let pipeline_for = |name: &str, defines: &[(&str, &str)]| -> Result<Pipeline> {
-            let fragment = shaders.compile("passes/splat.frag", defines)?;
-            let counted = defines.iter().any(|(d, _)| *d == "SPLAT_COUNT");
+        let pipeline_for = |name: &str, module: &ShaderModule| -> Result<Pipeline> {
+            let fragment = module.compile(shaders)?;
+            let counted = module.defines.iter().any(|(d, _)| *d == "SPLAT_COUNT");
             let formats = [format, COUNT_FORMAT];
             Ok(Pipeline::graphics(
                 ctx,
@@ -164,9 +178,9 @@ impl SplatPass {
                 },
             )?)
         };
-        let irradiance = pipeline_for("splat", &[])?;
-        let counted = pipeline_for("splat.counted", &[("SPLAT_COUNT", "1")])?;
-        let coverage = pipeline_for("splat.coverage", &[("SPLAT_COVERAGE", "1")])?;
+        let irradiance = pipeline_for("splat", &irradiance)?;
+        let counted = pipeline_for("splat.counted", &counted)?;
+        let coverage = pipeline_for("splat.coverage", &coverage)?;
         let sum = Image::new(
             ctx,
             &ImageDesc {

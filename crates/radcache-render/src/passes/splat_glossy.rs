@@ -24,6 +24,7 @@ use crate::bindings::{splat_glossy as b, FRAME};
 use crate::error::{Error, Result};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::splat::SplatWeights;
+use crate::scene::features::ShaderModule;
 use crate::scene::GpuScene;
 use crate::state::IcState;
 
@@ -48,6 +49,20 @@ impl std::fmt::Debug for GlossySplatPass {
 }
 
 impl GlossySplatPass {
+    /// The shader modules the pass compiles, `gradients` as in [`GlossySplatPass::new`]: the
+    /// splat's vertex shader and the glossy fragment shader.
+    pub(crate) fn modules(gradients: bool) -> Vec<ShaderModule> {
+        let defines = if gradients {
+            vec![("GLOSSY_GRADIENTS", "1")]
+        } else {
+            Vec::new()
+        };
+        vec![
+            ShaderModule::plain("passes/splat.vert"),
+            ShaderModule::new("passes/splat_glossy.frag", defines),
+        ]
+    }
+
     /// Compiles the pass and allocates the target and the weights for `width × height` pixels,
     /// and the table; `gradients` extrapolates
     /// the coefficients by their translational gradients (docs/radiance-caching.md §7).
@@ -58,13 +73,10 @@ impl GlossySplatPass {
         height: u32,
         gradients: bool,
     ) -> Result<Self> {
-        let vertex = shaders.compile("passes/splat.vert", &[])?;
-        let defines: &[(&str, &str)] = if gradients {
-            &[("GLOSSY_GRADIENTS", "1")]
-        } else {
-            &[]
-        };
-        let fragment = shaders.compile("passes/splat_glossy.frag", defines)?;
+        let [vertex, fragment] = <[ShaderModule; 2]>::try_from(Self::modules(gradients))
+            .expect("two glossy splat modules");
+        let vertex = vertex.compile(shaders)?;
+        let fragment = fragment.compile(shaders)?;
         let format = vk::Format::R32G32B32A32_SFLOAT;
         let pipeline = Pipeline::graphics(
             ctx,

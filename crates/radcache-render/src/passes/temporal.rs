@@ -48,6 +48,7 @@ use radcache_vk::{
 
 use crate::bindings::temporal as b;
 use crate::error::Result;
+use crate::scene::features::{SceneFeatures, ShaderModule};
 use crate::scene::GpuScene;
 use crate::state::{IcState, RADIANCE_BYTES_PER_RECORD};
 
@@ -215,6 +216,14 @@ pub struct TemporalVariant {
 }
 
 impl TemporalPass {
+    /// The shader module the pass compiles for a scene with `features`.
+    pub(crate) fn modules(features: &SceneFeatures) -> Vec<ShaderModule> {
+        vec![ShaderModule::new(
+            "passes/temporal.comp",
+            features.defines(),
+        )]
+    }
+
     /// Compiles the pass for `scene` and allocates its buffers for `variant`.
     pub fn new(
         ctx: &Context,
@@ -227,7 +236,7 @@ impl TemporalPass {
             lifespans,
             radiance,
         } = *variant;
-        let spirv = shaders.compile("passes/temporal.comp", &scene.defines())?;
+        let spirv = Self::modules(&scene.features())[0].compile(shaders)?;
         let pipeline = Pipeline::compute(
             ctx,
             "temporal",

@@ -25,6 +25,7 @@ use crate::scene::pack::{mesh_is_opaque, pack_geometry, pack_materials, PackedGe
 use crate::scene::upload::{cols, host_buffer, rows3x4, storage};
 
 pub(crate) mod env_map;
+pub mod features;
 pub(crate) mod lights;
 pub(crate) mod pack;
 pub(crate) mod upload;

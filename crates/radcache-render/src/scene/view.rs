@@ -8,6 +8,7 @@ use radcache_vk::Resource;
 use super::GpuScene;
 use crate::bindings as b;
 use crate::error::Result;
+use crate::scene::features::SceneFeatures;
 use crate::scene::upload::{cols, vulkan_clip_from_view};
 
 impl GpuScene {
@@ -54,52 +55,24 @@ impl GpuScene {
         &self.constants
     }
 
-    /// Shader defines of the scene's materials: `HAS_SPECULAR` when some material is not
-    /// Lambertian (`ScenePlan::specular`), which compiles in the full metallic-roughness BRDF;
-    /// `HAS_ALPHA` when some material is alpha-tested (`ScenePlan::alpha`), which compiles the
-    /// alpha test into every ray query and the G-buffer; `HAS_NORMAL_MAPS` when some primitive
-    /// has a normal map (`ScenePlan::normal_maps`), which compiles in the tangent binding and the
-    /// normal-map code; `HAS_UV_TRANSFORM` when some texture reference has a
-    /// `KHR_texture_transform` (`ScenePlan::uv_transform`) and `HAS_TEXCOORD1` when some samples
-    /// TEXCOORD_1 (`ScenePlan::texcoord1`), which compile in the transforms and the second set
-    /// (its binding, its interpolation and the choice of set per reference).
+    /// The features of the scene that set shader defines.
+    pub fn features(&self) -> SceneFeatures {
+        SceneFeatures::new(
+            &self.plan,
+            self.has_constant_environment(),
+            self.env_size.0 > 0,
+        )
+    }
+
+    /// Shader defines of the scene's materials ([`SceneFeatures::material_defines`]).
     pub fn material_defines(&self) -> Vec<(&'static str, &'static str)> {
-        let mut d = Vec::new();
-        if self.plan.specular {
-            d.push(("HAS_SPECULAR", "1"));
-        }
-        if self.plan.alpha {
-            d.push(("HAS_ALPHA", "1"));
-        }
-        if self.plan.normal_maps {
-            d.push(("HAS_NORMAL_MAPS", "1"));
-        }
-        if self.plan.uv_transform {
-            d.push(("HAS_UV_TRANSFORM", "1"));
-        }
-        if self.plan.texcoord1 {
-            d.push(("HAS_TEXCOORD1", "1"));
-        }
-        d
+        self.features().material_defines()
     }
 
     /// Shader defines that compile in only the light sources and material features the scene
-    /// has.
+    /// has ([`SceneFeatures::defines`]).
     pub fn defines(&self) -> Vec<(&'static str, &'static str)> {
-        let mut d = self.material_defines();
-        if self.plan.has_emissive() {
-            d.push(("HAS_EMITTERS", "1"));
-        }
-        if self.plan.has_punctual_lights() {
-            d.push(("HAS_LIGHTS", "1"));
-        }
-        if self.has_constant_environment() {
-            d.push(("HAS_ENV_CONSTANT", "1"));
-        }
-        if self.env_size.0 > 0 {
-            d.push(("HAS_ENV_MAP", "1"));
-        }
-        d
+        self.features().defines()
     }
 
     /// The scene's binding table (bindings 0–15), to prefix a pass's own bindings.

@@ -10,6 +10,7 @@ use radcache_vk::{Access, Buffer, Context, Pipeline, Recorder, Resource, ShaderC
 
 use crate::bindings::ic_counters as b;
 use crate::error::Result;
+use crate::scene::features::ShaderModule;
 
 /// The shader, relative to `shaders/`.
 pub const SHADER: &str = "passes/ic_counters.comp";
@@ -42,9 +43,14 @@ impl std::fmt::Debug for IcCountersPass {
 }
 
 impl IcCountersPass {
+    /// The shader module the pass compiles.
+    pub(crate) fn modules() -> Vec<ShaderModule> {
+        vec![ShaderModule::plain(SHADER)]
+    }
+
     /// Compiles the pass.
     pub fn new(ctx: &Context, shaders: &ShaderCompiler) -> Result<IcCountersPass> {
-        let spirv = shaders.compile(SHADER, &[])?;
+        let spirv = Self::modules()[0].compile(shaders)?;
         let pipeline = Pipeline::compute(
             ctx,
             "ic_counters",
