@@ -8,10 +8,9 @@
 //! wall and GPU time and its `compare` metrics go to `points.csv`, a log–log plot of relMSE
 //! against wall time to `error_vs_time.svg`/`.png`, and `summary.md` gives the Pareto front and,
 //! per cache point, the path tracer's time to reach the same error and the speed-up
-//! (definitions in [`model`]).
+//! (definitions in [`radcache_image::equal_error`], which `cargo xtask bench ic` uses too).
 
 mod ladder;
-mod model;
 mod plot;
 mod report;
 
@@ -22,6 +21,7 @@ use std::time::Instant;
 use anyhow::{bail, Context as _, Result};
 use clap::Args;
 use radcache_cache::WeightKind;
+use radcache_image::equal_error::{self, PtPoint};
 use radcache_image::{read_exr, write_exr, ExrOptions, Image, Metadata};
 use radcache_render::{EnvMap, GpuScene};
 use radcache_scene::{Environment, LoadOptions, Scene};
@@ -32,7 +32,6 @@ use crate::args::{parse_resolution, shader_root};
 use crate::progress::{self, FrameBar};
 use crate::sequence::{FrameArgs, Sequence};
 use ladder::{Bench, Ladder, Point};
-use model::PtPoint;
 
 /// Options of `radcache convergence`.
 #[derive(Args, Debug)]
@@ -281,8 +280,8 @@ fn analyse(points: &mut [Point], reference_spp: Option<u32>) -> (Option<f64>, f6
         .iter()
         .filter_map(|p| Some((p.spp?, p.metrics.relmse)))
         .collect();
-    let c = model::noise_constant(&pt, reference_spp);
-    let e_ref = model::reference_noise(c, reference_spp);
+    let c = equal_error::noise_constant(&pt, reference_spp);
+    let e_ref = equal_error::reference_noise(c, reference_spp);
     for p in points.iter_mut() {
         p.own_relmse = p.metrics.relmse - e_ref;
     }
@@ -296,7 +295,7 @@ fn analyse(points: &mut [Point], reference_spp: Option<u32>) -> (Option<f64>, f6
         })
         .collect();
     for p in points.iter_mut().filter(|p| p.ic.is_some()) {
-        p.matched = model::pt_time_to_match(&curve, p.own_relmse);
+        p.matched = equal_error::pt_time_to_match(&curve, p.own_relmse);
     }
     // The per-pixel glossy paths' curve, over the presets (scenes with radiance records).
     let paths: Vec<PtPoint> = points
@@ -311,14 +310,14 @@ fn analyse(points: &mut [Point], reference_spp: Option<u32>) -> (Option<f64>, f6
         .collect();
     if !paths.is_empty() {
         for p in points.iter_mut().filter(|p| p.ladder == Ladder::Preset) {
-            p.matched_paths = model::pt_time_to_match(&paths, p.own_relmse);
+            p.matched_paths = equal_error::pt_time_to_match(&paths, p.own_relmse);
         }
     }
     let xy: Vec<(f64, f64)> = points
         .iter()
         .map(|p| (p.wall_s, p.metrics.relmse))
         .collect();
-    for i in model::pareto_front(&xy) {
+    for i in equal_error::pareto_front(&xy) {
         points[i].pareto = true;
     }
     (c, e_ref)

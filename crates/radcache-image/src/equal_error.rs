@@ -1,11 +1,12 @@
-//! The arithmetic of the convergence report, free of the GPU: the reference's own noise, the
-//! path tracer's time to reach an error (log–log interpolation between its measured points), and
-//! the Pareto front of error against time.
+//! The path tracer's time to the same error, for the convergence report (`radcache
+//! convergence`) and `cargo xtask bench ic` alike: the reference's own noise, the path tracer's
+//! time to reach an error (log–log interpolation between its measured points), and the Pareto
+//! front of error against time. Free of the GPU.
 //!
-//! Error model (as `cargo xtask bench ic`): the path tracer is unbiased, so its expected relMSE
-//! against the true image is `c / spp`. A reference rendered by the path tracer with `S` spp adds
-//! its own independent noise `e_ref = c / S` to every relMSE measured against it, so a point's own
-//! error is `relMSE − e_ref`; `c` is the median over the path tracer's points of
+//! Error model: the path tracer is unbiased, so its expected relMSE against the true image is
+//! `c / spp`. A reference rendered by the path tracer with `S` spp adds its own independent noise
+//! `e_ref = c / S` to every relMSE measured against it, so a point's own error is
+//! `relMSE − e_ref`; `c` is the median over the path tracer's points of
 //! `relMSE_i / (1/spp_i + 1/S)`. A reference of unknown spp is taken as noise-free (`e_ref = 0`).
 
 /// One measured point of the path tracer's ladder, as the interpolation sees it.

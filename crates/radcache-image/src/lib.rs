@@ -8,6 +8,7 @@
 //! - [`contact_sheet`]: a sequence's frames reduced and tiled into one image.
 //! - [`write_png`]: 8-bit sRGB preview with exposure and an optional filmic curve ([`ToneMap`]).
 //! - [`frame_path`], [`output_path`], [`png_beside`]: output path patterns (`frame_####.exr`).
+//! - [`equal_error`]: the path tracer's time to reach an error, from its measured points.
 //! - [`compare`] → [`Metrics`] (RMSE, relMSE, MAE, 8×8 block RMSE, mean ratios, FLIP,
 //!   non-finite counts) and [`Thresholds::check`].
 //!
@@ -18,6 +19,7 @@
 mod atomic;
 mod color;
 mod contact;
+pub mod equal_error;
 mod error;
 mod exr_read;
 mod exr_write;

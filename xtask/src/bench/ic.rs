@@ -5,12 +5,13 @@
 //! courtyard: the default only): the IC
 //! frame's time (everything `render_ic` does, pipeline creation included), records and rays and
 //! its relMSE; the path tracer's relMSE at 4, 16 and 64 spp and its time per spp; the
-//! path tracer's time to reach the IC's relMSE, from relMSE ∝ 1/spp fitted to the measured points
-//! (an unbiased estimator's MSE falls as 1/N) and its time per spp timed at 16 spp just before
-//! each IC frame (this machine's speed drifts by up to 2× over minutes: a time per spp from the
-//! end of the run once doubled the ratios); and their ratio. Errors are each method's own: the
-//! reference's noise (the same fit at the reference's spp) is taken off the IC's measured relMSE,
-//! as the path tracer's fit at low spp barely contains it. At 512² (no reference): the
+//! path tracer's time to reach the IC's relMSE, as `radcache convergence` computes it
+//! ([`radcache_image::equal_error`]: log–log interpolation between the measured points, relMSE ∝
+//! 1/time beyond them), each point timed at the time per spp measured at 16 spp just before the
+//! IC frame (this machine's speed drifts by up to 2× over minutes: a time per spp from the end
+//! of the run once doubled the ratios); and their ratio. Errors are each method's own: the
+//! reference's noise (`c / S` of the fit `relMSE = c/spp + c/S`) is taken off every measured
+//! relMSE. At 512² (no reference): the
 //! default preset's time, records and rays. The record pass's ray rate is its rays over the wall
 //! time of the record-creation submissions (lavapipe's timestamps do not bracket asynchronous
 //! compute work; this time also holds the neighbour pass and the submission overhead, so the
@@ -55,8 +56,9 @@ const SCENES: &[BenchScene] = &[
     },
 ];
 
-use anyhow::Result;
+use anyhow::{Context as _, Result};
 use radcache_cache::{IcParams, Preset};
+use radcache_image::equal_error::{self, PtPoint};
 use radcache_image::{compare, read_exr, Image};
 use radcache_render::{
     render_ic, render_path, AntiAliasing, Budget, EmitterLight, EmitterShadows, GpuScene,
@@ -323,7 +325,7 @@ pub fn run(args: &[&str]) -> Result<()> {
     pt_beside.push(pt_s_per_spp(&mut gpu)?);
 
     // The path tracer at growing spp against the same reference.
-    let mut fit = Vec::new();
+    let mut pt_points = Vec::new();
     let mut per_spp_s = Vec::new();
     for spp in [4u32, 16, 64] {
         let out = render_path(
@@ -352,18 +354,19 @@ pub fn run(args: &[&str]) -> Result<()> {
             m.relmse,
             "relMSE",
         ));
-        fit.push(m.relmse * f64::from(spp));
+        pt_points.push((spp, m.relmse));
         per_spp_s.push(out.time_s / f64::from(spp));
     }
-    fit.sort_by(f64::total_cmp);
-    per_spp_s.sort_by(f64::total_cmp);
-    let (c, t1) = (fit[1], per_spp_s[1]);
-    // The reference is itself a path-traced image with ref_spp samples: its noise adds
-    // e_ref = c / ref_spp to every relMSE measured against it (independent errors add). Both
+    // The error model and the time to the same error are `radcache convergence`'s
+    // (`radcache_image::equal_error`): the reference is itself a path-traced image with ref_spp
+    // samples, whose noise e_ref = c / ref_spp adds to every relMSE measured against it; both
     // methods are compared on their own error, relMSE − e_ref.
-    let e_ref = c / f64::from(ref_spp);
+    let t1 = equal_error::median(&per_spp_s).context("the path tracer's per-spp times")?;
+    let c = equal_error::noise_constant(&pt_points, Some(ref_spp))
+        .context("the path tracer's relMSE against the reference")?;
+    let e_ref = equal_error::reference_noise(Some(c), Some(ref_spp));
     println!(
-        "PT: relMSE × spp = {c:.3e}, {t1:.3} s per spp; the {ref_spp}-spp reference's own relMSE ≈ {e_ref:.2e}"
+        "PT: relMSE = c/spp + c/{ref_spp} with c = {c:.3e}, {t1:.3} s per spp; the {ref_spp}-spp reference's own relMSE ≈ {e_ref:.2e}"
     );
     figures.push(Figure::new(
         format!("{}_256", bs.name),
@@ -378,10 +381,28 @@ pub fn run(args: &[&str]) -> Result<()> {
             println!("{case}: relMSE {relmse:.2e} is within the reference's own noise");
             continue;
         }
-        let spp_needed = c / own;
-        let pt_time = spp_needed * t_local;
+        // The path tracer's points, each timed at the per-spp cost measured around this case.
+        let curve: Vec<PtPoint> = pt_points
+            .iter()
+            .map(|&(spp, relmse)| PtPoint {
+                spp,
+                time_s: f64::from(spp) * t_local,
+                error: relmse - e_ref,
+            })
+            .collect();
+        let Some(matched) = equal_error::pt_time_to_match(&curve, own) else {
+            println!("{case}: no path-tracer point to match its relMSE {own:.2e} against");
+            continue;
+        };
+        let pt_time = matched.time_s;
+        let spp_needed = pt_time / t_local;
+        let how = if matched.extrapolated {
+            "extrapolated"
+        } else {
+            "interpolated"
+        };
         println!(
-            "{case}: own relMSE {own:.2e} ({relmse:.2e} against the reference); PT needs ~{spp_needed:.0} spp = {pt_time:.1} s at {t_local:.3} s per spp timed around it ({:.1} s at the fit's {t1:.3}); IC took {time:.1} s: {:.1}× faster",
+            "{case}: own relMSE {own:.2e} ({relmse:.2e} against the reference); PT needs ~{spp_needed:.0} spp ({how}) = {pt_time:.1} s at {t_local:.3} s per spp timed around it ({:.1} s at the median {t1:.3}); IC took {time:.1} s: {:.1}× faster",
             spp_needed * t1,
             pt_time / time
         );

@@ -10,7 +10,7 @@ use radcache_render::{
 use radcache_scene::Scene;
 use radcache_vk::{Context, ShaderCompiler};
 
-use super::model::Match;
+use radcache_image::equal_error::Match;
 
 /// Seed of the path tracer's ladder points (each point adds its spp, so no two share samples).
 pub const PT_SEED: u32 = 1000;

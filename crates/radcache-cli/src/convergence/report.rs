@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 
 use super::ladder::{accuracy_of, preset_name, weight_name, Ladder, Point};
-use super::model::Match;
+use radcache_image::equal_error::Match;
 
 /// The CSV's header: one column per field, in order.
 pub const CSV_HEADER: &str = "method,ladder,label,preset,weight,accuracy,weight_param,strata,spp,\
