@@ -4,7 +4,8 @@
 
 use glam::{DVec3, Mat3, Quat, Vec3};
 use radcache_render::{
-    DirectInputs, DirectOutputs, DirectPass, EnvMap, GBuffer, GBufferPass, GpuScene,
+    passes::direct::DirectInputs, passes::direct::DirectOutputs, passes::direct::DirectPass,
+    passes::gbuffer::GBuffer, passes::gbuffer::GBufferPass, EnvMap, GpuScene,
 };
 use radcache_scene::writer::{GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
 use radcache_scene::Scene;
@@ -324,7 +325,7 @@ pub fn gbuffer_fill_pipeline(
 pub fn fill_gbuffer_points(
     rec: &mut radcache_vk::Recorder,
     fill: &radcache_vk::Pipeline,
-    g: &radcache_render::GBuffer,
+    g: &radcache_render::passes::gbuffer::GBuffer,
     texels: &radcache_vk::Buffer,
     count: u32,
 ) {

@@ -10,8 +10,9 @@ use radcache_cache::sampling::{
     basis_from_normal, frame_to_world, normalize_or_z, stratum_direction_local, stratum_jitter,
 };
 use radcache_render::{
-    record_seed, GBuffer, GpuScene, IcState, RecordInputs, RecordJob, RecordOutputs, RecordPass,
-    R_EPS_REL,
+    passes::gbuffer::GBuffer, passes::record::record_seed, passes::record::RecordInputs,
+    passes::record::RecordJob, passes::record::RecordOutputs, passes::record::RecordPass,
+    passes::record::R_EPS_REL, GpuScene, IcState,
 };
 use radcache_scene::Scene;
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};

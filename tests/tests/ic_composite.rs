@@ -4,9 +4,13 @@
 //! followed by the composite pass adds.
 
 use radcache_render::{
-    sub_frame_jitter, CentreSamples, CompositeInputs, CompositePass, CompositeSubFrame,
-    CompositeTargets, CompositeVariant, DirectCompositing, DirectInputs, DirectOutputs, DirectPass,
-    DirectShadows, DirectVariant, EmitterLight, SkyLight, SplatPass,
+    frame::settings::sub_frame_jitter, passes::composite::CentreSamples,
+    passes::composite::CompositeInputs, passes::composite::CompositePass,
+    passes::composite::CompositeVariant, passes::direct::CompositeSubFrame,
+    passes::direct::CompositeTargets, passes::direct::DirectCompositing,
+    passes::direct::DirectInputs, passes::direct::DirectOutputs, passes::direct::DirectPass,
+    passes::direct::DirectShadows, passes::direct::DirectVariant, passes::splat::SplatPass,
+    EmitterLight, SkyLight,
 };
 use radcache_tests::ic_fixture::{cornell, Gpu};
 use radcache_vk::ImageUse;

@@ -6,8 +6,9 @@ use std::f64::consts::PI;
 
 use glam::{DVec3, Quat, Vec3};
 use radcache_render::{
-    CompositeInputs, CompositePass, CompositeVariant, DirectPass, DirectVariant, EmissionPass,
-    EmitterLight, EnvMap, SkyLight, SplatPass,
+    passes::composite::CompositeInputs, passes::composite::CompositePass,
+    passes::composite::CompositeVariant, passes::direct::DirectPass, passes::direct::DirectVariant,
+    passes::emission::EmissionPass, passes::splat::SplatPass, EmitterLight, EnvMap, SkyLight,
 };
 use radcache_scene::light::LightKind;
 use radcache_scene::writer::{GltfBuilder, LightDesc, MaterialDesc, NodeDesc};

@@ -6,7 +6,10 @@
 //! along it, and along an object thinner than a pixel that the first sub-frame missed.
 
 use glam::{DVec3, Quat, Vec3};
-use radcache_render::{DirectPass, DirectShadows, DirectVariant, EmitterLight, SkyLight};
+use radcache_render::{
+    passes::direct::DirectPass, passes::direct::DirectShadows, passes::direct::DirectVariant,
+    EmitterLight, SkyLight,
+};
 use radcache_scene::writer::{GltfBuilder, MaterialDesc};
 use radcache_scene::Scene;
 use radcache_tests::direct_cpu::{agree, cpu_direct};

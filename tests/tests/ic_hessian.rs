@@ -13,8 +13,9 @@ use radcache_cache::hessian::{compute_hessian, hessian_luminance, hessian_radius
 use radcache_cache::radius::{finalize_radius, pixel_footprint};
 use radcache_cache::{luminance_rec709, ErrorControl, IcParams, IC_FAR};
 use radcache_render::{
-    record_seed, GBuffer, GpuScene, IcState, RecordInputs, RecordJob, RecordOutputs, RecordPass,
-    RecordVariant, SkyLight, R_EPS_REL,
+    passes::gbuffer::GBuffer, passes::record::record_seed, passes::record::RecordInputs,
+    passes::record::RecordJob, passes::record::RecordOutputs, passes::record::RecordPass,
+    passes::record::RecordVariant, passes::record::R_EPS_REL, GpuScene, IcState, SkyLight,
 };
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::geometry::intersect;

@@ -7,7 +7,9 @@
 
 use glam::Vec3;
 use radcache_cache::temporal::temporal_lifespan;
-use radcache_render::{expires_at, GpuScene, IcRenderer, IcSettings, IcStats, PathGridMode};
+use radcache_render::{
+    passes::temporal::expires_at, GpuScene, IcRenderer, IcSettings, IcStats, PathGridMode,
+};
 use radcache_scene::Scene;
 use radcache_shared::consts::TEMPORAL_FLAG_ADOPTED;
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};

@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use radcache_cache::radius::neighbour_clamp;
-use radcache_render::{IcState, NeighbourPass};
+use radcache_render::{passes::neighbours::NeighbourPass, IcState};
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::{context, finish, shaders, Rng};
 use radcache_vk::{Access, Recorder};

@@ -9,7 +9,8 @@ use std::path::PathBuf;
 use radcache_cache::IcParams;
 use radcache_image::{compare, read_exr, Image, Metrics};
 use radcache_render::{
-    GpuScene, IcRenderer, IcSettings, IcStats, PathGridMode, RecordPass, RecordVariant, SkyLight,
+    passes::record::RecordPass, passes::record::RecordVariant, GpuScene, IcRenderer, IcSettings,
+    IcStats, PathGridMode, SkyLight,
 };
 use radcache_shared::consts::GPU_RECORD_R_ORIG_WORD;
 use radcache_shared::gpu::GpuRecord;

@@ -14,9 +14,15 @@ use radcache_cache::radius::finalize_radius;
 use radcache_cache::record::*;
 use radcache_cache::sampling::*;
 use radcache_cache::{IcParams, IC_FAR, R_FLOOR};
-use radcache_render::{RecordPass, RecordVariant, SkyLight};
-use radcache_render::{RECORD_FLAGS_MASK, RECORD_FLAG_INVALID_IRRADIANCE, RECORD_FLAG_NO_SURFACE};
-use radcache_render::{RECORD_FLAG_CLAMPED_DOWN, RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED};
+use radcache_render::{passes::record::RecordPass, passes::record::RecordVariant, SkyLight};
+use radcache_render::{
+    passes::record::RECORD_FLAGS_MASK, passes::record::RECORD_FLAG_INVALID_IRRADIANCE,
+    passes::record::RECORD_FLAG_NO_SURFACE,
+};
+use radcache_render::{
+    passes::record::RECORD_FLAG_CLAMPED_DOWN, passes::record::RECORD_FLAG_CLAMPED_UP,
+    passes::record::RECORD_FLAG_FOLDED,
+};
 use radcache_scene::Scene;
 use radcache_shared::gpu::{GpuRecord, IcCounters};
 use radcache_tests::geometry::intersect;

@@ -5,8 +5,9 @@
 
 use radcache_cache::IcParams;
 use radcache_render::{
-    GBuffer, GpuScene, IcRenderer, IcSettings, PathGridMode, RecordInputs, RecordJob,
-    RecordOutputs, RecordPass, RecordVariant, SplatMode,
+    passes::gbuffer::GBuffer, passes::record::RecordInputs, passes::record::RecordJob,
+    passes::record::RecordOutputs, passes::record::RecordPass, passes::record::RecordVariant,
+    GpuScene, IcRenderer, IcSettings, PathGridMode, SplatMode,
 };
 use radcache_shared::gpu::{DispatchArgs, GpuRecord, IcCounters};
 use radcache_tests::scenes::load;

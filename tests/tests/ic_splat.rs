@@ -5,8 +5,10 @@
 use glam::Vec3;
 use radcache_cache::{extrapolate_irradiance, record_weight, IcParams, WeightKind, WeightRecord};
 use radcache_render::{
-    GBuffer, GpuScene, HolePass, HoleSelection, IcState, NeighbourPass, SplatDraw, SplatInputs,
-    SplatOutput, SplatPass, SplatWeights,
+    passes::gbuffer::GBuffer, passes::holes::HolePass, passes::holes::HoleSelection,
+    passes::neighbours::NeighbourPass, passes::splat::SplatDraw, passes::splat::SplatInputs,
+    passes::splat::SplatOutput, passes::splat::SplatPass, passes::splat::SplatWeights, GpuScene,
+    IcState,
 };
 use radcache_scene::{LoadOptions, Scene};
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};

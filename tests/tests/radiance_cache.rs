@@ -10,8 +10,9 @@
 use radcache_cache::IcParams;
 use radcache_image::{compare, Image};
 use radcache_render::{
-    render_ic, FrameOutput, GlossyLight, GlossySpacing, GpuScene, IcRenderer, IcSettings,
-    RadianceBlock, RECORD_FLAG_GLOSSY, RECORD_FLAG_NO_SURFACE,
+    passes::record::RECORD_FLAG_GLOSSY, passes::record::RECORD_FLAG_NO_SURFACE, render_ic,
+    state::RadianceBlock, FrameOutput, GlossyLight, GlossySpacing, GpuScene, IcRenderer,
+    IcSettings,
 };
 use radcache_scene::Scene;
 use radcache_shared::consts::{GLOSSY_ROUGHNESS_MIN, RECORD_RADIANCE_VEC4S};

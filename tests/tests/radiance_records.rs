@@ -20,7 +20,7 @@ use radcache_cache::radiance::{
 use radcache_cache::record::wall_term;
 use radcache_cache::sampling::stratum_index;
 use radcache_cache::{IcParams, IC_FAR};
-use radcache_render::{RecordPass, RecordVariant, SkyLight};
+use radcache_render::{passes::record::RecordPass, passes::record::RecordVariant, SkyLight};
 use radcache_shared::consts::{
     RADIANCE_VEC4S, RECORD_FLAG_GLOSSY, RECORD_RADIANCE_VEC4S, SH_COEFFS,
 };

@@ -12,7 +12,7 @@ use glam::Vec3;
 use radcache_cache::cache_file::{CacheFile, CacheIdentity, CacheSettings};
 use radcache_cache::IcParams;
 use radcache_image::{compare, Image};
-use radcache_render::{FrameOutput, GpuScene, IcRenderer, IcState, RadianceBlock};
+use radcache_render::{state::RadianceBlock, FrameOutput, GpuScene, IcRenderer, IcState};
 use radcache_scene::Scene;
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
 use radcache_tests::ic_fixture::sequence_settings;

@@ -10,7 +10,7 @@
 //! outline → 1 − covered area fraction, up to the binomial noise of the jittered samples.
 
 use glam::{Quat, Vec3};
-use radcache_render::{render_path, Budget, GpuScene, PathSettings, REFITS_PER_REBUILD};
+use radcache_render::{render_path, scene::REFITS_PER_REBUILD, Budget, GpuScene, PathSettings};
 use radcache_scene::writer::{ChannelDesc, GltfBuilder, MaterialDesc, NodeDesc};
 use radcache_scene::{Interpolation, Property, Scene};
 use radcache_tests::scenes::{

@@ -15,7 +15,10 @@
 //! - [`technique`] and the errors: the technique switches that the frame chooses and the passes
 //!   compile in ([`SkyLight`], [`EmitterLight`], ...), and [`Error`].
 //!
-//! The crate root only declares the modules and re-exports the public API.
+//! The crate root declares the modules and re-exports what a user of the renderer needs: the
+//! frames, their settings and statistics, the scene, the technique switches and the errors.
+//! The passes, their variants and inputs are reached by their module path
+//! (`radcache_render::passes::direct::DirectPass`), as the tests that drive a pass alone do.
 
 pub mod bindings;
 mod error;
@@ -30,36 +33,13 @@ pub use frame::clock::{Span, Track};
 pub use frame::ic::{render_ic, IcRenderer};
 pub use frame::path::{render_path, Budget, FrameOutput, PathSettings, Progress};
 pub use frame::settings::{
-    sub_frame_jitter, AntiAliasing, ConfigChange, IcDebug, IcSettings, IcStats, TechniqueHelp,
+    AntiAliasing, ConfigChange, IcDebug, IcSettings, IcStats, TechniqueHelp,
 };
-pub use passes::aov::{render_aovs, AovPass, Aovs};
-pub use passes::composite::{CentreSamples, CompositeInputs, CompositePass, CompositeVariant};
-pub use passes::direct::{
-    CompositeSubFrame, CompositeTargets, DirectCompositing, DirectInputs, DirectOutputs,
-    DirectPass, DirectShadows, DirectVariant,
-};
-pub use passes::emission::EmissionPass;
-pub use passes::gbuffer::{GBuffer, GBufferPass, DEPTH_FORMAT, GBUFFER_BINDINGS, GBUFFER_FORMAT};
-pub use passes::holes::{HolePass, HoleSelection};
-pub use passes::neighbours::NeighbourPass;
-pub use passes::path_trace::PathTracer;
-pub use passes::record::{
-    creation_seed, record_seed, DISPATCH_OFFSET, RECORD_FLAGS_MASK, RECORD_FLAG_CLAMPED_DOWN,
-    RECORD_FLAG_CLAMPED_UP, RECORD_FLAG_FOLDED, RECORD_FLAG_GLOSSY, RECORD_FLAG_INVALID_IRRADIANCE,
-    RECORD_FLAG_NO_SURFACE, RECORD_INSTANCE_SHIFT,
-};
-pub use passes::record::{
-    RecordInputs, RecordJob, RecordOutputs, RecordPass, RecordVariant, MAX_STRATA, R_EPS_REL,
-};
-pub use passes::splat::{SplatDraw, SplatInputs, SplatOutput, SplatPass, SplatScope, SplatWeights};
-pub use passes::splat_glossy::GlossySplatPass;
-pub use passes::temporal::{
-    expires_at, Lifespans, TemporalInputs, TemporalJob, TemporalPass, TemporalVariant,
-};
-pub use scene::env_map::{gpu_alias, texel_solid_angle, EnvMap};
+pub use passes::aov::{render_aovs, Aovs};
+pub use scene::env_map::EnvMap;
 pub use scene::upload::vulkan_clip_from_view;
-pub use scene::{GpuScene, UploadStats, REFITS_PER_REBUILD};
-pub use state::{IcState, RadianceBlock, RADIANCE_BYTES_PER_RECORD};
+pub use scene::{GpuScene, UploadStats};
+pub use state::IcState;
 pub use technique::{
     EmitterLight, EmitterShadows, GlossyLight, GlossySpacing, PathGridMode, SkyLight,
     SpecularPaths, SplatMode,

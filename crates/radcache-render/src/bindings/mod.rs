@@ -1,7 +1,7 @@
 //! The one owner of binding numbers and kinds. Bindings 0–15 are the scene's (every
 //! pass that reads the scene pushes the same table); the G-buffer's six images follow at
 //! [`PASS_BASE`] in the passes that read it; each pass's own bindings come next, declared once
-//! here by [`pass_bindings!`] as a named table. `cargo xtask codegen` writes every number to
+//! here by `pass_bindings!` (below) as a named table. `cargo xtask codegen` writes every number to
 //! `shaders/shared/bindings.glsl` as `B_<PASS>_<NAME>` (a test fails when it is stale), so no
 //! shader writes a binding number; `radcache-vk` checks at record time that each binding pushed
 //! has the declared kind and that none was left out.

@@ -6,7 +6,7 @@
 //!
 //! Bindings: the scene (0–15), the G-buffer (16–21), then from 22: the splat sum (Σw·Ẽ, Σw), the
 //! frame accumulator, the non-finite counter, the emission accumulator (read by
-//! [`crate::EmissionPass`], which adds the box-filtered emission), the debug accumulator and the
+//! [`crate::passes::emission::EmissionPass`], which adds the box-filtered emission), the debug accumulator and the
 //! splat record count, and with adaptive anti-aliasing the accumulator of squares
 //! (`IC_AA_MOMENTS`, [`CompositePass::read_moments`]), and the pixels' centre samples
 //! ([`CentreSamples`]: splatting once per frame). A non-finite value is replaced by 0 and

@@ -4,7 +4,7 @@
 //!
 //! Made to composite ([`DirectVariant::composite`], `DIRECT_COMPOSITE`), the pass can also add
 //! a sub-frame's samples to the frame's accumulators itself, against the centre samples of a
-//! splat made once per frame ([`crate::CentreSamples::Match`]), instead of writing the direct
+//! splat made once per frame ([`crate::passes::composite::CentreSamples::Match`]), instead of writing the direct
 //! image for [`CompositePass`]: the composite's own pass would load the G-buffer and that image
 //! again, which on lavapipe was half of its time (docs/cache-frame.md §6.5).
 
@@ -171,7 +171,7 @@ pub enum DirectOutputs<'a> {
     Image,
     /// A pass made to composite, with the composite's resources: with `sub_frame` the
     /// sub-frame's samples go to the frame's accumulators against the centre samples stored by
-    /// [`CompositePass`] at sub-frame 0 ([`crate::CentreSamples::Match`]), as the composite
+    /// [`CompositePass`] at sub-frame 0 ([`crate::passes::composite::CentreSamples::Match`]), as the composite
     /// pass would add them, and the direct image is left as it is; without it the pass writes
     /// the direct image as any other.
     Composited {
