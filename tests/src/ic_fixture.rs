@@ -5,7 +5,8 @@
 use glam::{DVec3, Mat3, Quat, Vec3};
 use radcache_render::{
     passes::direct::DirectInputs, passes::direct::DirectOutputs, passes::direct::DirectPass,
-    passes::gbuffer::GBuffer, passes::gbuffer::GBufferPass, EnvMap, GpuScene,
+    passes::gbuffer::GBuffer, passes::gbuffer::GBufferPass, passes::gbuffer::GBufferVariant,
+    EnvMap, GpuScene,
 };
 use radcache_scene::writer::{GltfBuilder, MaterialDesc, NodeDesc, PrimitiveDesc};
 use radcache_scene::Scene;
@@ -117,8 +118,12 @@ impl Gpu {
         gpu.record_update(&ctx, &mut rec).unwrap();
         ctx.submit(rec).unwrap().wait().unwrap();
         let gbuffer = GBuffer::new(&ctx, size.0, size.1).unwrap();
-        let traced = traced.unwrap_or(gpu.plan().traced_gbuffer);
-        let pass = GBufferPass::with_method(&ctx, &shaders, &gpu, traced).unwrap();
+        let variant = match traced {
+            None => GBufferVariant::planned(gpu.plan()),
+            Some(true) => GBufferVariant::Traced,
+            Some(false) => GBufferVariant::Rasterized,
+        };
+        let pass = GBufferPass::new(&ctx, &shaders, &gpu, variant).unwrap();
         Gpu {
             ctx,
             shaders,

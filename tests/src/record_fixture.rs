@@ -12,7 +12,7 @@ use radcache_cache::sampling::{
 use radcache_render::{
     passes::gbuffer::GBuffer, passes::record::record_seed, passes::record::RecordInputs,
     passes::record::RecordJob, passes::record::RecordOutputs, passes::record::RecordPass,
-    passes::record::R_EPS_REL, GpuScene, IcState,
+    passes::record::R_EPS_REL, state::IcStateDesc, GpuScene, IcState,
 };
 use radcache_scene::Scene;
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
@@ -70,7 +70,7 @@ pub fn fixture(scene: &Scene) -> Fixture {
     Fixture {
         fill: gbuffer_fill_pipeline(&ctx, &shaders),
         gbuffer: GBuffer::new(&ctx, W, H).unwrap(),
-        state: IcState::new(&ctx, &shaders, 64, 64).unwrap(),
+        state: IcState::new(&ctx, &shaders, &IcStateDesc::new(64, 64)).unwrap(),
         r_eps: R_EPS_REL * gpu.constants().camera_position[3],
         tris,
         gpu,

@@ -15,7 +15,8 @@ use radcache_cache::{luminance_rec709, ErrorControl, IcParams, IC_FAR};
 use radcache_render::{
     passes::gbuffer::GBuffer, passes::record::record_seed, passes::record::RecordInputs,
     passes::record::RecordJob, passes::record::RecordOutputs, passes::record::RecordPass,
-    passes::record::RecordVariant, passes::record::R_EPS_REL, GpuScene, IcState, SkyLight,
+    passes::record::RecordVariant, passes::record::R_EPS_REL, state::IcStateDesc, GpuScene,
+    IcState, SkyLight,
 };
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::geometry::intersect;
@@ -42,7 +43,7 @@ fn hessian_records_match_the_cpu_twin() {
     gpu.set_view(&view, W, H, 0, 0).unwrap();
     let fill = gbuffer_fill_pipeline(&ctx, &shaders);
     let gbuffer = GBuffer::new(&ctx, W, H).unwrap();
-    let state = IcState::new(&ctx, &shaders, 64, 64).unwrap();
+    let state = IcState::new(&ctx, &shaders, &IcStateDesc::new(64, 64)).unwrap();
     let r_eps = R_EPS_REL * gpu.constants().camera_position[3];
     let mut tris = Vec::new();
     for (inst, m) in scene.instances.iter().zip(scene.instance_transforms(0.0)) {

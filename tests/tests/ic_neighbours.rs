@@ -5,7 +5,10 @@
 
 use glam::Vec3;
 use radcache_cache::radius::neighbour_clamp;
-use radcache_render::{passes::neighbours::NeighbourPass, IcState};
+use radcache_render::{
+    passes::neighbours::NeighbourJob, passes::neighbours::NeighbourPass, state::IcStateDesc,
+    IcState,
+};
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::{context, finish, shaders, Rng};
 use radcache_vk::{Access, Recorder};
@@ -104,7 +107,7 @@ fn the_hash_grid_gives_the_all_pairs_clamp() {
             record(p, if k < base { r.min(hi) } else { r }, hi)
         })
         .collect();
-    let state = IcState::new(&ctx, &shaders, 4096, 1024).unwrap();
+    let state = IcState::new(&ctx, &shaders, &IcStateDesc::new(4096, 1024)).unwrap();
     let pass = NeighbourPass::new(&ctx, &shaders).unwrap();
     let counters = IcCounters {
         record_count: n as u32,
@@ -124,8 +127,10 @@ fn the_hash_grid_gives_the_all_pairs_clamp() {
     let clamp = |records: &[GpuRecord]| -> (Vec<GpuRecord>, u32) {
         let mut rec = ctx.begin("test.grid").unwrap();
         upload(&mut rec, &state, records, counters);
-        pass.record_rebuild(&mut rec, &state, SCENE_SCALE).unwrap();
-        pass.record(&mut rec, &state, SCENE_SCALE).unwrap();
+        pass.record(&mut rec, &state, SCENE_SCALE, NeighbourJob::Rebuild)
+            .unwrap();
+        pass.record(&mut rec, &state, SCENE_SCALE, NeighbourJob::Batch)
+            .unwrap();
         ctx.submit(rec).unwrap().wait().unwrap();
         let out = ctx.read_buffer(&state.records, n).unwrap();
         (out, state.read_counters().unwrap().radii_shrunk)

@@ -6,9 +6,9 @@ use glam::Vec3;
 use radcache_cache::{extrapolate_irradiance, record_weight, IcParams, WeightKind, WeightRecord};
 use radcache_render::{
     passes::gbuffer::GBuffer, passes::holes::HolePass, passes::holes::HoleSelection,
-    passes::neighbours::NeighbourPass, passes::splat::SplatDraw, passes::splat::SplatInputs,
-    passes::splat::SplatOutput, passes::splat::SplatPass, passes::splat::SplatWeights, GpuScene,
-    IcState,
+    passes::neighbours::NeighbourJob, passes::neighbours::NeighbourPass, passes::splat::SplatDraw,
+    passes::splat::SplatInputs, passes::splat::SplatOutput, passes::splat::SplatPass,
+    passes::splat::SplatWeights, state::IcStateDesc, GpuScene, IcState,
 };
 use radcache_scene::{LoadOptions, Scene};
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
@@ -142,7 +142,7 @@ fn fixture() -> Fixture {
     gpu.set_view(&scene.camera_at(0.0), W, H, 1, 0).unwrap();
     let gbuffer = GBuffer::new(&ctx, W, H).unwrap();
     let splat = SplatPass::new(&ctx, &shaders, W, H).unwrap();
-    let state = IcState::new(&ctx, &shaders, 64, 1024).unwrap();
+    let state = IcState::new(&ctx, &shaders, &IcStateDesc::new(64, 1024)).unwrap();
     Fixture {
         ctx,
         gpu,
@@ -245,7 +245,7 @@ fn splat_quads_cover_every_pixel_of_each_zone() {
     let (w, h) = (96, 72);
     let gpu = Gpu::with_gbuffer(&scene, None, (w, h), Some(false));
     let splat = SplatPass::new(&gpu.ctx, &gpu.shaders, w, h).unwrap();
-    let state = IcState::new(&gpu.ctx, &gpu.shaders, 64, 1024).unwrap();
+    let state = IcState::new(&gpu.ctx, &gpu.shaders, &IcStateDesc::new(64, 1024)).unwrap();
     gpu.render([0.0, 0.0], None);
     let g = gpu.read_gbuffer();
     let params = IcParams::default();
@@ -475,8 +475,10 @@ fn neighbour_clamping_shrinks_radii_to_neighbour_plus_distance() {
     c.dispatch.x = 2; // records 1 and 2 are the new batch
     let mut rec = f.ctx.begin("test.neighbours").unwrap();
     set_state(&mut rec, &f.state, &recs, c);
-    pass.record_rebuild(&mut rec, &f.state, 200.0).unwrap();
-    pass.record(&mut rec, &f.state, 200.0).unwrap();
+    pass.record(&mut rec, &f.state, 200.0, NeighbourJob::Rebuild)
+        .unwrap();
+    pass.record(&mut rec, &f.state, 200.0, NeighbourJob::Batch)
+        .unwrap();
     f.ctx.submit(rec).unwrap().wait().unwrap();
     let out: Vec<GpuRecord> = f.ctx.read_buffer(&f.state.records, 4).unwrap();
     let r: Vec<f32> = out.iter().map(|r| r.normal_rorig[3]).collect();

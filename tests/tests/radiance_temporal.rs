@@ -12,7 +12,9 @@ use glam::Vec3;
 use radcache_cache::cache_file::{CacheFile, CacheIdentity, CacheSettings};
 use radcache_cache::IcParams;
 use radcache_image::{compare, Image};
-use radcache_render::{state::RadianceBlock, FrameOutput, GpuScene, IcRenderer, IcState};
+use radcache_render::{
+    state::IcStateDesc, state::RadianceBlock, FrameOutput, GpuScene, IcRenderer, IcState,
+};
 use radcache_scene::Scene;
 use radcache_shared::gpu::{GpuRecord, GpuRecordTemporal};
 use radcache_tests::ic_fixture::sequence_settings;
@@ -42,7 +44,15 @@ fn block(i: u32) -> RadianceBlock {
 #[test]
 fn compaction_moves_each_radiance_block_with_its_record() {
     let (ctx, shaders) = (context(), shaders());
-    let state = IcState::with_radiance(&ctx, &shaders, 16, 16, true).unwrap();
+    let state = IcState::new(
+        &ctx,
+        &shaders,
+        &IcStateDesc {
+            radiance: true,
+            ..IcStateDesc::new(16, 16)
+        },
+    )
+    .unwrap();
     let n = 10u32;
     let records: Vec<GpuRecord> = (0..n)
         .map(|i| {
@@ -76,7 +86,7 @@ fn compaction_moves_each_radiance_block_with_its_record() {
     // Too many blocks, or blocks for a cache without them, are refused.
     let too_many: Vec<RadianceBlock> = (0..17).map(block).collect();
     assert!(state.upload_radiance(&ctx, &too_many).is_err());
-    let plain = IcState::new(&ctx, &shaders, 16, 16).unwrap();
+    let plain = IcState::new(&ctx, &shaders, &IcStateDesc::new(16, 16)).unwrap();
     let err = plain.upload_radiance(&ctx, &blocks).unwrap_err();
     assert!(err.to_string().contains("radiance"), "{err}");
     assert!(plain.download_radiance(&ctx).unwrap().is_empty());

@@ -19,7 +19,7 @@ use crate::frame::settings::{
 use crate::passes::composite::{CompositePass, CompositeVariant};
 use crate::passes::direct::{DirectCompositing, DirectPass, DirectShadows, DirectVariant};
 use crate::passes::emission::EmissionPass;
-use crate::passes::gbuffer::{GBuffer, GBufferPass};
+use crate::passes::gbuffer::{GBuffer, GBufferPass, GBufferVariant};
 use crate::passes::holes::HolePass;
 use crate::passes::neighbours::NeighbourPass;
 use crate::passes::record::{RecordPass, RecordVariant};
@@ -27,7 +27,7 @@ use crate::passes::splat::SplatPass;
 use crate::passes::splat_glossy::GlossySplatPass;
 use crate::passes::temporal::{TemporalPass, TemporalVariant};
 use crate::scene::GpuScene;
-use crate::state::IcState;
+use crate::state::{IcState, IcStateDesc};
 
 mod anti_alias;
 mod cache;
@@ -121,7 +121,7 @@ impl IcRenderer {
             height: h,
             params,
             gbuffer: GBuffer::new(ctx, w, h)?,
-            gbuffer_pass: GBufferPass::new(ctx, shaders, gpu)?,
+            gbuffer_pass: GBufferPass::new(ctx, shaders, gpu, GBufferVariant::planned(gpu.plan()))?,
             // Splatting once, the later sub-frames' composite is the direct pass's.
             direct: DirectPass::new(
                 ctx,
@@ -171,7 +171,14 @@ impl IcRenderer {
                 },
             )?,
             emission: EmissionPass::new(ctx, shaders, gpu)?,
-            state: IcState::with_radiance(ctx, shaders, capacity, w * h, radiance)?,
+            state: IcState::new(
+                ctx,
+                shaders,
+                &IcStateDesc {
+                    radiance,
+                    ..IcStateDesc::new(capacity, w * h)
+                },
+            )?,
             temporal: if temporal {
                 let variant = TemporalVariant {
                     record_capacity: capacity,

@@ -29,6 +29,7 @@ use crate::bindings::SCENE;
 use crate::error::Result;
 use crate::scene::features::{SceneFeatures, ShaderModule};
 use crate::scene::GpuScene;
+use radcache_scene::ScenePlan;
 
 mod images;
 
@@ -44,6 +45,28 @@ radcache_shared::gpu_struct! {
         pub repair_stage: u32 => "uint",
         /// Jitter.
         pub jitter: [f32; 2] => "vec2",
+    }
+}
+
+/// How the G-buffer is made: what the G-buffer pass is compiled for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GBufferVariant {
+    /// One camera ray per pixel (`gbuffer.comp`).
+    Traced,
+    /// The triangles rasterized (`gbuffer.vert` and `.frag`), then the samples behind a
+    /// surface edge traced (`gbuffer.comp` with `GBUFFER_REPAIR`).
+    Rasterized,
+}
+
+impl GBufferVariant {
+    /// As `plan` chooses ([`ScenePlan::traced_gbuffer`]: traced from
+    /// [`radcache_scene::plan::TRACED_GBUFFER_MIN_TRIANGLES`] instanced triangles).
+    pub fn planned(plan: &ScenePlan) -> GBufferVariant {
+        if plan.traced_gbuffer {
+            GBufferVariant::Traced
+        } else {
+            GBufferVariant::Rasterized
+        }
     }
 }
 
@@ -65,19 +88,12 @@ impl std::fmt::Debug for GBufferPass {
 }
 
 impl GBufferPass {
-    /// Compiles the pass for `scene`'s plan (traced or rasterized) and materials (metallic and
-    /// roughness are stored only where some material is not Lambertian; the rasterization
-    /// carries tangents only where some primitive has a normal map).
-    pub fn new(ctx: &Context, shaders: &ShaderCompiler, scene: &GpuScene) -> Result<GBufferPass> {
-        Self::with_method(ctx, shaders, scene, scene.plan().traced_gbuffer)
-    }
-
-    /// The shader modules the pass compiles for a scene with `features`, `traced` or
-    /// rasterized: the traced G-buffer's compute shader; or the repair's compute shader and
-    /// the rasterizer's vertex and fragment shaders.
-    pub(crate) fn modules(features: &SceneFeatures, traced: bool) -> Vec<ShaderModule> {
+    /// The shader modules the pass compiles for a scene with `features` and `variant`: the
+    /// traced G-buffer's compute shader; or the repair's compute shader and the rasterizer's
+    /// vertex and fragment shaders.
+    pub(crate) fn modules(features: &SceneFeatures, variant: GBufferVariant) -> Vec<ShaderModule> {
         let defines = features.material_defines();
-        if traced {
+        if variant == GBufferVariant::Traced {
             return vec![ShaderModule::new("passes/gbuffer.comp", defines)];
         }
         let mut repair = defines.clone();
@@ -89,14 +105,17 @@ impl GBufferPass {
         ]
     }
 
-    /// As [`GBufferPass::new`], traced or rasterized as `traced` says whatever the plan.
-    pub fn with_method(
+    /// Compiles the pass as `variant` ([`GBufferVariant::planned`] for the scene's plan) for
+    /// `scene`'s materials (metallic and roughness are stored only where some material is not
+    /// Lambertian; the rasterization carries tangents only where some primitive has a normal
+    /// map).
+    pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
-        traced: bool,
+        variant: GBufferVariant,
     ) -> Result<GBufferPass> {
-        let modules = Self::modules(&scene.features(), traced);
+        let modules = Self::modules(&scene.features(), variant);
         let compute = |name: &str, module: &ShaderModule| -> Result<Pipeline> {
             let spirv = module.compile(shaders)?;
             Ok(Pipeline::compute(
@@ -107,7 +126,7 @@ impl GBufferPass {
                 std::mem::size_of::<GBufferPush>() as u32,
             )?)
         };
-        if traced {
+        if variant == GBufferVariant::Traced {
             return Ok(GBufferPass {
                 pipeline: compute("gbuffer", &modules[0])?,
                 repair: None,

@@ -84,8 +84,11 @@ pub fn every_shader_module() -> Vec<ShaderModule> {
             };
             modules.extend(composite::CompositePass::modules(f, &variant));
         }
-        for traced in bools {
-            modules.extend(gbuffer::GBufferPass::modules(f, traced));
+        for variant in [
+            gbuffer::GBufferVariant::Traced,
+            gbuffer::GBufferVariant::Rasterized,
+        ] {
+            modules.extend(gbuffer::GBufferPass::modules(f, variant));
         }
         modules.extend(temporal::TemporalPass::modules(f));
         modules.extend(emission::EmissionPass::modules(f));

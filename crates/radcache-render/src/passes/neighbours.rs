@@ -26,6 +26,18 @@ radcache_shared::gpu_struct! {
 
 use radcache_shared::consts::NeighbourStep as Mode;
 
+/// What a neighbour dispatch does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NeighbourJob {
+    /// Rebuild the grid from every record outside the pending batch (the batch is inserted by
+    /// [`NeighbourJob::Batch`]); needed whenever records were added, moved or removed other than
+    /// through this pass, e.g. at the start of a frame.
+    Rebuild,
+    /// Clamp the new batch against every record (after `IcState::record_end_batch`): the
+    /// batch's radii are capped at their R⁺ and inserted into the grid, then clamped.
+    Batch,
+}
+
 /// The neighbour-clamping pipeline.
 pub struct NeighbourPass {
     pipeline: Pipeline,
@@ -85,39 +97,37 @@ impl NeighbourPass {
         });
     }
 
-    /// Records rebuilding the grid from every record outside the pending batch (the batch is
-    /// inserted by [`NeighbourPass::record`]); needed whenever records were added, moved or
-    /// removed other than through this pass, e.g. at the start of a frame. `scene_scale` must be
-    /// the one later batches use.
-    pub fn record_rebuild(
+    /// Records `job` against `state`'s records, `scene_scale` the scene's (the same for a
+    /// rebuild and the batches after it).
+    pub fn record(
         &self,
         rec: &mut Recorder,
         state: &IcState,
         scene_scale: f32,
+        job: NeighbourJob,
     ) -> Result<()> {
-        rec.barrier(Access::ALL_WRITES, Access::TRANSFER_WRITE);
-        rec.fill_buffer(&state.grid_heads, 0, vk::WHOLE_SIZE, 0);
-        rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
-        rec.pass("neighbours.grid", |rec| -> Result<()> {
-            self.bind(rec, state, Mode::InsertOld, scene_scale);
-            rec.dispatch(state.record_capacity().div_ceil(64).max(1), 1, 1)?;
-            Ok(())
-        })?;
-        rec.barrier(Access::COMPUTE_WRITE, Access::ALL);
-        Ok(())
-    }
-
-    /// Records clamping the new batch against every record (after `IcState::record_end_batch`):
-    /// the batch's radii are capped at their R⁺ and inserted into the grid, then clamped.
-    pub fn record(&self, rec: &mut Recorder, state: &IcState, scene_scale: f32) -> Result<()> {
-        rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
-        rec.pass("neighbours", |rec| {
-            self.bind(rec, state, Mode::InsertBatch, scene_scale);
-            rec.dispatch_indirect(&state.counters, 16);
-            rec.barrier(Access::COMPUTE_WRITE, Access::COMPUTE_READ_WRITE);
-            self.bind(rec, state, Mode::Clamp, scene_scale);
-            rec.dispatch_indirect(&state.counters, 16);
-        });
+        match job {
+            NeighbourJob::Rebuild => {
+                rec.barrier(Access::ALL_WRITES, Access::TRANSFER_WRITE);
+                rec.fill_buffer(&state.grid_heads, 0, vk::WHOLE_SIZE, 0);
+                rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
+                rec.pass("neighbours.grid", |rec| -> Result<()> {
+                    self.bind(rec, state, Mode::InsertOld, scene_scale);
+                    rec.dispatch(state.record_capacity().div_ceil(64).max(1), 1, 1)?;
+                    Ok(())
+                })?;
+            }
+            NeighbourJob::Batch => {
+                rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
+                rec.pass("neighbours", |rec| {
+                    self.bind(rec, state, Mode::InsertBatch, scene_scale);
+                    rec.dispatch_indirect(&state.counters, 16);
+                    rec.barrier(Access::COMPUTE_WRITE, Access::COMPUTE_READ_WRITE);
+                    self.bind(rec, state, Mode::Clamp, scene_scale);
+                    rec.dispatch_indirect(&state.counters, 16);
+                });
+            }
+        }
         rec.barrier(Access::COMPUTE_WRITE, Access::ALL);
         Ok(())
     }

@@ -128,7 +128,7 @@ impl GlossySplatPass {
 
     /// Records the glossy splat of every record with `weights` (the final splat's, without
     /// marking), after the direct pass wrote the pixels' world weights; `state` must hold
-    /// radiance blocks ([`IcState::with_radiance`]).
+    /// radiance blocks ([`crate::state::IcStateDesc::radiance`]).
     pub fn record(
         &self,
         rec: &mut Recorder,

@@ -51,10 +51,33 @@ pub struct IcState {
     pub temporal: Buffer,
     /// `RadianceBlock[record_capacity]`: each record's radiance coefficients and their
     /// gradients (docs/radiance-caching.md §7.2; the record pass writes them, the glossy splat
-    /// reads them), in scenes with glossy lobes from the cache ([`IcState::with_radiance`]).
+    /// reads them), in scenes with glossy lobes from the cache ([`IcStateDesc::radiance`]).
     pub radiance: Option<Buffer>,
     record_capacity: u32,
     request_capacity: u32,
+}
+
+/// What [`IcState::new`] allocates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct IcStateDesc {
+    /// Room for this many records.
+    pub record_capacity: u32,
+    /// Room for this many pixel requests per batch.
+    pub request_capacity: u32,
+    /// Also a radiance block per record ([`IcState::radiance`]).
+    pub radiance: bool,
+}
+
+impl IcStateDesc {
+    /// Room for `record_capacity` records and `request_capacity` requests per batch, without
+    /// radiance blocks.
+    pub fn new(record_capacity: u32, request_capacity: u32) -> IcStateDesc {
+        IcStateDesc {
+            record_capacity,
+            request_capacity,
+            radiance: false,
+        }
+    }
 }
 
 impl std::fmt::Debug for IcState {
@@ -67,24 +90,13 @@ impl std::fmt::Debug for IcState {
 }
 
 impl IcState {
-    /// Allocates room for `record_capacity` records and `request_capacity` requests per batch.
-    pub fn new(
-        ctx: &Context,
-        shaders: &ShaderCompiler,
-        record_capacity: u32,
-        request_capacity: u32,
-    ) -> Result<IcState> {
-        Self::with_radiance(ctx, shaders, record_capacity, request_capacity, false)
-    }
-
-    /// As [`IcState::new`]; with `radiance` also a radiance block per record.
-    pub fn with_radiance(
-        ctx: &Context,
-        shaders: &ShaderCompiler,
-        record_capacity: u32,
-        request_capacity: u32,
-        radiance: bool,
-    ) -> Result<IcState> {
+    /// Allocates the state `desc` describes.
+    pub fn new(ctx: &Context, shaders: &ShaderCompiler, desc: &IcStateDesc) -> Result<IcState> {
+        let IcStateDesc {
+            record_capacity,
+            request_capacity,
+            radiance,
+        } = *desc;
         let bookkeeping = IcCountersPass::new(ctx, shaders)?;
         let buffer = |name, size: u64, usage, location| {
             Buffer::new(

@@ -17,6 +17,7 @@ use crate::frame::settings::{sub_frame_jitter, IcSettings, IcStats, SplatMode};
 use crate::passes::composite::{CentreSamples, CompositeInputs};
 use crate::passes::direct::{CompositeSubFrame, CompositeTargets, DirectInputs, DirectOutputs};
 use crate::passes::holes::HoleSelection;
+use crate::passes::neighbours::NeighbourJob;
 use crate::passes::record::{creation_seed, RecordInputs, RecordJob, RecordOutputs};
 use crate::passes::splat::{SplatDraw, SplatInputs, SplatOutput, SplatScope, SplatWeights};
 use crate::passes::temporal::{expires_at, TemporalInputs, TemporalJob};
@@ -168,8 +169,9 @@ impl IcRenderer {
                 t.record(&mut rec, &io, job)?;
             }
         }
+        let scale = gpu.scene_scale();
         self.neighbours
-            .record_rebuild(&mut rec, &self.state, gpu.scene_scale())?;
+            .record(&mut rec, &self.state, scale, NeighbourJob::Rebuild)?;
         self.composite.record_clear(&mut rec);
         run.clock.submit(ctx, rec)?;
         run.stats.records_kept = u64::from(self.state.read_counters()?.record_count);
@@ -311,8 +313,9 @@ impl IcRenderer {
             };
             self.records.record(&mut rec, &inputs, &outputs)?;
             self.state.record_end_batch(&mut rec)?;
+            let scale = gpu.scene_scale();
             self.neighbours
-                .record(&mut rec, &self.state, gpu.scene_scale())?;
+                .record(&mut rec, &self.state, scale, NeighbourJob::Batch)?;
             run.clock.submit(ctx, rec)?;
             let created_s = creation_start.elapsed().as_secs_f64();
             run.stats.record_pass_s += created_s;
