@@ -5,12 +5,12 @@
 
 use radcache_render::{
     frame::settings::sub_frame_jitter, passes::composite::CentreSamples,
-    passes::composite::CompositeInputs, passes::composite::CompositePass,
-    passes::composite::CompositeVariant, passes::direct::CompositeSubFrame,
-    passes::direct::CompositeTargets, passes::direct::DirectCompositing,
-    passes::direct::DirectInputs, passes::direct::DirectOutputs, passes::direct::DirectPass,
-    passes::direct::DirectShadows, passes::direct::DirectVariant, passes::splat::SplatPass,
-    EmitterLight, SkyLight,
+    passes::composite::CompositeInputs, passes::composite::CompositeJob,
+    passes::composite::CompositePass, passes::composite::CompositeVariant,
+    passes::direct::CompositeSubFrame, passes::direct::CompositeTargets,
+    passes::direct::DirectCompositing, passes::direct::DirectInputs, passes::direct::DirectOutputs,
+    passes::direct::DirectPass, passes::direct::DirectShadows, passes::direct::DirectVariant,
+    passes::splat::SplatPass, EmitterLight, SkyLight,
 };
 use radcache_tests::ic_fixture::{cornell, Gpu};
 use radcache_vk::ImageUse;
@@ -70,7 +70,7 @@ fn the_direct_pass_composites_as_the_composite_pass() {
         }
         for (i, (direct, composite)) in passes.iter().enumerate() {
             if k == 0 {
-                composite.record_clear(&mut rec);
+                composite.record(&mut rec, CompositeJob::Clear).unwrap();
             }
             let fused = k > 0 && i == 0;
             let outputs = DirectOutputs::Composited {
@@ -92,7 +92,9 @@ fn the_direct_pass_composites_as_the_composite_pass() {
                     centre,
                     ..CompositeInputs::own(&gpu.scene, g, &splat, jitter)
                 };
-                composite.record(&mut rec, &inputs).unwrap();
+                composite
+                    .record(&mut rec, CompositeJob::Add(&inputs))
+                    .unwrap();
             }
         }
         ctx.submit(rec).unwrap().wait().unwrap();

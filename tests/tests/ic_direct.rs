@@ -6,9 +6,10 @@ use std::f64::consts::PI;
 
 use glam::{DVec3, Quat, Vec3};
 use radcache_render::{
-    passes::composite::CompositeInputs, passes::composite::CompositePass,
-    passes::composite::CompositeVariant, passes::direct::DirectPass, passes::direct::DirectVariant,
-    passes::emission::EmissionPass, passes::splat::SplatPass, EmitterLight, EnvMap, SkyLight,
+    passes::composite::CompositeInputs, passes::composite::CompositeJob,
+    passes::composite::CompositePass, passes::composite::CompositeVariant,
+    passes::direct::DirectPass, passes::direct::DirectVariant, passes::emission::EmissionPass,
+    passes::splat::SplatPass, EmitterLight, EnvMap, SkyLight,
 };
 use radcache_scene::light::LightKind;
 use radcache_scene::writer::{GltfBuilder, LightDesc, MaterialDesc, NodeDesc};
@@ -307,14 +308,16 @@ fn composite_sums_direct_indirect_emission_and_environment() {
     let sub_frame = |sum: Px, clear: bool| {
         let mut rec = ctx.begin("test.composite").unwrap();
         if clear {
-            composite.record_clear(&mut rec);
+            composite.record(&mut rec, CompositeJob::Clear).unwrap();
         }
         for (image, value) in [(&splat.sum, sum), (&splat.count, [0.0; 4])] {
             rec.use_image(image, ImageUse::TransferDst);
             rec.clear_color(image, value);
         }
         let inputs = CompositeInputs::own(&gpu.scene, &gpu.gbuffer, &splat, jitter);
-        composite.record(&mut rec, &inputs).unwrap();
+        composite
+            .record(&mut rec, CompositeJob::Add(&inputs))
+            .unwrap();
         names(&ctx.submit(rec).unwrap().wait().unwrap())
     };
     // No record reaches any pixel (Σw = 0: no indirect light), then Ẽ = (1, 2, 3) everywhere.

@@ -9,7 +9,7 @@ use radcache_vk::{Context, ShaderCompiler};
 use crate::error::{Error, Result};
 use crate::frame::clock::{FrameClock, Span};
 use crate::passes::aov::{AovPass, Aovs};
-use crate::passes::path_trace::PathTracer;
+use crate::passes::path_trace::{PathTraceJob, PathTracer};
 use crate::scene::GpuScene;
 
 /// When to stop sampling.
@@ -143,7 +143,7 @@ fn path_setup(
     };
     let mut rec = ctx.begin("frame.setup")?;
     gpu.record_update(ctx, &mut rec)?;
-    tracer.record_clear(&mut rec);
+    tracer.record(&mut rec, PathTraceJob::Clear)?;
     if let Some(pass) = &aov_pass {
         pass.record(&mut rec, gpu)?;
     }
@@ -182,7 +182,7 @@ fn path_sample(
     while tracer.samples() < target {
         let count = chunk.min(target - tracer.samples());
         let mut rec = ctx.begin("frame.path_trace")?;
-        tracer.record_samples(&mut rec, gpu, count)?;
+        tracer.record(&mut rec, PathTraceJob::Samples { scene: gpu, count })?;
         let submitted = Instant::now();
         let timings = ctx.submit(rec)?.wait()?;
         let gpu_ms: f64 = timings.iter().map(|t| t.duration_ms).sum();

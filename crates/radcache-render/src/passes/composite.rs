@@ -129,6 +129,18 @@ impl CompositeVariant {
     }
 }
 
+/// What a composite recording does.
+#[derive(Debug, Clone, Copy)]
+pub enum CompositeJob<'a> {
+    /// Zero the accumulators and the non-finite counter (the start of a frame).
+    Clear,
+    /// Add the sub-frame rendered with the inputs' jitter to the accumulator: with
+    /// `glossy`, the glossy target's `rgb/a` where its weight is positive; `centre` says whose
+    /// samples the splat targets hold (anything but [`CentreSamples::Own`] needs a pass made
+    /// with `centres`).
+    Add(&'a CompositeInputs<'a>),
+}
+
 /// What one composite dispatch reads: the G-buffer's samples, the splat's targets, and the
 /// sub-frame's parameters.
 #[derive(Debug, Clone, Copy)]
@@ -242,20 +254,20 @@ impl CompositePass {
         })
     }
 
-    /// Records zeroing the accumulator and the non-finite counter.
-    pub fn record_clear(&self, rec: &mut Recorder) {
-        rec.fill_buffer(&self.accum, 0, vk::WHOLE_SIZE, 0);
-        rec.fill_buffer(&self.emission_accum, 0, vk::WHOLE_SIZE, 0);
-        rec.fill_buffer(&self.debug_accum, 0, vk::WHOLE_SIZE, 0);
-        rec.fill_buffer(&self.nonfinite, 0, vk::WHOLE_SIZE, 0);
-        rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
-    }
-
-    /// Records adding the sub-frame rendered with `inputs.jitter` to the accumulator: with
-    /// `inputs.glossy`, the glossy target's `rgb/a` is added where its weight is positive;
-    /// `inputs.centre` says whose samples the splat targets hold (anything but
-    /// [`CentreSamples::Own`] needs a pass made with `centres`).
-    pub fn record(&self, rec: &mut Recorder, inputs: &CompositeInputs<'_>) -> Result<()> {
+    /// Records `job`: zeroing the accumulators and the non-finite counter, or adding a
+    /// sub-frame.
+    pub fn record(&self, rec: &mut Recorder, job: CompositeJob<'_>) -> Result<()> {
+        let inputs = match job {
+            CompositeJob::Clear => {
+                rec.fill_buffer(&self.accum, 0, vk::WHOLE_SIZE, 0);
+                rec.fill_buffer(&self.emission_accum, 0, vk::WHOLE_SIZE, 0);
+                rec.fill_buffer(&self.debug_accum, 0, vk::WHOLE_SIZE, 0);
+                rec.fill_buffer(&self.nonfinite, 0, vk::WHOLE_SIZE, 0);
+                rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
+                return Ok(());
+            }
+            CompositeJob::Add(inputs) => inputs,
+        };
         let CompositeInputs {
             scene,
             gbuffer,

@@ -43,6 +43,20 @@ pub struct PathTracer {
     samples: u32,
 }
 
+/// What a path-tracer recording does.
+#[derive(Debug, Clone, Copy)]
+pub enum PathTraceJob<'a> {
+    /// Clear the accumulators (the start of a new image).
+    Clear,
+    /// `count` more samples per pixel of `scene` (one dispatch) in a pass named `path_trace`.
+    Samples {
+        /// The scene.
+        scene: &'a GpuScene,
+        /// Samples per pixel to add.
+        count: u32,
+    },
+}
+
 impl std::fmt::Debug for PathTracer {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("PathTracer")
@@ -117,21 +131,18 @@ impl PathTracer {
         self.samples
     }
 
-    /// Records clearing the accumulators (start of a new image).
-    pub fn record_clear(&mut self, rec: &mut Recorder) {
-        rec.fill_buffer(&self.accum, 0, vk::WHOLE_SIZE, 0);
-        rec.fill_buffer(&self.compensation, 0, vk::WHOLE_SIZE, 0);
-        rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
-        self.samples = 0;
-    }
-
-    /// Records `count` more samples per pixel (one dispatch) in a pass named `path_trace`.
-    pub fn record_samples(
-        &mut self,
-        rec: &mut Recorder,
-        scene: &GpuScene,
-        count: u32,
-    ) -> Result<()> {
+    /// Records `job`: clearing the accumulators, or more samples.
+    pub fn record(&mut self, rec: &mut Recorder, job: PathTraceJob<'_>) -> Result<()> {
+        let (scene, count) = match job {
+            PathTraceJob::Clear => {
+                rec.fill_buffer(&self.accum, 0, vk::WHOLE_SIZE, 0);
+                rec.fill_buffer(&self.compensation, 0, vk::WHOLE_SIZE, 0);
+                rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
+                self.samples = 0;
+                return Ok(());
+            }
+            PathTraceJob::Samples { scene, count } => (scene, count),
+        };
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
         rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
         let push = PathTracePush {

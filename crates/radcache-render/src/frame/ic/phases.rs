@@ -14,7 +14,7 @@ use crate::error::Result;
 use crate::frame::clock::FrameClock;
 use crate::frame::path::{FrameOutput, Progress};
 use crate::frame::settings::{sub_frame_jitter, IcSettings, IcStats, SplatMode};
-use crate::passes::composite::{CentreSamples, CompositeInputs};
+use crate::passes::composite::{CentreSamples, CompositeInputs, CompositeJob};
 use crate::passes::direct::{CompositeSubFrame, CompositeTargets, DirectInputs, DirectOutputs};
 use crate::passes::holes::HoleSelection;
 use crate::passes::neighbours::NeighbourJob;
@@ -172,7 +172,7 @@ impl IcRenderer {
         let scale = gpu.scene_scale();
         self.neighbours
             .record(&mut rec, &self.state, scale, NeighbourJob::Rebuild)?;
-        self.composite.record_clear(&mut rec);
+        self.composite.record(&mut rec, CompositeJob::Clear)?;
         run.clock.submit(ctx, rec)?;
         run.stats.records_kept = u64::from(self.state.read_counters()?.record_count);
         run.clock.lap("setup");
@@ -422,7 +422,8 @@ impl IcRenderer {
                 centre,
                 debug,
             };
-            self.composite.record(&mut rec, &inputs)?;
+            self.composite
+                .record(&mut rec, CompositeJob::Add(&inputs))?;
         }
         run.clock.submit(ctx, rec)?;
         run.add_rays("direct", self.direct.rays()?);
