@@ -170,18 +170,23 @@ fn furnace_scene(le: f32) -> Scene {
     load(&radcache_scene::assets::write_furnace(&dir, 0.5, le).unwrap())
 }
 
-#[test]
-fn furnace_records_match_the_analytic_irradiance() {
-    let (albedo, le) = (0.5f32, 1.0f32);
-    let mut f = fixture(&furnace_scene(le));
-    let params = IcParams::draft();
-    let pass = RecordPass::new(
+/// The record pass for `f`'s scene with `params`, the sky through the records.
+fn record_pass(f: &Fixture, params: IcParams) -> RecordPass {
+    RecordPass::new(
         &f.ctx,
         &f.shaders,
         &f.gpu,
         &RecordVariant::new(params, SkyLight::Records),
     )
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn furnace_records_match_the_analytic_irradiance() {
+    let (albedo, le) = (0.5f32, 1.0f32);
+    let mut f = fixture(&furnace_scene(le));
+    let params = IcParams::draft();
+    let pass = record_pass(&f, params);
     let (m, n) = (params.strata_m, params.strata_n);
     // Shading normal tilted off the geometric one: some directions must be folded.
     let tilted = Vec3::new(0.6, 1.0, 0.0).normalize();
@@ -250,13 +255,7 @@ fn invalid_irradiance_background_and_overflow_are_guarded() {
     // Le = 1e36: every sample is finite (≈ 1e36) but their sum over the 12×36 strata overflows.
     let mut f = fixture(&furnace_scene(1e36));
     let params = IcParams::default();
-    let pass = RecordPass::new(
-        &f.ctx,
-        &f.shaders,
-        &f.gpu,
-        &RecordVariant::new(params, SkyLight::Records),
-    )
-    .unwrap();
+    let pass = record_pass(&f, params);
     let q = point(5, 5, Vec3::new(0.0, -1.0, 0.0), Vec3::Y);
     // Surface (overflows), background pixel, pixel past the image, and one request past the
     // capacity (base 2 + 3 records); one workgroup more than there are requests.
@@ -309,20 +308,8 @@ fn cornell_records_agree_with_an_independent_estimate() {
     let requests: Vec<u32> = points.iter().map(point_index).collect();
     let k = points.len() as u32;
     let (draft, fine) = (IcParams::draft(), IcParams::default());
-    let pass_a = RecordPass::new(
-        &f.ctx,
-        &f.shaders,
-        &f.gpu,
-        &RecordVariant::new(draft, SkyLight::Records),
-    )
-    .unwrap();
-    let pass_b = RecordPass::new(
-        &f.ctx,
-        &f.shaders,
-        &f.gpu,
-        &RecordVariant::new(fine, SkyLight::Records),
-    )
-    .unwrap();
+    let pass_a = record_pass(&f, draft);
+    let pass_b = record_pass(&f, fine);
     let c = counters(0, k, k, 64);
     let batch = Batch::new(&points, &requests, c);
     let a = run(&mut f, &pass_a, &batch, create(11, 1, 0));
