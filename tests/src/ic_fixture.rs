@@ -166,9 +166,6 @@ impl Gpu {
     ) -> (Vec<Px>, u64) {
         let mut rec = self.ctx.begin("test.direct").unwrap();
         // A read-back leaves the images in transfer layouts.
-        for image in self.gbuffer.images() {
-            rec.use_image(image, radcache_vk::ImageUse::ComputeStorage);
-        }
         let inputs = DirectInputs {
             scene: &self.scene,
             gbuffer: &self.gbuffer,
@@ -334,13 +331,9 @@ pub fn fill_gbuffer_points(
     texels: &radcache_vk::Buffer,
     count: u32,
 ) {
-    use radcache_vk::{ImageUse, Resource};
+    use radcache_vk::Resource;
     for image in g.images() {
-        rec.use_image(image, ImageUse::TransferDst);
         rec.clear_color(image, [0.0; 4]);
-    }
-    for image in [&g.position, &g.normal, &g.geometric, &g.emission] {
-        rec.use_image(image, ImageUse::ComputeStorage);
     }
     rec.bind_pipeline(fill);
     rec.push_bindings(&[

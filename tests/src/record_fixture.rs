@@ -16,7 +16,7 @@ use radcache_render::{
 };
 use radcache_scene::Scene;
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
-use radcache_vk::{vk, Access, Buffer, Context, Pipeline, ShaderCompiler};
+use radcache_vk::{vk, Buffer, Context, Pipeline, ShaderCompiler};
 
 use crate::geometry::intersect;
 use crate::ic_fixture::{fill_gbuffer_points, gbuffer_fill_pipeline, GbufferPoint};
@@ -158,7 +158,6 @@ pub fn run_with_radiance(
     rec.update_buffer(&st.requests, 0, requests);
     rec.update_buffer(&st.counters, 0, &[counters]);
     rec.update_buffer(&st.records, 0, &[sentinel(); SLOTS]);
-    rec.barrier(Access::ALL_WRITES, Access::ALL);
     let inputs = RecordInputs {
         scene: &f.gpu,
         gbuffer: g,

@@ -4,9 +4,9 @@
 use bytemuck::{Pod, Zeroable};
 use radcache_tests::{context, finish, init_log, shaders, Rng};
 use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, Blend, Buffer, BufferDesc, ColorTarget, Context,
-    ContextOptions, DepthState, DepthTarget, Error, GraphicsDesc, Image, ImageDesc, ImageUse,
-    MemoryLocation, Pipeline, Resource, ShaderCompiler,
+    vk, BindingKind, BindingLayout, Blend, Buffer, BufferDesc, ColorTarget, Context,
+    ContextOptions, DepthState, DepthTarget, Error, GraphicsDesc, Image, ImageDesc, MemoryLocation,
+    Pipeline, RenderTargets, Resource, ShaderCompiler,
 };
 
 #[repr(C)]
@@ -149,41 +149,39 @@ fn additive_splats_under_depth_test_sum_exactly() {
     };
 
     let mut rec = ctx.begin("test").unwrap();
-    rec.use_image(&accum, ImageUse::ColorAttachment);
-    rec.use_image(&depth, ImageUse::DepthAttachment);
     rec.pass("test.depth_prepass", |rec| {
-        rec.begin_rendering(
-            &[ColorTarget {
-                image: &accum,
-                clear: Some([0.0; 4]),
-            }],
-            Some(DepthTarget {
-                image: &depth,
-                clear: Some(1.0),
-            }),
-        );
         rec.bind_pipeline(&depth_pipe);
         rec.push_bindings(&[(0, Resource::Buffer(&prepass_buf))]);
         rec.push_constants(&push);
+        rec.begin_rendering(&RenderTargets {
+            colors: &[ColorTarget {
+                image: &accum,
+                clear: Some([0.0; 4]),
+            }],
+            depth: Some(DepthTarget {
+                image: &depth,
+                clear: Some(1.0),
+            }),
+            indirect: &[],
+        });
         rec.draw(6, 1);
         rec.end_rendering();
     });
-    rec.use_image(&depth, ImageUse::DepthAttachment);
-    rec.use_image(&accum, ImageUse::ColorAttachment);
     rec.pass("test.splat", |rec| {
-        rec.begin_rendering(
-            &[ColorTarget {
-                image: &accum,
-                clear: None,
-            }],
-            Some(DepthTarget {
-                image: &depth,
-                clear: None,
-            }),
-        );
         rec.bind_pipeline(&splat_pipe);
         rec.push_bindings(&[(0, Resource::Buffer(&quad_buf))]);
         rec.push_constants(&push);
+        rec.begin_rendering(&RenderTargets {
+            colors: &[ColorTarget {
+                image: &accum,
+                clear: None,
+            }],
+            depth: Some(DepthTarget {
+                image: &depth,
+                clear: None,
+            }),
+            indirect: &[],
+        });
         rec.draw(6, quads.len() as u32);
         rec.end_rendering();
     });
@@ -249,7 +247,6 @@ fn pass_scopes_give_named_positive_timings() {
                 });
                 rec.dispatch(1024, 1, 1).unwrap();
             });
-            rec.barrier(Access::COMPUTE_WRITE, Access::COMPUTE_WRITE);
         }
     });
     assert_eq!(rec.scope_names(), ["outer", "busy.a", "busy.b"]);

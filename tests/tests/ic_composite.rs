@@ -13,7 +13,6 @@ use radcache_render::{
     passes::splat::SplatPass, EmitterLight, SkyLight,
 };
 use radcache_tests::ic_fixture::{cornell, Gpu};
-use radcache_vk::ImageUse;
 
 /// The Cornell box at 48×40 (its closed-form emitter, adaptive shadows, the anti-aliasing
 /// moments): two direct passes made to composite, each with its own accumulators, shade the
@@ -65,7 +64,6 @@ fn the_direct_pass_composites_as_the_composite_pass() {
             .unwrap();
         if k == 0 {
             // Σw·Ẽ, Σw: every centre holds Ẽ = (0.5, 1, 1.5).
-            rec.use_image(&splat.sum, ImageUse::TransferDst);
             rec.clear_color(&splat.sum, [1.0, 2.0, 3.0, 2.0]);
         }
         for (i, (direct, composite)) in passes.iter().enumerate() {

@@ -19,7 +19,6 @@ use radcache_tests::ic_fixture::*;
 use radcache_tests::scenes::{
     camera_node, load, mean_se, pixel_to_ndc, plane_y, temp_dir, write_and_load,
 };
-use radcache_vk::ImageUse;
 
 const ALBEDO: [f32; 3] = [0.8, 0.5, 0.25];
 
@@ -311,7 +310,6 @@ fn composite_sums_direct_indirect_emission_and_environment() {
             composite.record(&mut rec, CompositeJob::Clear).unwrap();
         }
         for (image, value) in [(&splat.sum, sum), (&splat.count, [0.0; 4])] {
-            rec.use_image(image, ImageUse::TransferDst);
             rec.clear_color(image, value);
         }
         let inputs = CompositeInputs::own(&gpu.scene, &gpu.gbuffer, &splat, jitter);

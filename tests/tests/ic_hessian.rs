@@ -23,7 +23,7 @@ use radcache_tests::geometry::intersect;
 use radcache_tests::ic_fixture::{fill_gbuffer_points, gbuffer_fill_pipeline, GbufferPoint};
 use radcache_tests::scenes::load;
 use radcache_tests::{context, finish, shaders};
-use radcache_vk::{vk, Access};
+use radcache_vk::vk;
 
 const W: u32 = 32;
 const H: u32 = 32;
@@ -134,7 +134,6 @@ fn hessian_records_match_the_cpu_twin() {
         fill_gbuffer_points(&mut rec, &fill, &gbuffer, &texels, k);
         rec.update_buffer(&state.requests, 0, &requests);
         rec.update_buffer(&state.counters, 0, &[counters]);
-        rec.barrier(Access::ALL_WRITES, Access::ALL);
         let inputs = RecordInputs {
             scene: &gpu,
             gbuffer: &gbuffer,

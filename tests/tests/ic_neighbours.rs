@@ -11,7 +11,7 @@ use radcache_render::{
 };
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::{context, finish, shaders, Rng};
-use radcache_vk::{Access, Recorder};
+use radcache_vk::Recorder;
 
 const SCENE_SCALE: f32 = 20.0;
 
@@ -39,7 +39,6 @@ fn upload(rec: &mut Recorder, state: &IcState, records: &[GpuRecord], counters: 
         rec.update_buffer(&state.records, offset, chunk);
     }
     rec.update_buffer(&state.counters, 0, std::slice::from_ref(&counters));
-    rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
 }
 
 /// The all-pairs clamp of the batch `[base, n)` against every record, in rounds until nothing

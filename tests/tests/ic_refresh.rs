@@ -12,7 +12,7 @@ use radcache_render::{
 use radcache_shared::gpu::{DispatchArgs, GpuRecord, IcCounters};
 use radcache_tests::scenes::load;
 use radcache_tests::{context, finish, shaders};
-use radcache_vk::{Access, Context};
+use radcache_vk::Context;
 
 const SIZE: u32 = 48;
 const SEED: u32 = 5;
@@ -34,7 +34,6 @@ fn refresh(
     let mut rec = ctx.begin("test.refresh").unwrap();
     rec.update_buffer(&state.requests, 0, which);
     rec.update_buffer(&state.counters, 0, std::slice::from_ref(&c));
-    rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
     let inputs = RecordInputs {
         scene: gpu,
         gbuffer,

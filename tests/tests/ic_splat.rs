@@ -14,7 +14,7 @@ use radcache_scene::{LoadOptions, Scene};
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
 use radcache_tests::ic_fixture::Gpu;
 use radcache_tests::{context, finish, shaders, Rng};
-use radcache_vk::{Context, ImageUse, Recorder};
+use radcache_vk::{Context, Recorder};
 
 const W: u32 = 32;
 const H: u32 = 24;
@@ -81,7 +81,6 @@ fn fill_gbuffer(rec: &mut Recorder, g: &GBuffer) {
         [0.0; 4],
     ];
     for (image, value) in g.images().into_iter().zip(values) {
-        rec.use_image(image, ImageUse::TransferDst);
         rec.clear_color(image, value);
     }
 }
@@ -91,10 +90,6 @@ fn set_state(rec: &mut Recorder, state: &IcState, records: &[GpuRecord], counter
         rec.update_buffer(&state.records, 0, records);
     }
     rec.update_buffer(&state.counters, 0, std::slice::from_ref(&counters));
-    rec.barrier(
-        radcache_vk::Access::TRANSFER_WRITE,
-        radcache_vk::Access::ALL,
-    );
 }
 
 fn counters(records: u32, batch_base: u32) -> IcCounters {
@@ -279,9 +274,6 @@ fn splat_quads_cover_every_pixel_of_each_zone() {
     let splat_all = |output: SplatOutput| -> Vec<[f32; 4]> {
         let mut rec = gpu.ctx.begin("test.splat_bounds").unwrap();
         set_state(&mut rec, &state, &recs, counters(recs.len() as u32, 0));
-        for image in gpu.gbuffer.images() {
-            rec.use_image(image, ImageUse::ComputeStorage);
-        }
         let inputs = SplatInputs {
             scene: &gpu.scene,
             gbuffer: &gpu.gbuffer,

@@ -1,4 +1,6 @@
-//! `cargo xtask test`: the whole suite on lavapipe with the validation layer, as CI runs it.
+//! `cargo xtask test`: the whole suite on lavapipe with the validation layer and its
+//! synchronization validation (every derived barrier checked: a hazard is a validation error,
+//! which fails the test), as CI runs it.
 
 use std::process::Command;
 
@@ -13,7 +15,7 @@ pub fn run(extra: &[&str]) -> Result<()> {
     cmd.current_dir(crate::root())
         .args(["test", "--workspace", "--no-fail-fast"])
         .args(extra)
-        .env("RADCACHE_VALIDATION", "1");
+        .env("RADCACHE_VALIDATION", "sync");
     if std::env::var_os("VK_DRIVER_FILES").is_none() && std::path::Path::new(LVP_ICD).exists() {
         cmd.env("VK_DRIVER_FILES", LVP_ICD);
     }

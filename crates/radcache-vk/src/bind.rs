@@ -8,9 +8,11 @@ use bytemuck::Pod;
 
 use crate::buffer::Buffer;
 use crate::commands::Recorder;
+use crate::hazard::{Scope, Target, Use};
 use crate::image::{Image, Sampler};
 use crate::pipeline::{BindingKind, BindingLayout, Pipeline};
-use crate::state::{BoundPipeline, PushedImage};
+use crate::state::{BoundPipeline, Pushed};
+use crate::sync::Access;
 use crate::tlas::Tlas;
 
 /// A resource bound at a binding of the current pipeline.
@@ -22,7 +24,7 @@ pub enum Resource<'a> {
     BufferRange(&'a Buffer, u64, u64),
     /// A top-level acceleration structure.
     Tlas(&'a Tlas),
-    /// A storage image (in `GENERAL` layout: `ImageUse::ComputeStorage`/`FragmentStorage`).
+    /// A storage image (transitioned to `GENERAL` for the dispatch or draw).
     StorageImage(&'a Image),
     /// A sampled image with its sampler (in a read-only layout).
     Sampled(&'a Image, &'a Sampler),
@@ -142,6 +144,25 @@ impl Recorder {
                 .push_descriptor
                 .cmd_push_descriptor_set(self.cmd, bind_point, layout, 0, &writes)
         };
+        let bound = self.state.bound.as_ref().expect("checked above");
+        let graphics = bound.bind_point == vk::PipelineBindPoint::GRAPHICS;
+        let stage = if graphics {
+            vk::PipelineStageFlags2::VERTEX_SHADER | vk::PipelineStageFlags2::FRAGMENT_SHADER
+        } else {
+            vk::PipelineStageFlags2::COMPUTE_SHADER
+        };
+        let pushed: Vec<Pushed> = resources
+            .iter()
+            .zip(&layouts)
+            .filter_map(|((binding, res), l)| {
+                let writes = bound.written.contains(binding);
+                shader_use(res, l.kind, stage, writes).map(|(target, use_)| Pushed {
+                    binding: *binding,
+                    target,
+                    use_,
+                })
+            })
+            .collect();
         for (binding, res) in resources {
             if let Resource::Buffer(b) | Resource::BufferRange(b, ..) = res {
                 b.used_by(self.index);
@@ -150,16 +171,25 @@ impl Recorder {
             if !bound.pushed.contains(binding) {
                 bound.pushed.push(*binding);
             }
-            bound.images.retain(|i| i.binding != *binding);
-            if let Resource::StorageImage(i) | Resource::Sampled(i, _) = res {
-                bound.images.push(PushedImage {
-                    binding: *binding,
-                    name: i.name().to_string(),
-                    state: i.state.clone(),
-                    layout: descriptor_layout(res),
-                });
-            }
+            bound.uses.retain(|u| u.binding != *binding);
         }
+        if graphics {
+            // The draws come inside a rendering, where no barrier may be recorded: derive them
+            // now (outside one, for the next rendering), or check that none is needed.
+            let scope = if self.state.rendering.is_some() {
+                Scope::InRendering
+            } else {
+                Scope::NextRendering
+            };
+            let uses: Vec<_> = pushed.iter().map(|p| (p.target.clone(), p.use_)).collect();
+            self.sync("push_bindings", scope, &uses);
+        }
+        self.state
+            .bound
+            .as_mut()
+            .expect("checked above")
+            .uses
+            .extend(pushed);
     }
 
     /// Panics unless `res` fits the binding `l` of pipeline `pipeline`.
@@ -276,6 +306,47 @@ impl Recorder {
             .as_mut()
             .expect("checked above")
             .constants_set = true;
+    }
+}
+
+/// How a shader at `stage` uses the resource at a binding (`writes`: the binding is not
+/// `readonly` in some shader of the pipeline); `None` for what is not tracked (a TLAS: its
+/// builds order themselves against ray queries, `tlas.rs`).
+fn shader_use(
+    res: &Resource<'_>,
+    kind: BindingKind,
+    stage: vk::PipelineStageFlags2,
+    writes: bool,
+) -> Option<(Target, Use)> {
+    type A = vk::AccessFlags2;
+    let storage = |writes: bool| {
+        if writes {
+            Use::write(Access::new(
+                stage,
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+            ))
+        } else {
+            Use::read(Access::new(stage, A::SHADER_STORAGE_READ))
+        }
+    };
+    match *res {
+        Resource::Buffer(b) | Resource::BufferRange(b, ..) => Some((
+            b.target(),
+            if kind == BindingKind::StorageBuffer {
+                storage(writes)
+            } else {
+                Use::read(Access::new(stage, A::UNIFORM_READ))
+            },
+        )),
+        Resource::StorageImage(i) => Some((
+            i.target(),
+            storage(writes).in_layout(descriptor_layout(res)),
+        )),
+        Resource::Sampled(i, _) => Some((
+            i.target(),
+            Use::read(Access::new(stage, A::SHADER_SAMPLED_READ)).in_layout(descriptor_layout(res)),
+        )),
+        Resource::Tlas(_) => None,
     }
 }
 

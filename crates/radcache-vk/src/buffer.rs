@@ -26,6 +26,7 @@ pub use gpu_allocator::MemoryLocation;
 
 use crate::context::{Context, DeviceShared, Garbage};
 use crate::error::{Error, Result, VkResultExt};
+use crate::hazard::{Track, Tracked};
 
 /// What to create.
 #[derive(Debug, Clone)]
@@ -52,6 +53,8 @@ pub struct Buffer {
     usage: vk::BufferUsageFlags,
     /// Indices of the recordings that took this buffer and had not ended when it was last taken.
     uses: Mutex<Vec<u64>>,
+    /// Its last use, from which the barrier of its next use is derived (`hazard.rs`).
+    pub(crate) track: Tracked,
     address: Option<u64>,
     name: String,
     alloc_id: u64,
@@ -119,6 +122,7 @@ impl Buffer {
             size,
             usage,
             uses: Mutex::new(Vec::new()),
+            track: Track::shared(),
             address: None,
             name: desc.name.to_string(),
             alloc_id,
@@ -325,9 +329,7 @@ impl Context {
             },
         )?;
         let mut rec = self.begin("readback")?;
-        rec.barrier(crate::Access::ALL_WRITES, crate::Access::TRANSFER_READ);
         rec.copy_buffer(buffer, 0, &staging, 0, bytes);
-        rec.barrier(crate::Access::TRANSFER_WRITE, crate::Access::HOST_READ);
         self.submit(rec)?.wait()?;
         staging.read(count)
     }

@@ -94,6 +94,7 @@ impl Context {
             "recording {:?} submitted with an open rendering (end_rendering first)",
             rec.label
         );
+        rec.sync_host();
         let shared = rec.shared.clone();
         // SAFETY: the command buffer is in the recording state, outside a rendering, with every
         // scope (debug label) closed (both asserted above).
@@ -230,14 +231,14 @@ impl Recorder {
 impl Drop for Recorder {
     fn drop(&mut self) {
         if !self.finished {
-            // Abandoned: the command buffer never reached the queue, so the layouts its
-            // `use_image` calls recorded never happened; UNDEFINED is always a valid old layout.
-            for image in &self.state.touched {
-                let mut track = image.lock().unwrap_or_else(|p| p.into_inner());
+            // Abandoned: the command buffer never reached the queue, so the uses and layouts its
+            // tracks recorded never happened; UNDEFINED is always a valid old layout, and a
+            // barrier after every earlier write is always sound.
+            for tracked in &self.state.touched {
+                let mut track = crate::hazard::lock(tracked);
                 if track.recording == self.index {
-                    track.layout = vk::ImageLayout::UNDEFINED;
-                    track.access = crate::sync::Access::ALL_WRITES;
-                    track.recording = 0;
+                    *track = crate::hazard::Track::new();
+                    track.write = crate::sync::Access::ALL_WRITES;
                 }
             }
             self.shared.retire(Garbage::CommandBuffer(self.cmd));

@@ -303,7 +303,7 @@ impl Context {
 
     /// Creates a context: instance, device choice, logical device, allocator.
     pub fn with_options(opts: &ContextOptions) -> Result<Self> {
-        let inst = instance::create_instance(opts.validation)?;
+        let inst = instance::create_instance(opts.validation, opts.sync_validation)?;
         // From here on, `Guard` destroys the instance if anything fails.
         struct Guard(Option<InstanceParts>);
         impl Drop for Guard {

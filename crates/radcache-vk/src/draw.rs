@@ -7,13 +7,29 @@ use ash::vk;
 use crate::buffer::Buffer;
 use crate::commands::Recorder;
 use crate::error::{Error, Result};
+use crate::hazard::{Scope, Target, Use};
 use crate::image::Image;
-use crate::state::{layout_of, IndexBuffer, Rendering};
+use crate::state::{IndexBuffer, Rendering};
+use crate::sync::Access;
+
+/// What a rendering draws into, and the indirect arguments its draws read: everything a
+/// rendering needs prepared before it begins (no barrier may be recorded inside one). The
+/// attachments' layouts and barriers are derived; the draws' bindings are prepared by pushing them
+/// before `begin_rendering`.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RenderTargets<'a> {
+    /// The colour attachments, in the pipelines' order.
+    pub colors: &'a [ColorTarget<'a>],
+    /// The depth attachment, if any.
+    pub depth: Option<DepthTarget<'a>>,
+    /// Buffers the draws read indirect arguments from.
+    pub indirect: &'a [&'a Buffer],
+}
 
 /// A colour attachment of a rendering.
 #[derive(Debug, Clone, Copy)]
 pub struct ColorTarget<'a> {
-    /// The image (must be in `ImageUse::ColorAttachment`).
+    /// The image.
     pub image: &'a Image,
     /// Clear to this value, or load the existing contents when `None`.
     pub clear: Option<[f32; 4]>,
@@ -22,7 +38,7 @@ pub struct ColorTarget<'a> {
 /// The depth attachment of a rendering.
 #[derive(Debug, Clone, Copy)]
 pub struct DepthTarget<'a> {
-    /// The image (must be in `ImageUse::DepthAttachment`).
+    /// The image.
     pub image: &'a Image,
     /// Clear to this depth, or load the existing contents when `None`.
     pub clear: Option<f32>,
@@ -46,6 +62,7 @@ impl Recorder {
         if x == 0 || y == 0 || z == 0 {
             return Ok(());
         }
+        self.sync_bound("dispatch", None);
         // SAFETY: recording outside a rendering, with a compute pipeline bound whose every
         // binding and push constant was set since (`check_dispatch`); counts within the limits.
         unsafe { self.shared.device.cmd_dispatch(self.cmd, x, y, z) };
@@ -61,6 +78,7 @@ impl Recorder {
         self.check_dispatch("dispatch_indirect");
         self.check_indirect("dispatch_indirect", args, offset, DISPATCH_ARGS);
         args.used_by(self.index);
+        self.sync_bound("dispatch_indirect", Some(args));
         // SAFETY: as for `dispatch`; `args` has INDIRECT_BUFFER usage and holds the arguments at
         // an aligned offset (`check_indirect`). The group counts are GPU data no host check can
         // see: keeping them within the limits is the documented contract above, left to the
@@ -73,10 +91,15 @@ impl Recorder {
     }
 
     /// Begins dynamic rendering into the targets over their full extent, with matching viewport
-    /// (y down, depth 0..1) and scissor. Panics when a rendering is already open, or when an
-    /// attachment lacks its usage, is not in its attachment layout (`use_image`) or is smaller
-    /// than the first one.
-    pub fn begin_rendering(&mut self, colors: &[ColorTarget<'_>], depth: Option<DepthTarget<'_>>) {
+    /// (y down, depth 0..1) and scissor, after the barriers and layout transitions that the
+    /// attachments and the indirect arguments need. Panics when a rendering is already open, or
+    /// when an attachment lacks its usage or is smaller than the first one.
+    pub fn begin_rendering(&mut self, targets: &RenderTargets<'_>) {
+        let RenderTargets {
+            colors,
+            depth,
+            indirect,
+        } = *targets;
         assert!(
             self.state.rendering.is_none(),
             "begin_rendering in recording {:?}: a rendering is already open (end_rendering first)",
@@ -94,12 +117,7 @@ impl Recorder {
             colors.len()
         );
         for c in colors {
-            check_attachment(
-                c.image,
-                extent,
-                vk::ImageUsageFlags::COLOR_ATTACHMENT,
-                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-            );
+            check_attachment(c.image, extent, vk::ImageUsageFlags::COLOR_ATTACHMENT);
             assert!(
                 !c.image.is_depth(),
                 "begin_rendering: depth image {:?} given as a colour target",
@@ -111,7 +129,6 @@ impl Recorder {
                 d.image,
                 extent,
                 vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
             );
             assert!(
                 d.image.is_depth(),
@@ -119,6 +136,24 @@ impl Recorder {
                 d.image.name()
             );
         }
+        let mut uses: Vec<(Target, Use)> = colors
+            .iter()
+            .map(|c| {
+                let u = Use::write(Access::COLOR_ATTACHMENT)
+                    .in_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+                (c.image.target(), u)
+            })
+            .collect();
+        if let Some(d) = depth {
+            let u = Use::write(Access::DEPTH_ATTACHMENT)
+                .in_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL);
+            uses.push((d.image.target(), u));
+        }
+        for args in indirect {
+            args.used_by(self.index);
+            uses.push((args.target(), Use::read(Access::INDIRECT)));
+        }
+        self.sync("begin_rendering", Scope::NextRendering, &uses);
         let color_infos: Vec<_> = colors
             .iter()
             .map(|c| {
@@ -178,8 +213,7 @@ impl Recorder {
             max_depth: 1.0,
         };
         // SAFETY: recording outside a rendering (checked above); every attachment has its usage,
-        // is in the layout named above by its tracked layout (`use_image`) and contains the
-        // render area (checked by `check_attachment`); the images outlive the recording (the
+        // was transitioned to the layout named above (`sync`) and contains the render area (checked by `check_attachment`); the images outlive the recording (the
         // graveyard).
         unsafe {
             self.shared.device.cmd_begin_rendering(self.cmd, &info);
@@ -188,6 +222,7 @@ impl Recorder {
                 .cmd_set_viewport(self.cmd, 0, &[viewport]);
             self.shared.device.cmd_set_scissor(self.cmd, 0, &[area]);
         }
+        self.state.renderings += 1;
         self.state.rendering = Some(Rendering {
             color_formats: colors.iter().map(|c| c.image.format()).collect(),
             depth_format: depth.map_or(vk::Format::UNDEFINED, |d| d.image.format()),
@@ -210,6 +245,7 @@ impl Recorder {
     /// constants) pushed.
     pub fn draw(&mut self, vertex_count: u32, instance_count: u32) {
         self.check_draw("draw");
+        self.sync_bound("draw", None);
         // SAFETY: recording inside a rendering whose formats match the bound graphics pipeline,
         // every binding and push constant set (`check_draw`); no vertex buffers are declared.
         unsafe {
@@ -238,6 +274,7 @@ impl Recorder {
             u64::from(draw_count) * DRAW_ARGS,
         );
         args.used_by(self.index);
+        self.sync_bound("draw_indirect", Some(args));
         // SAFETY: as for `draw`; `args` has INDIRECT_BUFFER usage and holds `draw_count` ≤ 1
         // commands at an aligned offset (`check_indirect`). Every value of their fields is valid:
         // drawIndirectFirstInstance is enabled, and vertex pulling reads no vertex buffers.
@@ -268,6 +305,13 @@ impl Recorder {
             indices.size()
         );
         indices.used_by(self.index);
+        let scope = if self.state.rendering.is_some() {
+            Scope::InRendering
+        } else {
+            Scope::NextRendering
+        };
+        let uses = [(indices.target(), Use::read(Access::INDEX_READ))];
+        self.sync("bind_index_buffer", scope, &uses);
         // SAFETY: recording; the buffer has INDEX_BUFFER usage and `offset` is a multiple of the
         // index size inside it (checked above); it outlives the recording (the graveyard).
         unsafe {
@@ -288,6 +332,7 @@ impl Recorder {
     /// as [`Self::draw`] does, and unless the bound index buffer holds the indices drawn.
     pub fn draw_indexed(&mut self, index_count: u32, first_index: u32, first_instance: u32) {
         self.check_draw("draw_indexed");
+        self.sync_bound("draw_indexed", None);
         let index = self
             .state
             .index
@@ -316,22 +361,11 @@ impl Recorder {
     }
 }
 
-/// Panics unless `image` has `usage`, is in `layout` by its tracked state, and contains `extent`.
-fn check_attachment(
-    image: &Image,
-    extent: (u32, u32),
-    usage: vk::ImageUsageFlags,
-    layout: vk::ImageLayout,
-) {
+/// Panics unless `image` has `usage` and contains `extent`.
+fn check_attachment(image: &Image, extent: (u32, u32), usage: vk::ImageUsageFlags) {
     assert!(
         image.usage().contains(usage),
         "begin_rendering: image {:?} has no {usage:?} usage",
-        image.name()
-    );
-    let current = layout_of(&image.state);
-    assert!(
-        current == layout,
-        "begin_rendering: image {:?} is in layout {current:?}, not {layout:?} (use_image first)",
         image.name()
     );
     let (w, h) = image.extent();
@@ -342,4 +376,26 @@ fn check_attachment(
         extent.0,
         extent.1
     );
+}
+
+impl Recorder {
+    /// Derives the barriers the bound pipeline's pushed resources (and `args`, read as indirect
+    /// arguments) need before a dispatch, or checks that a draw needs none, then checks that
+    /// every pushed image is in its descriptor's layout.
+    fn sync_bound(&mut self, call: &str, args: Option<&Buffer>) {
+        let bound = self.bound_for(call);
+        let mut uses: Vec<(Target, Use)> = bound
+            .uses
+            .iter()
+            .map(|p| (p.target.clone(), p.use_))
+            .collect();
+        uses.extend(args.map(|a| (a.target(), Use::read(Access::INDIRECT))));
+        let scope = if self.state.rendering.is_some() {
+            Scope::InRendering
+        } else {
+            Scope::Outside
+        };
+        self.sync(call, scope, &uses);
+        self.check_layouts(call);
+    }
 }

@@ -1,6 +1,6 @@
 //! 2D images with one view (RAII over gpu-allocator), their tracked layout, and samplers.
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
@@ -8,7 +8,7 @@ use gpu_allocator::MemoryLocation;
 
 use crate::context::{Context, DeviceShared, Garbage};
 use crate::error::{Error, Result, VkResultExt};
-use crate::state::{ImageState, ImageTrack};
+use crate::hazard::{Track, Tracked};
 
 /// What to create.
 #[derive(Debug, Clone)]
@@ -36,9 +36,8 @@ pub struct Image {
     aspect: vk::ImageAspectFlags,
     /// The usage it was created with (`TRANSFER_SRC | TRANSFER_DST` included).
     usage: vk::ImageUsageFlags,
-    /// Current layout and the last access, for the barrier of the next use; shared with the
-    /// recordings that pushed the image as a descriptor, which check it at each draw or dispatch.
-    pub(crate) state: ImageState,
+    /// Its layout and last use, from which the barrier of its next use is derived (`hazard.rs`).
+    pub(crate) track: Tracked,
     name: String,
     alloc_id: u64,
 }
@@ -131,7 +130,7 @@ impl Image {
             },
             aspect,
             usage,
-            state: Arc::new(Mutex::new(ImageTrack::new())),
+            track: Track::shared(),
             name: desc.name.to_string(),
             alloc_id,
         };

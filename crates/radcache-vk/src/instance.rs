@@ -34,8 +34,13 @@ pub(crate) struct InstanceParts {
     pub validation: bool,
 }
 
-/// Creates the instance (API 1.3), enabling validation if asked and available.
-pub(crate) fn create_instance(want_validation: bool) -> Result<InstanceParts> {
+/// Creates the instance (API 1.3), enabling validation if asked and available, and the layer's
+/// synchronization validation (hazards between commands that no barrier orders) with it if
+/// `sync_validation`.
+pub(crate) fn create_instance(
+    want_validation: bool,
+    sync_validation: bool,
+) -> Result<InstanceParts> {
     // SAFETY: loading the system Vulkan loader; no Vulkan call is in flight.
     let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loader(e.to_string()))?;
 
@@ -72,15 +77,34 @@ pub(crate) fn create_instance(want_validation: bool) -> Result<InstanceParts> {
     } else {
         vec![]
     };
-    let ext_ptrs: Vec<*const i8> = if has_debug_utils {
+    let mut ext_ptrs: Vec<*const i8> = if has_debug_utils {
         vec![ash::ext::debug_utils::NAME.as_ptr()]
     } else {
         vec![]
     };
-    let info = vk::InstanceCreateInfo::default()
+    // The layer provides VK_EXT_validation_features, which carries the synchronization check.
+    let sync_validation = validation && sync_validation && {
+        // SAFETY: as above; the layer name is a NUL-terminated string of the loader's list.
+        let layer_exts =
+            unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }
+                .call("vkEnumerateInstanceExtensionProperties")?;
+        layer_exts.iter().any(|e| {
+            e.extension_name_as_c_str()
+                .is_ok_and(|n| n == ash::ext::validation_features::NAME)
+        })
+    };
+    let enables = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enables);
+    if sync_validation {
+        ext_ptrs.push(ash::ext::validation_features::NAME.as_ptr());
+    }
+    let mut info = vk::InstanceCreateInfo::default()
         .application_info(&app)
         .enabled_layer_names(&layer_ptrs)
         .enabled_extension_names(&ext_ptrs);
+    if sync_validation {
+        info = info.push_next(&mut features);
+    }
     // SAFETY: `info` and everything it points to live until the call returns.
     let instance = unsafe { entry.create_instance(&info, None) }.call("vkCreateInstance")?;
 

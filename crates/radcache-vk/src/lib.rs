@@ -3,7 +3,8 @@
 //! A headless [`Context`] (validation layer routed into `log`, device choice with a clear refusal
 //! report), RAII GPU objects with deferred destruction ([`Buffer`], [`Image`], [`Pipeline`],
 //! [`Blas`], [`Tlas`]), command recording with named, timed pass scopes ([`Recorder::pass`]),
-//! synchronization2 barriers ([`Access`], [`ImageUse`]) and run-time GLSL compilation
+//! synchronization2 barriers and image layouts derived from what each command reads and writes
+//! (no caller places a barrier: `hazard.rs`) and run-time GLSL compilation
 //! ([`ShaderCompiler`]). Every unsafe block carries a `SAFETY:` note; the public API is safe:
 //! each recording function checks its preconditions against the recording's state (a pipeline of
 //! the right kind bound, every declared binding pushed, a rendering open for draws, the usage and
@@ -20,6 +21,7 @@ mod context;
 mod device;
 mod draw;
 mod error;
+mod hazard;
 mod image;
 mod instance;
 mod options;
@@ -43,7 +45,7 @@ pub use buffer::{Buffer, BufferDesc, MemoryLocation};
 pub use commands::{Recorder, Submission};
 pub use context::{Context, ShutdownReport};
 pub use device::DeviceInfo;
-pub use draw::{ColorTarget, DepthTarget};
+pub use draw::{ColorTarget, DepthTarget, RenderTargets};
 pub use error::{Error, Result};
 pub use image::{Image, ImageDesc, Sampler};
 pub use options::{pipeline_cache_dir_from_env, ContextOptions, PIPELINE_CACHE_ENV};
@@ -52,5 +54,4 @@ pub use pipeline::{BindingKind, BindingLayout, Blend, DepthState, GraphicsDesc, 
 pub use profiler::PassTiming;
 pub use select::DeviceKind;
 pub use shader::{ShaderCompiler, ShaderStage, ShaderStats};
-pub use sync::{Access, ImageUse};
 pub use tlas::{Tlas, TlasInstance, TlasUpdate};

@@ -10,6 +10,9 @@ pub const PIPELINE_CACHE_ENV: &str = "RADCACHE_PIPELINE_CACHE";
 pub struct ContextOptions {
     /// Enable the Khronos validation layer (if installed).
     pub validation: bool,
+    /// With the layer, also check synchronization: a hazard between two commands that no
+    /// barrier orders is a validation error (slower; the tests of the derived barriers use it).
+    pub sync_validation: bool,
     /// Keep only devices whose name contains this (case-insensitive).
     pub device_filter: Option<String>,
     /// Device extensions to require on top of radcache's own.
@@ -20,20 +23,23 @@ pub struct ContextOptions {
 }
 
 impl ContextOptions {
-    /// Options from the environment: `RADCACHE_VALIDATION=0/1` (default: on in debug builds),
+    /// Options from the environment: `RADCACHE_VALIDATION=0/1` (default: on in debug builds;
+    /// `=sync` adds synchronization validation),
     /// `RADCACHE_DEVICE=<substring of the device name>` and the pipeline cache folder
     /// ([`pipeline_cache_dir_from_env`]).
     pub fn from_env() -> Self {
         let validation = match std::env::var("RADCACHE_VALIDATION").as_deref() {
             Ok("0") | Ok("false") | Ok("off") | Ok("no") => false,
-            Ok("1") | Ok("true") | Ok("on") | Ok("yes") => true,
+            Ok("1") | Ok("true") | Ok("on") | Ok("yes") | Ok("sync") => true,
             _ => cfg!(debug_assertions),
         };
+        let sync_validation = std::env::var("RADCACHE_VALIDATION").as_deref() == Ok("sync");
         let device_filter = std::env::var("RADCACHE_DEVICE")
             .ok()
             .filter(|s| !s.is_empty());
         ContextOptions {
             validation,
+            sync_validation,
             device_filter,
             extra_device_extensions: Vec::new(),
             pipeline_cache_dir: pipeline_cache_dir_from_env(),

@@ -120,6 +120,9 @@ pub struct Pipeline {
     /// Attachment formats of a graphics pipeline (none and `UNDEFINED` for compute).
     pub(crate) color_formats: Vec<vk::Format>,
     pub(crate) depth_format: vk::Format,
+    /// Bindings some shader may write (not `readonly`); the rest are only read. The barriers
+    /// before a dispatch or draw are derived from this (`hazard.rs`).
+    pub(crate) written: Vec<u32>,
     name: String,
 }
 
@@ -237,9 +240,10 @@ impl Pipeline {
             stages,
             color_formats: Vec::new(),
             depth_format: vk::Format::UNDEFINED,
+            written: Vec::new(),
             name: name.to_string(),
         };
-        reflect::check_layout(name, &[spirv], bindings, push_constant_size)?;
+        pipeline.written = reflect::check_layout(name, &[spirv], bindings, push_constant_size)?;
         let module = shader_module(shared, spirv)?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
@@ -297,9 +301,10 @@ impl Pipeline {
             stages,
             color_formats: desc.color_formats.to_vec(),
             depth_format: desc.depth.map_or(vk::Format::UNDEFINED, |d| d.format),
+            written: Vec::new(),
             name: desc.name.to_string(),
         };
-        reflect::check_layout(
+        pipeline.written = reflect::check_layout(
             desc.name,
             &[desc.vertex, desc.fragment],
             desc.bindings,

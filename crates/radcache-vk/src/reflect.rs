@@ -43,6 +43,7 @@ const DEC_MATRIX_STRIDE: u32 = 7;
 const DEC_OFFSET: u32 = 35;
 const DEC_BINDING: u32 = 33;
 const DEC_DESCRIPTOR_SET: u32 = 34;
+const DEC_NON_WRITABLE: u32 = 24;
 
 /// A type, as far as the check needs it.
 #[derive(Debug, Clone)]
@@ -66,11 +67,12 @@ enum Type {
     Pointer(u32),
 }
 
-/// A resource the shader uses: (set, binding) → (kind, array length if known), or its complaint.
+/// A resource the shader uses: (set, binding) → (kind, array length if known, whether the shader
+/// may write it), or its complaint.
 type Used = Vec<(
     u32,
     u32,
-    std::result::Result<(BindingKind, Option<u32>), String>,
+    std::result::Result<(BindingKind, Option<u32>, bool), String>,
 )>;
 
 /// What a module uses: its descriptor resources and, when it reads push constants, the byte
@@ -147,6 +149,9 @@ fn parse(spirv: &[u32]) -> std::result::Result<Uses, String> {
     let mut blocks: HashSet<u32> = HashSet::new();
     let mut buffer_blocks: HashSet<u32> = HashSet::new();
     let mut interface: HashSet<u32> = HashSet::new();
+    // Ids decorated NonWritable, and (struct, member) pairs member-decorated so (`readonly`).
+    let mut non_writable: HashSet<u32> = HashSet::new();
+    let mut non_writable_members: HashSet<(u32, u32)> = HashSet::new();
     let mut layout = Layout::default();
     let mut at = 5;
     while at < spirv.len() {
@@ -174,11 +179,17 @@ fn parse(spirv: &[u32]) -> std::result::Result<Uses, String> {
                 (DEC_BUFFER_BLOCK, _) => {
                     buffer_blocks.insert(w[0]);
                 }
+                (DEC_NON_WRITABLE, _) => {
+                    non_writable.insert(w[0]);
+                }
                 (DEC_ARRAY_STRIDE, Some(&stride)) => {
                     layout.array_strides.insert(w[0], u64::from(stride));
                 }
                 _ => {}
             },
+            OP_MEMBER_DECORATE if w.len() >= 3 && w[2] == DEC_NON_WRITABLE => {
+                non_writable_members.insert((w[0], w[1]));
+            }
             OP_MEMBER_DECORATE if w.len() >= 4 => match w[2] {
                 DEC_OFFSET => {
                     layout.offsets.insert((w[0], w[1]), u64::from(w[3]));
@@ -278,7 +289,21 @@ fn parse(spirv: &[u32]) -> std::result::Result<Uses, String> {
                 "a resource radcache has no binding kind for (storage class {class}, {t:?})"
             )),
         };
-        resources.push((set, binding, kind.map(|k| (k, length))));
+        // A buffer is read-only when the variable or every member of its block is NonWritable
+        // (glslang puts `readonly` on the members), an image when the variable is.
+        let read_only = non_writable.contains(id)
+            || match types.get(&base) {
+                Some(Type::Struct(members)) => {
+                    !members.is_empty()
+                        && (0..members.len() as u32)
+                            .all(|m| non_writable_members.contains(&(base, m)))
+                }
+                _ => false,
+            };
+        let writes = |k: BindingKind| {
+            matches!(k, BindingKind::StorageBuffer | BindingKind::StorageImage) && !read_only
+        };
+        resources.push((set, binding, kind.map(|k| (k, length, writes(k)))));
     }
     Ok(Uses {
         resources,
@@ -287,13 +312,15 @@ fn parse(spirv: &[u32]) -> std::result::Result<Uses, String> {
 }
 
 /// Checks that `bindings` (set 0) declares every resource the modules use, with its kind and
-/// enough descriptors, and that push constants are declared when a module reads them.
+/// enough descriptors, and that push constants are declared when a module reads them. Returns the
+/// bindings some module may write (storage buffers and images not declared `readonly`).
 pub(crate) fn check_layout(
     pipeline: &str,
     modules: &[&[u32]],
     bindings: &[BindingLayout],
     push_constant_size: u32,
-) -> Result<()> {
+) -> Result<Vec<u32>> {
+    let mut written = Vec::new();
     let invalid = |m: String| Error::Invalid(format!("pipeline {pipeline:?}: {m}"));
     for spirv in modules {
         let uses = parse(spirv).map_err(|m| invalid(format!("cannot read its SPIR-V: {m}")))?;
@@ -317,7 +344,11 @@ pub(crate) fn check_layout(
             _ => {}
         }
         for (set, binding, used) in uses.resources {
-            let (kind, length) = used.map_err(|m| invalid(format!("binding {binding}: {m}")))?;
+            let (kind, length, writes) =
+                used.map_err(|m| invalid(format!("binding {binding}: {m}")))?;
+            if writes && !written.contains(&binding) {
+                written.push(binding);
+            }
             if set != 0 {
                 return Err(invalid(format!(
                     "the shader uses set {set} (binding {binding}); radcache pipelines have set 0 only"
@@ -346,5 +377,5 @@ pub(crate) fn check_layout(
             }
         }
     }
-    Ok(())
+    Ok(written)
 }

@@ -14,56 +14,23 @@
 //!   bound (binding another pipeline starts both afresh: push descriptors and push constants do
 //!   not survive a layout change);
 //! - the open rendering (its attachment formats), if any;
-//! - the bound index buffer (how many indices it holds past its offset).
-
-use std::sync::{Arc, Mutex};
+//! - the bound index buffer (how many indices it holds past its offset);
+//! - the resources it touched and the renderings it began, for the derived barriers
+//!   (`hazard.rs`; each resource's own track lives in the resource).
 
 use ash::vk;
 
 use crate::buffer::Buffer;
 use crate::commands::Recorder;
+use crate::hazard::{lock, Target, Tracked, Use};
 use crate::pipeline::{BindingLayout, Pipeline};
-use crate::sync::Access;
 
-/// An image's tracked layout and last access, shared between the image and the recordings that
-/// pushed it as a descriptor.
-pub(crate) type ImageState = Arc<Mutex<ImageTrack>>;
-
-/// What `use_image` knows of an image at record time.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct ImageTrack {
-    /// The layout it will be in once everything recorded so far has executed.
-    pub layout: vk::ImageLayout,
-    /// The access of its last use, for the source of the next barrier.
-    pub access: Access,
-    /// The recording that set `layout` (0: none yet).
-    pub recording: u64,
-}
-
-impl ImageTrack {
-    /// A new image: `UNDEFINED`, never used.
-    pub fn new() -> Self {
-        ImageTrack {
-            layout: vk::ImageLayout::UNDEFINED,
-            access: Access::NONE,
-            recording: 0,
-        }
-    }
-}
-
-/// The tracked layout of an image.
-pub(crate) fn layout_of(state: &ImageState) -> vk::ImageLayout {
-    state.lock().unwrap_or_else(|p| p.into_inner()).layout
-}
-
-/// An image pushed as a descriptor: its layout is checked at every draw or dispatch that may use it.
+/// A resource pushed as a descriptor and its use by the bound pipeline's shaders.
 #[derive(Debug, Clone)]
-pub(crate) struct PushedImage {
+pub(crate) struct Pushed {
     pub binding: u32,
-    pub name: String,
-    pub state: ImageState,
-    /// The layout the descriptor names.
-    pub layout: vk::ImageLayout,
+    pub target: Target,
+    pub use_: Use,
 }
 
 /// The pipeline bound last and what was pushed for it since.
@@ -82,8 +49,12 @@ pub(crate) struct BoundPipeline {
     pub pushed: Vec<u32>,
     /// Whether `push_constants` was called since `bind_pipeline`.
     pub constants_set: bool,
-    /// Images among the pushed bindings (a binding pushed again replaces its entry).
-    pub images: Vec<PushedImage>,
+    /// Binding numbers the shaders may write (the rest they only read).
+    pub written: Vec<u32>,
+    /// The tracked resources among the pushed bindings (a binding pushed again replaces its
+    /// entry): their barriers are derived at the next dispatch (compute) or at the push
+    /// (graphics: before the rendering begins).
+    pub uses: Vec<Pushed>,
 }
 
 impl BoundPipeline {
@@ -99,7 +70,8 @@ impl BoundPipeline {
             depth_format: p.depth_format,
             pushed: Vec::new(),
             constants_set: false,
-            images: Vec::new(),
+            written: p.written.clone(),
+            uses: Vec::new(),
         }
     }
 
@@ -134,8 +106,13 @@ pub(crate) struct RecordState {
     pub bound: Option<BoundPipeline>,
     pub rendering: Option<Rendering>,
     pub index: Option<IndexBuffer>,
-    /// Images whose tracked layout this recording changed (reset if it is abandoned).
-    pub touched: Vec<ImageState>,
+    /// Resources whose track this recording changed (reset if it is abandoned).
+    pub touched: Vec<Tracked>,
+    /// Renderings begun so far (numbering them from 1 for the tracks).
+    pub renderings: u64,
+    /// Whether any command so far may write (the end of the recording then makes the device's
+    /// writes visible to the host).
+    pub wrote: bool,
 }
 
 impl Recorder {
@@ -191,6 +168,24 @@ impl Recorder {
         check_pushed(bound, call);
     }
 
+    /// Checks that every image pushed for the bound pipeline is in its descriptor's layout (the
+    /// derived transitions put it there: a failure here is a bug of `hazard.rs`).
+    pub(crate) fn check_layouts(&self, call: &str) {
+        let bound = self.bound_for(call);
+        for pushed in &bound.uses {
+            let (track, want) = (lock(&pushed.target.track), pushed.use_.layout);
+            assert!(
+                want.is_none_or(|l| l == track.layout),
+                "{call} with pipeline {:?}: image {:?} at binding {} is in layout {:?}, its \
+             descriptor expects {want:?} (a derived transition is missing)",
+                bound.name,
+                pushed.target.name,
+                pushed.binding,
+                track.layout
+            );
+        }
+    }
+
     /// Panics when a rendering is open: `call` is only valid outside one.
     pub(crate) fn check_outside_rendering(&self, call: &str) {
         assert!(
@@ -228,8 +223,7 @@ impl Recorder {
     }
 }
 
-/// Every declared binding pushed, every pushed image in its descriptor's layout, push constants
-/// set when the layout has any.
+/// Every declared binding pushed, push constants set when the layout has any.
 fn check_pushed(bound: &BoundPipeline, call: &str) {
     let missing = bound.missing();
     assert!(
@@ -244,16 +238,4 @@ fn check_pushed(bound: &BoundPipeline, call: &str) {
         bound.name,
         bound.push_constant_size
     );
-    for image in &bound.images {
-        let layout = layout_of(&image.state);
-        assert!(
-            layout == image.layout,
-            "{call} with pipeline {:?}: image {:?} at binding {} is in layout {layout:?}, its \
-             descriptor expects {:?} (use_image first)",
-            bound.name,
-            image.name,
-            image.binding,
-            image.layout
-        );
-    }
 }

@@ -1,7 +1,9 @@
-//! Recording barriers, image transitions, copies, fills and clears; image readback.
+//! Recording copies, fills and clears; image readback; the explicit barrier the acceleration
+//! structure builds of this crate use.
 //!
-//! None of these is allowed inside a rendering, and each checks its ranges and the tracked layout
-//! of the images it touches: a violation is a programming error and panics.
+//! None of these is allowed inside a rendering, and each checks its ranges: a violation is a
+//! programming error and panics. The barriers and layout transitions before each are derived from
+//! its source and destination (`hazard.rs`).
 
 use ash::vk;
 use bytemuck::Pod;
@@ -10,13 +12,14 @@ use crate::buffer::{Buffer, BufferDesc, MemoryLocation};
 use crate::commands::Recorder;
 use crate::context::Context;
 use crate::error::{Error, Result};
+use crate::hazard::{Scope, Use};
 use crate::image::Image;
-use crate::state::layout_of;
-use crate::sync::{Access, ImageUse};
+use crate::sync::Access;
 
 impl Recorder {
-    /// A global memory dependency: everything `src` did is visible to `dst`.
-    pub fn barrier(&mut self, src: Access, dst: Access) {
+    /// A global memory dependency: everything `src` did is visible to `dst`. Only for what the
+    /// tracks do not see (acceleration structure builds and the ray queries that read them).
+    pub(crate) fn barrier(&mut self, src: Access, dst: Access) {
         self.check_outside_rendering("barrier");
         let barrier = [vk::MemoryBarrier2::default()
             .src_stage_mask(src.stage)
@@ -26,55 +29,6 @@ impl Recorder {
         let info = vk::DependencyInfo::default().memory_barriers(&barrier);
         // SAFETY: recording outside a rendering (checked above); `info` outlives the call.
         unsafe { self.shared.device.cmd_pipeline_barrier2(self.cmd, &info) };
-    }
-
-    /// Transitions `image` to the layout of `usage`, after whatever it was last used for.
-    ///
-    /// The layout is tracked per image at record time, so recordings that touch an image must
-    /// reach the queue in the order they were recorded: this panics when another recording that
-    /// transitioned `image` is still open (not submitted, not dropped). A recording dropped
-    /// unsubmitted leaves its images `UNDEFINED` (their contents are then undefined too).
-    pub fn use_image(&mut self, image: &Image, usage: ImageUse) {
-        self.check_outside_rendering("use_image");
-        let mut state = image.state.lock().unwrap_or_else(|p| p.into_inner());
-        assert!(
-            state.recording == self.index || !self.shared.is_unsubmitted(state.recording),
-            "use_image in recording {:?}: image {:?} was last transitioned by recording {}, which \
-             is still open (submit or drop it first: layouts are tracked in record order)",
-            self.label,
-            image.name(),
-            state.recording
-        );
-        let (old_layout, src) = (state.layout, state.access);
-        let (new_layout, dst) = usage.layout_and_access(image.is_depth());
-        let barrier = [vk::ImageMemoryBarrier2::default()
-            .src_stage_mask(if src.stage.is_empty() {
-                vk::PipelineStageFlags2::NONE
-            } else {
-                src.stage
-            })
-            .src_access_mask(src.access)
-            .dst_stage_mask(dst.stage)
-            .dst_access_mask(dst.access)
-            .old_layout(old_layout)
-            .new_layout(new_layout)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .image(image.raw())
-            .subresource_range(image.subresource_range())];
-        let info = vk::DependencyInfo::default().image_memory_barriers(&barrier);
-        // SAFETY: recording outside a rendering (checked above); the image is live and
-        // `old_layout` is the layout it will have when this barrier executes: the tracked layout
-        // was set by this recording, by one already submitted (queue order = record order), or
-        // reset to UNDEFINED when its recording was abandoned (checked above).
-        unsafe { self.shared.device.cmd_pipeline_barrier2(self.cmd, &info) };
-        state.layout = new_layout;
-        state.access = dst;
-        if state.recording != self.index {
-            state.recording = self.index;
-            drop(state);
-            self.state.touched.push(image.state.clone());
-        }
     }
 
     /// Copies `size` bytes between buffers.
@@ -110,6 +64,11 @@ impl Recorder {
         );
         src.used_by(self.index);
         dst.used_by(self.index);
+        let uses = [
+            (src.target(), Use::read(Access::TRANSFER_READ)),
+            (dst.target(), Use::write(Access::TRANSFER_WRITE)),
+        ];
+        self.sync("copy_buffer", Scope::Outside, &uses);
         let region = [vk::BufferCopy {
             src_offset,
             dst_offset,
@@ -142,6 +101,8 @@ impl Recorder {
             buffer.size()
         );
         buffer.used_by(self.index);
+        let uses = [(buffer.target(), Use::write(Access::TRANSFER_WRITE))];
+        self.sync("fill_buffer", Scope::Outside, &uses);
         // SAFETY: recording outside a rendering; the buffer has TRANSFER_DST usage (always
         // added), the range is aligned and inside it (checked above), and it outlives the
         // recording (the graveyard).
@@ -178,6 +139,8 @@ impl Recorder {
             buffer.size()
         );
         buffer.used_by(self.index);
+        let uses = [(buffer.target(), Use::write(Access::TRANSFER_WRITE))];
+        self.sync("update_buffer", Scope::Outside, &uses);
         // SAFETY: recording outside a rendering; size, alignment and range checked above; the
         // buffer has TRANSFER_DST usage (always added) and outlives the recording.
         unsafe {
@@ -187,7 +150,7 @@ impl Recorder {
         };
     }
 
-    /// Clears a colour image (it must be in `ImageUse::TransferDst`).
+    /// Clears a colour image.
     pub fn clear_color(&mut self, image: &Image, value: [f32; 4]) {
         self.check_outside_rendering("clear_color");
         assert!(
@@ -195,11 +158,15 @@ impl Recorder {
             "clear_color: image {:?} is a depth image",
             image.name()
         );
-        check_layout("clear_color", image, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+        let uses = [(
+            image.target(),
+            Use::write(Access::TRANSFER_WRITE).in_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL),
+        )];
+        self.sync("clear_color", Scope::Outside, &uses);
         let range = [image.subresource_range()];
         let color = vk::ClearColorValue { float32: value };
         // SAFETY: recording outside a rendering; a colour image with TRANSFER_DST usage (always
-        // added) in TRANSFER_DST_OPTIMAL by its tracked layout (checked above, see `use_image`).
+        // added), transitioned to TRANSFER_DST_OPTIMAL above.
         unsafe {
             self.shared.device.cmd_clear_color_image(
                 self.cmd,
@@ -211,14 +178,9 @@ impl Recorder {
         };
     }
 
-    /// Copies a whole image (in `ImageUse::TransferSrc`) into a tightly packed buffer.
+    /// Copies a whole image into a tightly packed buffer.
     pub fn copy_image_to_buffer(&mut self, image: &Image, buffer: &Buffer) {
         self.check_outside_rendering("copy_image_to_buffer");
-        check_layout(
-            "copy_image_to_buffer",
-            image,
-            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-        );
         let (w, h) = image.extent();
         let texel = texel_bytes(image.format()).unwrap_or_else(|| {
             panic!(
@@ -236,6 +198,14 @@ impl Recorder {
             buffer.size()
         );
         buffer.used_by(self.index);
+        let uses = [
+            (
+                image.target(),
+                Use::read(Access::TRANSFER_READ).in_layout(vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
+            ),
+            (buffer.target(), Use::write(Access::TRANSFER_WRITE)),
+        ];
+        self.sync("copy_image_to_buffer", Scope::Outside, &uses);
         let region = [vk::BufferImageCopy {
             buffer_offset: 0,
             buffer_row_length: 0,
@@ -253,8 +223,8 @@ impl Recorder {
                 depth: 1,
             },
         }];
-        // SAFETY: recording outside a rendering; the image is in TRANSFER_SRC_OPTIMAL by its
-        // tracked layout and the buffer holds every texel (checked above); both have transfer
+        // SAFETY: recording outside a rendering; the image was transitioned to
+        // TRANSFER_SRC_OPTIMAL above and the buffer holds every texel (checked above); both have transfer
         // usage (always added).
         unsafe {
             self.shared.device.cmd_copy_image_to_buffer(
@@ -266,16 +236,6 @@ impl Recorder {
             )
         };
     }
-}
-
-/// Panics unless `image`'s tracked layout is `layout`.
-fn check_layout(call: &str, image: &Image, layout: vk::ImageLayout) {
-    let current = layout_of(&image.state);
-    assert!(
-        current == layout,
-        "{call}: image {:?} is in layout {current:?}, not {layout:?} (use_image first)",
-        image.name()
-    );
 }
 
 /// Bytes per texel of the formats radcache reads back.
@@ -319,9 +279,7 @@ impl Context {
             },
         )?;
         let mut rec = self.begin("image_readback")?;
-        rec.use_image(image, ImageUse::TransferSrc);
         rec.copy_image_to_buffer(image, &staging);
-        rec.barrier(Access::TRANSFER_WRITE, Access::HOST_READ);
         self.submit(rec)?.wait()?;
         staging.read(count)
     }

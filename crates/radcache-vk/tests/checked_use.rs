@@ -1,4 +1,4 @@
-//! Indirect arguments, host access to buffers in flight, record-order image tracking, transfer
+//! Indirect arguments, host access to buffers in flight, record-order resource tracking, transfer
 //! ranges and the binding table against the shader: each misuse is refused (a panic for a
 //! recording call, an error for a host access or a pipeline), and correct use still works.
 
@@ -9,7 +9,7 @@ use common::{
     tri_pipeline, FillPush,
 };
 use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, ColorTarget, Error, ImageUse, Pipeline, Resource,
+    vk, BindingKind, BindingLayout, ColorTarget, Error, Pipeline, RenderTargets, Resource,
 };
 
 const STORAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::STORAGE_BUFFER;
@@ -50,17 +50,16 @@ fn indirect_arguments_need_indirect_usage_and_fit_their_buffer() {
         || rec.dispatch_indirect(&args, 2),
     );
     rec.dispatch_indirect(&args, 4);
-    rec.barrier(Access::COMPUTE_WRITE, Access::HOST_READ);
-    rec.use_image(&target, ImageUse::ColorAttachment);
-    rec.begin_rendering(
-        &[ColorTarget {
+    rec.bind_pipeline(&tri);
+    rec.push_bindings(&[(0, Resource::Buffer(&colour))]);
+    rec.begin_rendering(&RenderTargets {
+        colors: &[ColorTarget {
             image: &target,
             clear: Some([0.0; 4]),
         }],
-        None,
-    );
-    rec.bind_pipeline(&tri);
-    rec.push_bindings(&[(0, Resource::Buffer(&colour))]);
+        depth: None,
+        indirect: &[&draw_args],
+    });
     expect_panic(
         "draw_indirect with pipeline \"test.tri\": 16 bytes of arguments at offset 4 run past \
          the end of buffer \"test.draw_args\"",
@@ -107,7 +106,6 @@ fn host_access_waits_for_the_submissions_that_use_a_buffer() {
             count: 64,
         });
         rec.dispatch(1, 1, 1).unwrap();
-        rec.barrier(Access::COMPUTE_WRITE, Access::HOST_READ);
         rec
     };
     // Writing between recording and submitting is sound: submission makes host writes visible.
@@ -137,34 +135,40 @@ fn host_access_waits_for_the_submissions_that_use_a_buffer() {
 }
 
 #[test]
-fn image_layouts_are_tracked_in_record_order() {
+fn resources_are_tracked_in_record_order() {
     let ctx = context();
     let image = colour_image(&ctx, "test.image", 8);
+    let a = host_buffer(&ctx, "test.a", STORAGE, &[1, 2, 3, 4]);
     let mut first = ctx.begin("first").unwrap();
-    first.use_image(&image, ImageUse::ComputeStorage);
+    first.clear_color(&image, [0.0; 4]);
+    first.fill_buffer(&a, 0, 16, 7);
     let mut second = ctx.begin("second").unwrap();
     expect_panic(
-        "image \"test.image\" was last transitioned by recording",
-        || second.use_image(&image, ImageUse::TransferSrc),
+        "clear_color in recording \"second\": \"test.image\" was last used by recording",
+        || second.clear_color(&image, [1.0; 4]),
     );
-    // Abandoning `first` forgets its layout: `second` starts from UNDEFINED, which is valid.
+    expect_panic(
+        "fill_buffer in recording \"second\": \"test.a\" was last used by recording",
+        || second.fill_buffer(&a, 0, 16, 8),
+    );
+    // Abandoning `first` forgets what it recorded: `second` starts from UNDEFINED (always a
+    // valid old layout) after a barrier from every earlier write.
     drop(first);
-    second.use_image(&image, ImageUse::TransferDst);
     second.clear_color(&image, [1.0, 2.0, 3.0, 4.0]);
-    second.use_image(&image, ImageUse::TransferSrc);
+    second.fill_buffer(&a, 0, 16, 8);
     ctx.submit(second).unwrap().wait().unwrap();
+    assert_eq!(a.read::<u32>(4).unwrap(), vec![8; 4]);
     let texels: Vec<[f32; 4]> = ctx.read_image(&image).unwrap();
     assert!(texels.iter().all(|t| *t == [1.0, 2.0, 3.0, 4.0]));
-    drop(image);
+    drop((image, a));
     finish(ctx);
 }
 
 #[test]
-fn transfers_stay_inside_their_buffers_and_layouts() {
+fn transfers_stay_inside_their_buffers() {
     let ctx = context();
     let a = host_buffer(&ctx, "test.a", STORAGE, &[1, 2, 3, 4]);
     let b = host_buffer(&ctx, "test.b", STORAGE, &[0; 4]);
-    let image = colour_image(&ctx, "test.image", 8);
     let mut rec = ctx.begin("test").unwrap();
     expect_panic("copy_buffer: 16 bytes from \"test.a\"+4", || {
         rec.copy_buffer(&a, 4, &b, 0, 16)
@@ -180,16 +184,11 @@ fn transfers_stay_inside_their_buffers_and_layouts() {
         "update_buffer: 8 bytes at 12 run past the end of buffer \"test.b\"",
         || rec.update_buffer(&b, 12, &[0u32; 2]),
     );
-    expect_panic(
-        "clear_color: image \"test.image\" is in layout UNDEFINED",
-        || rec.clear_color(&image, [0.0; 4]),
-    );
     rec.copy_buffer(&a, 0, &b, 4, 8);
     rec.fill_buffer(&b, 12, 4, 9);
-    rec.barrier(Access::TRANSFER_WRITE, Access::HOST_READ);
     ctx.submit(rec).unwrap().wait().unwrap();
     assert_eq!(b.read::<u32>(4).unwrap(), vec![0, 1, 2, 9]);
-    drop((a, b, image));
+    drop((a, b));
     finish(ctx);
 }
 

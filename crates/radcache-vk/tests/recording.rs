@@ -8,7 +8,7 @@ use common::{
     colour_image, compiler, context, expect_panic, fill_pipeline, finish, host_buffer,
     tri_pipeline, FillPush,
 };
-use radcache_vk::{vk, ColorTarget, ImageUse, Resource};
+use radcache_vk::{vk, ColorTarget, RenderTargets, Resource};
 
 const STORAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::STORAGE_BUFFER;
 const INDIRECT: vk::BufferUsageFlags = vk::BufferUsageFlags::INDIRECT_BUFFER;
@@ -32,18 +32,21 @@ fn draws_need_an_open_rendering_and_a_graphics_pipeline() {
         "end_rendering in recording \"test\": no rendering is open",
         || rec.end_rendering(),
     );
-    rec.use_image(&target, ImageUse::ColorAttachment);
-    let targets = [ColorTarget {
+    let colors = [ColorTarget {
         image: &target,
         clear: Some([0.0; 4]),
     }];
-    rec.begin_rendering(&targets, None);
+    let targets = RenderTargets {
+        colors: &colors,
+        ..Default::default()
+    };
+    rec.begin_rendering(&targets);
     expect_panic("a rendering is already open", || {
-        rec.begin_rendering(&targets, None)
+        rec.begin_rendering(&targets)
     });
     expect_panic(
-        "use_image in recording \"test\": not allowed inside a rendering",
-        || rec.use_image(&target, ImageUse::TransferSrc),
+        "clear_color in recording \"test\": not allowed inside a rendering",
+        || rec.clear_color(&target, [0.0; 4]),
     );
     rec.bind_pipeline(&fill);
     expect_panic("draw: pipeline \"test.fill\" is a compute pipeline", || {
@@ -70,14 +73,13 @@ fn a_recording_with_an_open_rendering_is_not_submitted() {
     let ctx = context();
     let target = colour_image(&ctx, "test.target", 8);
     let mut rec = ctx.begin("open").unwrap();
-    rec.use_image(&target, ImageUse::ColorAttachment);
-    rec.begin_rendering(
-        &[ColorTarget {
+    rec.begin_rendering(&RenderTargets {
+        colors: &[ColorTarget {
             image: &target,
             clear: Some([0.0; 4]),
         }],
-        None,
-    );
+        ..Default::default()
+    });
     expect_panic(
         "recording \"open\" submitted with an open rendering",
         || {
@@ -97,19 +99,10 @@ fn a_rendering_checks_its_attachments_against_the_pipeline() {
     let target = colour_image(&ctx, "test.target", 8);
     let other = colour_image(&ctx, "test.other", 8);
     let mut rec = ctx.begin("test").unwrap();
-    expect_panic("image \"test.target\" is in layout UNDEFINED", || {
-        rec.begin_rendering(
-            &[ColorTarget {
-                image: &target,
-                clear: None,
-            }],
-            None,
-        )
-    });
-    rec.use_image(&target, ImageUse::ColorAttachment);
-    rec.use_image(&other, ImageUse::ColorAttachment);
-    rec.begin_rendering(
-        &[
+    rec.bind_pipeline(&tri);
+    rec.push_bindings(&[(0, Resource::Buffer(&colour))]);
+    rec.begin_rendering(&RenderTargets {
+        colors: &[
             ColorTarget {
                 image: &target,
                 clear: Some([0.0; 4]),
@@ -119,10 +112,8 @@ fn a_rendering_checks_its_attachments_against_the_pipeline() {
                 clear: Some([0.0; 4]),
             },
         ],
-        None,
-    );
-    rec.bind_pipeline(&tri);
-    rec.push_bindings(&[(0, Resource::Buffer(&colour))]);
+        ..Default::default()
+    });
     expect_panic(
         "the open rendering has colours [R32G32B32A32_SFLOAT, R32G32B32A32_SFLOAT]",
         || rec.draw(3, 1),
@@ -160,10 +151,6 @@ fn every_declared_binding_is_pushed_before_a_dispatch() {
     // The rest in a second call: the dispatch is complete now.
     rec.push_bindings(&[(1, Resource::Buffer(&extra))]);
     rec.dispatch(1, 1, 1).unwrap();
-    rec.barrier(
-        radcache_vk::Access::COMPUTE_WRITE,
-        radcache_vk::Access::COMPUTE_READ_WRITE,
-    );
     // Binding the pipeline again starts afresh: bindings and push constants are gone.
     rec.bind_pipeline(&fill);
     expect_panic(
@@ -177,10 +164,6 @@ fn every_declared_binding_is_pushed_before_a_dispatch() {
         rec.dispatch(1, 1, 1).unwrap();
     });
     rec.push_constants(&push);
-    rec.barrier(
-        radcache_vk::Access::COMPUTE_WRITE,
-        radcache_vk::Access::HOST_READ,
-    );
     rec.dispatch(1, 1, 1).unwrap();
     ctx.submit(rec).unwrap().wait().unwrap();
     assert_eq!(data.read::<u32>(64).unwrap(), vec![12; 64]);
@@ -222,7 +205,7 @@ fn pushed_resources_are_checked_against_the_table() {
 }
 
 #[test]
-fn a_pushed_image_must_be_in_its_descriptor_layout_at_the_dispatch() {
+fn a_pushed_image_is_transitioned_for_each_use() {
     let ctx = context();
     let shaders = compiler();
     let spirv = shaders.compile("store.comp", &[]).unwrap();
@@ -240,17 +223,11 @@ fn a_pushed_image_must_be_in_its_descriptor_layout_at_the_dispatch() {
     let image = colour_image(&ctx, "test.image", 8);
     let mut rec = ctx.begin("test").unwrap();
     rec.bind_pipeline(&store);
+    // Cleared (TRANSFER_DST), stored into (GENERAL), read back (TRANSFER_SRC, by another
+    // recording): every transition derived from the use.
+    rec.clear_color(&image, [9.0; 4]);
     rec.push_bindings(&[(0, Resource::StorageImage(&image))]);
-    expect_panic(
-        "image \"test.image\" at binding 0 is in layout UNDEFINED, its descriptor expects GENERAL",
-        || {
-            rec.dispatch(1, 1, 1).unwrap();
-        },
-    );
-    // Transitioned after the push and before the dispatch: what counts is the dispatch.
-    rec.use_image(&image, ImageUse::ComputeStorage);
     rec.dispatch(1, 1, 1).unwrap();
-    rec.use_image(&image, ImageUse::TransferSrc);
     ctx.submit(rec).unwrap().wait().unwrap();
     let texels: Vec<[f32; 4]> = ctx.read_image(&image).unwrap();
     assert_eq!(texels[8 * 3 + 5], [5.0, 3.0, 0.0, 1.0]);

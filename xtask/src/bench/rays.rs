@@ -13,8 +13,8 @@ use glam::{Mat4, Vec3};
 use radcache_tests::geometry::{room, uv_sphere, Mesh};
 use radcache_tests::Rng;
 use radcache_vk::{
-    vk, Access, BindingKind, BindingLayout, BlasGeometry, Buffer, BufferDesc, Context,
-    MemoryLocation, Pipeline, Resource, ShaderCompiler, Tlas, TlasInstance, TlasUpdate,
+    vk, BindingKind, BindingLayout, BlasGeometry, Buffer, BufferDesc, Context, MemoryLocation,
+    Pipeline, Resource, ShaderCompiler, Tlas, TlasInstance, TlasUpdate,
 };
 
 use super::harness::{Bench, Figure};
@@ -160,7 +160,6 @@ pub(super) fn trace(ctx: &Context, pipe: &Pipeline, tlas: &Tlas, rays: &[GpuRay]
             });
             rec.dispatch(ROW / 64, n.div_ceil(ROW), 1)
         })?;
-        rec.barrier(Access::COMPUTE_WRITE, Access::COMPUTE_WRITE);
         let t = ctx.submit(rec)?.wait()?;
         if run > 0 {
             times.push(t[0].duration_ms);

@@ -14,8 +14,7 @@
 
 use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
-    vk, Access, Buffer, BufferDesc, Context, ImageUse, MemoryLocation, Pipeline, Recorder,
-    Resource, ShaderCompiler,
+    vk, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource, ShaderCompiler,
 };
 
 use crate::bindings::composite as b;
@@ -263,7 +262,6 @@ impl CompositePass {
                 rec.fill_buffer(&self.emission_accum, 0, vk::WHOLE_SIZE, 0);
                 rec.fill_buffer(&self.debug_accum, 0, vk::WHOLE_SIZE, 0);
                 rec.fill_buffer(&self.nonfinite, 0, vk::WHOLE_SIZE, 0);
-                rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
                 return Ok(());
             }
             CompositeJob::Add(inputs) => inputs,
@@ -282,14 +280,8 @@ impl CompositePass {
                 "the composite pass was made without centre samples".into(),
             ));
         }
-        for image in gbuffer.images() {
-            rec.use_image(image, ImageUse::ComputeStorage);
-        }
-        rec.use_image(&splat.sum, ImageUse::ComputeStorage);
-        rec.use_image(&splat.count, ImageUse::ComputeStorage);
         // Without a glossy splat the target is not read; the splat's own stands in.
         let glossy_sum = glossy.map_or(&splat.sum, |g| &g.sum);
-        rec.use_image(glossy_sum, ImageUse::ComputeStorage);
         let mut bindings = scene.bindings();
         bindings.extend(gbuffer.bindings());
         bindings.extend([
@@ -314,7 +306,6 @@ impl CompositePass {
             pad0: 0,
         };
         let (w, h) = (self.width, self.height);
-        rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
         rec.pass("composite", |rec| {
             rec.bind_pipeline(&self.pipeline);
             rec.push_bindings(&bindings);
@@ -322,12 +313,6 @@ impl CompositePass {
             let [x, y, z] = image_dispatch(w, h);
             rec.dispatch(x, y, z)
         })?;
-        rec.barrier(
-            Access::COMPUTE_WRITE,
-            Access::COMPUTE_READ_WRITE
-                .union(Access::TRANSFER_READ)
-                .union(Access::HOST_READ),
-        );
         Ok(())
     }
 

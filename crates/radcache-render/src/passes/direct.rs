@@ -10,8 +10,7 @@
 
 use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
-    vk, Access, Buffer, BufferDesc, Context, ImageUse, MemoryLocation, Pipeline, Recorder,
-    Resource, ShaderCompiler,
+    vk, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource, ShaderCompiler,
 };
 
 use crate::bindings::{direct as b, direct_composite as c, direct_composite_layout};
@@ -389,13 +388,6 @@ impl DirectPass {
             glossy,
         } = *inputs;
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
-        // The composite's resources were last written by other passes (the splat's targets by
-        // rasterization) as well.
-        let before = match composite {
-            Some(_) => Access::ALL_WRITES,
-            None => Access::TRANSFER_WRITE,
-        };
-        rec.barrier(before, Access::COMPUTE_READ_WRITE);
         let mut bindings = scene.bindings();
         bindings.extend(gbuffer.bindings());
         bindings.push((b::RAY_COUNT, Resource::Buffer(&self.rays)));
@@ -422,7 +414,6 @@ impl DirectPass {
         let sub_frame_composite = composite.and_then(|(_, s)| s);
         if let Some((targets, _)) = composite {
             bindings.extend(composite_bindings(
-                rec,
                 targets,
                 glossy,
                 sub_frame_composite.is_some(),
@@ -448,7 +439,6 @@ impl DirectPass {
             let [x, y, z] = image_dispatch(w, h);
             rec.dispatch(x, y, z)
         })?;
-        rec.barrier(Access::COMPUTE_WRITE, Access::ALL);
         Ok(())
     }
 
@@ -462,7 +452,6 @@ impl DirectPass {
 /// target where the frame has one (`matching`: this sub-frame composites against the centre
 /// samples, which the composite pass must hold).
 fn composite_bindings<'a>(
-    rec: &mut Recorder,
     targets: CompositeTargets<'a>,
     glossy: Option<&'a GlossySplatPass>,
     matching: bool,
@@ -475,9 +464,6 @@ fn composite_bindings<'a>(
     }
     // Without a glossy splat the target is not read; the splat's own stands in.
     let glossy_sum = glossy.map_or(&splat.sum, |g| &g.sum);
-    for image in [&splat.sum, glossy_sum] {
-        rec.use_image(image, ImageUse::ComputeStorage);
-    }
     let r = composite.resources();
     Ok(vec![
         (c::SPLAT_SUM, Resource::StorageImage(&splat.sum)),

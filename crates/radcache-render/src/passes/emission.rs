@@ -6,8 +6,7 @@
 
 use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
-    vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
-    ShaderCompiler,
+    vk, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource, ShaderCompiler,
 };
 
 use crate::bindings::emission as b;
@@ -63,7 +62,6 @@ impl EmissionPass {
         composite: &CompositePass,
     ) -> Result<()> {
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
-        rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
         let mut bindings = scene.bindings();
         bindings.extend([
             (b::ACCUM, Resource::Buffer(&composite.accum)),
@@ -80,10 +78,6 @@ impl EmissionPass {
             let [x, y, z] = image_dispatch(w, h);
             rec.dispatch(x, y, z)
         })?;
-        rec.barrier(
-            Access::COMPUTE_WRITE,
-            Access::TRANSFER_READ.union(Access::HOST_READ),
-        );
         Ok(())
     }
 

@@ -21,8 +21,8 @@
 
 use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
-    vk, Access, ColorTarget, Context, DepthState, DepthTarget, GraphicsDesc, ImageUse, Pipeline,
-    Recorder, ShaderCompiler,
+    vk, ColorTarget, Context, DepthState, DepthTarget, GraphicsDesc, Pipeline, Recorder,
+    RenderTargets, ShaderCompiler,
 };
 
 use crate::bindings::SCENE;
@@ -168,9 +168,8 @@ impl GBufferPass {
     /// Records the G-buffer of `scene`'s current view, clearing everything first, in the profiler
     /// scope `gbuffer`. `jitter` is where each pixel's sample lies relative to its centre (pixels,
     /// each in [−0.5, 0.5]): pixel p holds the first hit of the camera ray through
-    /// p + 0.5 + `jitter` (`camera_ray(p, 0.5 + jitter)` in `shaders/common/path.glsl`). The
-    /// images are left ready for compute reads (`ImageUse::ComputeStorage`), the direct-light
-    /// image zeroed.
+    /// p + 0.5 + `jitter` (`camera_ray(p, 0.5 + jitter)` in `shaders/common/path.glsl`), the
+    /// direct-light image zeroed.
     pub fn record(
         &self,
         rec: &mut Recorder,
@@ -179,14 +178,10 @@ impl GBufferPass {
         jitter: [f32; 2],
     ) -> Result<()> {
         if self.traced() {
-            for image in gbuffer.images() {
-                rec.use_image(image, ImageUse::ComputeStorage);
-            }
             let mut bindings = scene.bindings();
             bindings.extend(gbuffer.bindings());
             bindings.push(gbuffer.active_binding());
             let (w, h) = (gbuffer.width, gbuffer.height);
-            rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
             rec.pass("gbuffer", |rec| {
                 rec.bind_pipeline(&self.pipeline);
                 rec.push_bindings(&bindings);
@@ -198,13 +193,8 @@ impl GBufferPass {
                 let [x, y, z] = image_dispatch(w, h);
                 rec.dispatch(x, y, z)
             })?;
-            rec.barrier(Access::COMPUTE_WRITE, Access::ALL);
             return Ok(());
         }
-        for image in gbuffer.attachments() {
-            rec.use_image(image, ImageUse::ColorAttachment);
-        }
-        rec.use_image(&gbuffer.depth, ImageUse::DepthAttachment);
         let targets: Vec<ColorTarget<'_>> = gbuffer
             .attachments()
             .into_iter()
@@ -216,15 +206,16 @@ impl GBufferPass {
         let bindings = scene.bindings();
         let draws = scene.instance_draws();
         rec.pass("gbuffer", |rec| {
-            rec.begin_rendering(
-                &targets,
-                Some(DepthTarget {
+            rec.bind_pipeline(&self.pipeline);
+            rec.push_bindings(&bindings);
+            rec.begin_rendering(&RenderTargets {
+                colors: &targets,
+                depth: Some(DepthTarget {
                     image: &gbuffer.depth,
                     clear: Some(0.0),
                 }),
-            );
-            rec.bind_pipeline(&self.pipeline);
-            rec.push_bindings(&bindings);
+                indirect: &[],
+            });
             for &(instance, triangles) in &draws {
                 rec.push_constants(&GBufferPush {
                     instance,
@@ -235,24 +226,16 @@ impl GBufferPass {
             }
             rec.end_rendering();
         });
-        rec.use_image(&gbuffer.direct, ImageUse::TransferDst);
         rec.clear_color(&gbuffer.direct, [0.0; 4]);
-        for image in gbuffer.images() {
-            rec.use_image(image, ImageUse::ComputeStorage);
-        }
         if let Some(repair) = &self.repair {
             let mut bindings = scene.bindings();
             bindings.extend(gbuffer.bindings());
             bindings.push(gbuffer.active_binding());
             let [x, y, z] = image_dispatch(gbuffer.width, gbuffer.height);
-            rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
             rec.pass("gbuffer.repair", |rec| {
                 rec.bind_pipeline(repair);
                 rec.push_bindings(&bindings);
                 for repair_stage in [0, 1] {
-                    if repair_stage == 1 {
-                        rec.barrier(Access::COMPUTE_WRITE, Access::COMPUTE_READ_WRITE);
-                    }
                     rec.push_constants(&GBufferPush {
                         instance: 0,
                         repair_stage,
@@ -262,7 +245,6 @@ impl GBufferPass {
                 }
                 Ok::<(), radcache_vk::Error>(())
             })?;
-            rec.barrier(Access::COMPUTE_WRITE, Access::ALL);
         }
         Ok(())
     }

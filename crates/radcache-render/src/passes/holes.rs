@@ -5,7 +5,7 @@
 //! Reads the G-buffer and the coverage splat (`bindings::holes`); writes the requests and
 //! `IcCounters::{requested, holes, dropped_requests}`.
 
-use radcache_vk::{Context, ImageUse, Pipeline, Recorder, Resource, ShaderCompiler};
+use radcache_vk::{Context, Pipeline, Recorder, Resource, ShaderCompiler};
 
 use crate::bindings::holes as b;
 use crate::error::Result;
@@ -104,10 +104,6 @@ impl HolePass {
             },
         };
         let spacing = push.spacing;
-        for image in gbuffer.images() {
-            rec.use_image(image, ImageUse::ComputeStorage);
-        }
-        rec.use_image(&splat.sum, ImageUse::ComputeStorage);
         let mut bindings = gbuffer.bindings().to_vec();
         bindings.extend([
             (b::SPLAT_SUM, Resource::StorageImage(&splat.sum)),

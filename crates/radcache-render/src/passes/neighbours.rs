@@ -5,7 +5,7 @@
 //! dispatches (one workgroup per new record). The result equals the all-pairs clamp (see the
 //! shader), at a cost that grows with the number of nearby records instead of with all records.
 
-use radcache_vk::{vk, Access, Context, Pipeline, Recorder, Resource, ShaderCompiler};
+use radcache_vk::{vk, Context, Pipeline, Recorder, Resource, ShaderCompiler};
 
 use crate::bindings::neighbours as b;
 use crate::error::Result;
@@ -108,9 +108,7 @@ impl NeighbourPass {
     ) -> Result<()> {
         match job {
             NeighbourJob::Rebuild => {
-                rec.barrier(Access::ALL_WRITES, Access::TRANSFER_WRITE);
                 rec.fill_buffer(&state.grid_heads, 0, vk::WHOLE_SIZE, 0);
-                rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
                 rec.pass("neighbours.grid", |rec| -> Result<()> {
                     self.bind(rec, state, Mode::InsertOld, scene_scale);
                     rec.dispatch(state.record_capacity().div_ceil(64).max(1), 1, 1)?;
@@ -118,17 +116,14 @@ impl NeighbourPass {
                 })?;
             }
             NeighbourJob::Batch => {
-                rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
                 rec.pass("neighbours", |rec| {
                     self.bind(rec, state, Mode::InsertBatch, scene_scale);
                     rec.dispatch_indirect(&state.counters, 16);
-                    rec.barrier(Access::COMPUTE_WRITE, Access::COMPUTE_READ_WRITE);
                     self.bind(rec, state, Mode::Clamp, scene_scale);
                     rec.dispatch_indirect(&state.counters, 16);
                 });
             }
         }
-        rec.barrier(Access::COMPUTE_WRITE, Access::ALL);
         Ok(())
     }
 }

@@ -8,8 +8,7 @@
 
 use radcache_shared::dispatch::image_dispatch;
 use radcache_vk::{
-    vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
-    ShaderCompiler,
+    vk, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource, ShaderCompiler,
 };
 
 use crate::bindings::path_trace as b;
@@ -137,14 +136,12 @@ impl PathTracer {
             PathTraceJob::Clear => {
                 rec.fill_buffer(&self.accum, 0, vk::WHOLE_SIZE, 0);
                 rec.fill_buffer(&self.compensation, 0, vk::WHOLE_SIZE, 0);
-                rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
                 self.samples = 0;
                 return Ok(());
             }
             PathTraceJob::Samples { scene, count } => (scene, count),
         };
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
-        rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
         let push = PathTracePush {
             sample_start: self.samples,
             sample_count: count,
@@ -165,12 +162,6 @@ impl PathTracer {
             let [x, y, z] = image_dispatch(w, h);
             rec.dispatch(x, y, z)
         })?;
-        rec.barrier(
-            Access::COMPUTE_READ_WRITE,
-            Access::COMPUTE_READ_WRITE
-                .union(Access::HOST_READ)
-                .union(Access::TRANSFER_READ),
-        );
         self.samples += count;
         Ok(())
     }

@@ -27,8 +27,7 @@
 
 use radcache_cache::{ErrorControl, IcParams};
 use radcache_vk::{
-    vk, Access, Buffer, BufferDesc, Context, ImageUse, MemoryLocation, Pipeline, Recorder,
-    Resource, ShaderCompiler,
+    vk, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource, ShaderCompiler,
 };
 
 use crate::bindings::record as b;
@@ -349,11 +348,7 @@ impl RecordPass {
             grid_epoch: self.grid.as_ref().map_or(0, |g| g.next_epoch()),
         };
         let gbuffer = inputs.gbuffer;
-        for image in gbuffer.images() {
-            rec.use_image(image, ImageUse::ComputeStorage);
-        }
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
-        rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
         let mut bindings = inputs.scene.bindings();
         bindings.extend(gbuffer.bindings());
         let grid = |f: fn(&PathGrid) -> &Buffer| self.grid.as_ref().map_or(&self.no_samples, f);
@@ -379,7 +374,6 @@ impl RecordPass {
             rec.push_constants(&push);
             rec.dispatch_indirect(inputs.counters, DISPATCH_OFFSET);
         });
-        rec.barrier(Access::COMPUTE_WRITE, Access::ALL.union(Access::HOST_READ));
         Ok(())
     }
 

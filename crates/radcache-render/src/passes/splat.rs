@@ -5,8 +5,8 @@
 
 use radcache_cache::IcParams;
 use radcache_vk::{
-    vk, Blend, ColorTarget, Context, GraphicsDesc, Image, ImageDesc, ImageUse, Pipeline, Recorder,
-    Resource, ShaderCompiler,
+    vk, Blend, ColorTarget, Context, GraphicsDesc, Image, ImageDesc, Pipeline, Recorder,
+    RenderTargets, Resource, ShaderCompiler,
 };
 
 use crate::bindings::{splat as b, FRAME};
@@ -242,20 +242,13 @@ impl SplatPass {
             SplatScope::All => (Some([0.0; 4]), 32),
             SplatScope::LastBatch => (None, 64),
         };
-        for image in gbuffer.images() {
-            rec.use_image(image, ImageUse::FragmentStorage);
-        }
-        rec.use_image(&self.sum, ImageUse::ColorAttachment);
-        if counted {
-            rec.use_image(&self.count, ImageUse::ColorAttachment);
-        }
         let scene_bindings = scene.bindings();
         let mut bindings = vec![scene_bindings[FRAME as usize]];
         bindings.extend(gbuffer.bindings());
         bindings.push((b::RECORDS, Resource::Buffer(&state.records)));
         bindings.push((b::LAST_USED, Resource::Buffer(&state.last_used)));
         rec.pass(name, |rec| {
-            let targets = [
+            let colors = [
                 ColorTarget {
                     image: &self.sum,
                     clear,
@@ -265,17 +258,17 @@ impl SplatPass {
                     clear,
                 },
             ];
-            rec.begin_rendering(&targets[..if counted { 2 } else { 1 }], None);
             rec.bind_pipeline(pipeline);
             rec.push_bindings(&bindings);
             rec.push_constants(weights);
+            rec.begin_rendering(&RenderTargets {
+                colors: &colors[..if counted { 2 } else { 1 }],
+                depth: None,
+                indirect: &[&state.counters],
+            });
             rec.draw_indirect(&state.counters, offset, 1);
             rec.end_rendering();
         });
-        rec.use_image(&self.sum, ImageUse::ComputeStorage);
-        if counted {
-            rec.use_image(&self.count, ImageUse::ComputeStorage);
-        }
         Ok(())
     }
 }

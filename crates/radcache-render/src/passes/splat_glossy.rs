@@ -16,8 +16,8 @@
 use radcache_material::glossy::{glossy_table, GLOSSY_TABLE_STRATA};
 use radcache_shared::consts::RADIANCE_VEC4S;
 use radcache_vk::{
-    vk, Blend, Buffer, BufferDesc, ColorTarget, Context, GraphicsDesc, Image, ImageDesc, ImageUse,
-    MemoryLocation, Pipeline, Recorder, Resource, ShaderCompiler,
+    vk, Blend, Buffer, BufferDesc, ColorTarget, Context, GraphicsDesc, Image, ImageDesc,
+    MemoryLocation, Pipeline, Recorder, RenderTargets, Resource, ShaderCompiler,
 };
 
 use crate::bindings::{splat_glossy as b, FRAME};
@@ -140,10 +140,6 @@ impl GlossySplatPass {
         let radiance = state.radiance.as_ref().ok_or_else(|| {
             Error::Invalid("the glossy splat needs a cache with radiance blocks".into())
         })?;
-        for image in gbuffer.images() {
-            rec.use_image(image, ImageUse::FragmentStorage);
-        }
-        rec.use_image(&self.sum, ImageUse::ColorAttachment);
         let push = SplatWeights {
             mark_frame: 0,
             ..*weights
@@ -157,21 +153,21 @@ impl GlossySplatPass {
             (b::GLOSSY_WEIGHTS, Resource::Buffer(&self.weights)),
         ]);
         rec.pass("splat.glossy", |rec| {
-            rec.begin_rendering(
-                &[ColorTarget {
-                    image: &self.sum,
-                    clear: Some([0.0; 4]),
-                }],
-                None,
-            );
             rec.bind_pipeline(&self.pipeline);
             rec.push_bindings(&bindings);
             rec.push_constants(&push);
+            rec.begin_rendering(&RenderTargets {
+                colors: &[ColorTarget {
+                    image: &self.sum,
+                    clear: Some([0.0; 4]),
+                }],
+                depth: None,
+                indirect: &[&state.counters],
+            });
             // The draw of every record (IcCounters::draw, as SplatScope::All).
             rec.draw_indirect(&state.counters, 32, 1);
             rec.end_rendering();
         });
-        rec.use_image(&self.sum, ImageUse::ComputeStorage);
         Ok(())
     }
 }

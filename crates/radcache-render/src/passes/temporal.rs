@@ -42,8 +42,7 @@ use radcache_scene::Scene;
 use radcache_shared::consts::TEMPORAL_FLAG_ADOPTED;
 use radcache_shared::gpu::{GpuInstance, GpuRecord, GpuRecordTemporal, IcCounters};
 use radcache_vk::{
-    vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource,
-    ShaderCompiler,
+    vk, Buffer, BufferDesc, Context, MemoryLocation, Pipeline, Recorder, Resource, ShaderCompiler,
 };
 
 use crate::bindings::temporal as b;
@@ -338,17 +337,12 @@ impl TemporalPass {
             moving_count: self.moving_count,
             ..push
         };
-        rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
         rec.pass("temporal", |rec| {
             rec.bind_pipeline(&self.pipeline);
             rec.push_bindings(&bindings);
             rec.push_constants(&push);
             rec.dispatch(invocations.div_ceil(64).max(1), 1, 1)
         })?;
-        rec.barrier(
-            Access::COMPUTE_WRITE,
-            Access::ALL.union(Access::INDIRECT).union(Access::HOST_READ),
-        );
         Ok(())
     }
 
@@ -497,7 +491,6 @@ impl TemporalPass {
         let state = io.state;
         let bytes = u64::from(records) * std::mem::size_of::<GpuRecord>() as u64;
         if bytes > 0 {
-            rec.barrier(Access::ALL_WRITES, Access::TRANSFER_READ);
             rec.copy_buffer(&state.records, 0, &self.lookahead, 0, bytes);
             self.promote = 0;
             if let (Some(from), Some(to)) = (&state.radiance, &self.lookahead_radiance) {
@@ -507,7 +500,6 @@ impl TemporalPass {
                     self.promote = records;
                 }
             }
-            rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
         }
         Ok(())
     }
@@ -519,9 +511,7 @@ impl TemporalPass {
         if let (Some(from), Some(to)) = (&self.lookahead_radiance, &state.radiance) {
             if self.promote > 0 {
                 let bytes = u64::from(self.promote) * RADIANCE_BYTES_PER_RECORD;
-                rec.barrier(Access::ALL_WRITES, Access::TRANSFER_READ);
                 rec.copy_buffer(from, 0, to, 0, bytes);
-                rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
             }
         }
         self.promote = 0;
@@ -560,9 +550,7 @@ impl TemporalPass {
         let (buffer, count) = scene.instances();
         let bytes = u64::from(count) * std::mem::size_of::<GpuInstance>() as u64;
         if bytes > 0 {
-            rec.barrier(Access::ALL_WRITES, Access::TRANSFER_READ);
             rec.copy_buffer(buffer, 0, &self.previous, 0, bytes);
-            rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
             self.has_previous = true;
         }
     }

@@ -6,7 +6,7 @@
 //! Reads and writes: the `IcCounters` buffer (`bindings::ic_counters::COUNTERS`).
 
 use radcache_shared::consts::CounterStep as Step;
-use radcache_vk::{Access, Buffer, Context, Pipeline, Recorder, Resource, ShaderCompiler};
+use radcache_vk::{Buffer, Context, Pipeline, Recorder, Resource, ShaderCompiler};
 
 use crate::bindings::ic_counters as b;
 use crate::error::Result;
@@ -75,15 +75,10 @@ impl IcCountersPass {
             request_capacity: capacities.1,
             pad: 0,
         };
-        rec.barrier(Access::ALL_WRITES, Access::COMPUTE_READ_WRITE);
         rec.bind_pipeline(&self.pipeline);
         rec.push_bindings(&[(b::COUNTERS, Resource::Buffer(counters))]);
         rec.push_constants(&push);
         rec.dispatch(1, 1, 1)?;
-        rec.barrier(
-            Access::COMPUTE_WRITE,
-            Access::ALL.union(Access::INDIRECT).union(Access::HOST_READ),
-        );
         Ok(())
     }
 }

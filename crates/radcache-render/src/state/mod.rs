@@ -7,9 +7,7 @@
 
 use bytemuck::Zeroable;
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, GpuRecordTemporal, IcCounters};
-use radcache_vk::{
-    vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Recorder, ShaderCompiler,
-};
+use radcache_vk::{vk, Buffer, BufferDesc, Context, MemoryLocation, Recorder, ShaderCompiler};
 
 use crate::error::{Error, Result};
 use ic_counters::{CounterStep, IcCountersPass};
@@ -185,7 +183,6 @@ impl IcState {
 
     /// Records forgetting every record (the start of a frame without reuse).
     pub fn record_reset(&self, rec: &mut Recorder) -> Result<()> {
-        rec.barrier(Access::ALL, Access::TRANSFER_WRITE);
         rec.fill_buffer(&self.last_used, 0, vk::WHOLE_SIZE, 0);
         self.step(rec, CounterStep::Reset)
     }
@@ -268,7 +265,6 @@ impl IcState {
             let u = ctx.create_buffer_init("ic.compact.last_used", src, &new_used)?;
             let new_temporal: Vec<GpuRecordTemporal> = kept.iter().map(|&i| temporal[i]).collect();
             let t = ctx.create_buffer_init("ic.compact.temporal", src, &new_temporal)?;
-            rec.barrier(Access::ALL, Access::TRANSFER_WRITE);
             let bytes = std::mem::size_of_val(&new_records[..]) as u64;
             rec.copy_buffer(&r, 0, &self.records, 0, bytes);
             rec.copy_buffer(&u, 0, &self.last_used, 0, u64::from(n) * 4);
@@ -297,7 +293,6 @@ impl IcState {
         c.draw = DrawArgs::quads(n, 0);
         c.batch_draw = DrawArgs::quads(0, 0);
         rec.update_buffer(&self.counters, 0, std::slice::from_ref(&c));
-        rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
         ctx.submit(rec)?.wait()?;
         drop(staging);
         Ok(dropped)
@@ -347,7 +342,6 @@ impl IcState {
         }
         let n = n as u32;
         let mut rec = ctx.begin("ic.upload")?;
-        rec.barrier(Access::ALL, Access::TRANSFER_WRITE);
         rec.fill_buffer(&self.last_used, 0, vk::WHOLE_SIZE, 0);
         let mut staging = Vec::new();
         if n > 0 {
@@ -369,8 +363,6 @@ impl IcState {
                 0,
                 std::mem::size_of_val(temporal) as u64,
             );
-            // The fill above and this copy both write `last_used`.
-            rec.barrier(Access::TRANSFER_WRITE, Access::TRANSFER_WRITE);
             rec.copy_buffer(&u, 0, &self.last_used, 0, u64::from(n) * 4);
             staging.extend([r, t, u]);
         }
@@ -394,7 +386,6 @@ impl IcState {
             radii_shrunk: 0,
         };
         rec.update_buffer(&self.counters, 0, std::slice::from_ref(&counters));
-        rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
         ctx.submit(rec)?.wait()?;
         drop(staging);
         Ok(())
@@ -435,9 +426,7 @@ impl IcState {
         let src = vk::BufferUsageFlags::TRANSFER_SRC;
         let b = ctx.create_buffer_init("ic.upload.radiance", src, blocks)?;
         let mut rec = ctx.begin("ic.upload.radiance")?;
-        rec.barrier(Access::ALL, Access::TRANSFER_WRITE);
         rec.copy_buffer(&b, 0, radiance, 0, std::mem::size_of_val(blocks) as u64);
-        rec.barrier(Access::TRANSFER_WRITE, Access::ALL);
         ctx.submit(rec)?.wait()?;
         drop(b);
         Ok(())

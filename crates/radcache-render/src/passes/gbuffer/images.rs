@@ -145,7 +145,8 @@ impl GBuffer {
         GBUFFER
     }
 
-    /// The images to push at `PASS_BASE + 0..5` (they must be in a storage-image layout).
+    /// The images to push at `PASS_BASE + 0..5` (as storage images: each dispatch or draw that
+    /// pushes them transitions them to `GENERAL`).
     pub fn bindings(&self) -> [(u32, Resource<'_>); GBUFFER_BINDINGS as usize] {
         [
             (b::POSITION, Resource::StorageImage(&self.position)),

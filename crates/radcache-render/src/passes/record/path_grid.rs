@@ -10,7 +10,7 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use radcache_shared::consts::PATH_GRID_CELLS;
-use radcache_vk::{vk, Access, Buffer, BufferDesc, Context, MemoryLocation, Recorder};
+use radcache_vk::{vk, Buffer, BufferDesc, Context, MemoryLocation, Recorder};
 
 use crate::error::Result;
 
@@ -53,7 +53,6 @@ impl PathGrid {
     pub(super) fn record_reset(&self, rec: &mut Recorder) {
         rec.fill_buffer(&self.keys, 0, vk::WHOLE_SIZE, 0);
         rec.fill_buffer(&self.sums, 0, vk::WHOLE_SIZE, 0);
-        rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
         self.epoch.store(0, Ordering::Relaxed);
         self.cleared.store(true, Ordering::Relaxed);
     }
@@ -72,7 +71,6 @@ impl PathGrid {
         let (first, count) = (u64::from(slots.start), u64::from(slots.len() as u32));
         rec.fill_buffer(&self.keys, first * KEY_BYTES, count * KEY_BYTES, 0);
         rec.fill_buffer(&self.sums, first * SUM_BYTES, count * SUM_BYTES, 0);
-        rec.barrier(Access::TRANSFER_WRITE, Access::COMPUTE_READ_WRITE);
     }
 
     /// The epoch of the next dispatch (from 1; 0 tells the shader the grid is off).
