@@ -41,7 +41,7 @@ use radcache_shared::gpu::IcCounters;
 
 mod path_grid;
 mod push;
-use path_grid::PathGrid;
+pub use path_grid::{GridJob, PathGrid};
 pub use push::{creation_seed, record_seed, RecordPush};
 
 /// The shader, relative to `shaders/`.
@@ -95,7 +95,7 @@ pub struct RecordVariant {
     pub glossy_spacing: GlossySpacing,
     /// With [`PathGridMode::On`] and a scene whose plan allows it (`ScenePlan::path_grid`: some
     /// material is Lambertian) the gathers share a radiance grid (`PATH_GRID`,
-    /// docs/cache-frame.md §4.1), which [`RecordPass::record_grid_frame`] readies at the start
+    /// docs/cache-frame.md §4.1), which the frame readies at the start ([`RecordPass::grid`])
     /// of each frame.
     pub path_grid: PathGridMode,
 }
@@ -281,16 +281,10 @@ impl RecordPass {
         self.grid.is_some()
     }
 
-    /// Readies the radiance grid for a frame (its first step; nothing without a grid): clears it,
-    /// or with `age = Some((frame, life))` (a renderer that keeps records with lifespans,
-    /// docs/temporal.md §3.8) clears only the slice that keeps every cell at most `life` frames
-    /// old; the other cells, ready ones included, serve this frame's gathers and refreshes.
-    pub fn record_grid_frame(&self, rec: &mut Recorder, age: Option<(u32, u32)>) {
-        match (&self.grid, age) {
-            (Some(g), Some((frame, life))) => g.record_age(rec, frame, life),
-            (Some(g), None) => g.record_reset(rec),
-            (None, _) => {}
-        }
+    /// The radiance grid its gathers share ([`RecordVariant::path_grid`]), which the frame
+    /// readies at its start ([`PathGrid::record`]); `None` without one.
+    pub fn grid(&self) -> Option<&PathGrid> {
+        self.grid.as_ref()
     }
 
     /// The parameters the pass was built with.

@@ -18,7 +18,7 @@ use crate::passes::composite::{CentreSamples, CompositeInputs, CompositeJob};
 use crate::passes::direct::{CompositeSubFrame, CompositeTargets, DirectInputs, DirectOutputs};
 use crate::passes::holes::HoleSelection;
 use crate::passes::neighbours::NeighbourJob;
-use crate::passes::record::{creation_seed, RecordInputs, RecordJob, RecordOutputs};
+use crate::passes::record::{creation_seed, GridJob, RecordInputs, RecordJob, RecordOutputs};
 use crate::passes::splat::{SplatDraw, SplatInputs, SplatOutput, SplatScope, SplatWeights};
 use crate::passes::temporal::{expires_at, TemporalInputs, TemporalJob};
 use crate::scene::GpuScene;
@@ -138,8 +138,14 @@ impl IcRenderer {
         // so that no cell is older than a record may be (`Δt_max`, docs/temporal.md §3.8).
         let lifespans = self.temporal.as_ref().is_some_and(|t| t.lifespans());
         let life = self.params.max_age_frames.round().max(1.0) as u32;
-        let age = (temporal && lifespans && self.has_records).then_some((now, life));
-        self.records.record_grid_frame(&mut rec, age);
+        if let Some(grid) = self.records.grid() {
+            let job = if temporal && lifespans && self.has_records {
+                GridJob::Age { frame: now, life }
+            } else {
+                GridJob::Reset
+            };
+            grid.record(&mut rec, job);
+        }
         if !self.has_records {
             self.state.record_reset(&mut rec)?;
         }

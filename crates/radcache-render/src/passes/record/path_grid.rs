@@ -2,7 +2,7 @@
 //! `PATH_GRID_CELLS` cells of a key, a ready epoch and a count (`uvec4`) and three 64-bit
 //! fixed-point sums (`int64_t[4]`). A frame whose records are not kept over time clears it at its
 //! start; a renderer that keeps records with lifespans (temporal caching) keeps it over frames
-//! and clears a slice of it per frame instead ([`PathGrid::record_age`], docs/temporal.md §3.8).
+//! and clears a slice of it per frame instead ([`GridJob::Age`], docs/temporal.md §3.8).
 //! Each dispatch that uses it takes the next epoch; epochs keep counting across frames until a
 //! whole reset.
 
@@ -18,9 +18,27 @@ use crate::error::Result;
 const KEY_BYTES: u64 = 16;
 const SUM_BYTES: u64 = 32;
 
+/// What a frame does to the grid at its start ([`PathGrid::record`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GridJob {
+    /// Clear every cell (a frame whose records are not kept with lifespans).
+    Reset,
+    /// Clear the slice frame `frame` ages out, so that no cell is older than `life` frames (a
+    /// renderer that keeps records with lifespans, docs/temporal.md §3.8); the other cells, ready
+    /// ones included, serve this frame's gathers and refreshes.
+    Age {
+        /// The frame number.
+        frame: u32,
+        /// The longest life of a cell, in frames.
+        life: u32,
+    },
+}
+
 /// The grid's buffers, the epoch of the next dispatch, and whether a whole clear has been
-/// recorded since they were allocated (their memory is undefined until then).
-pub(super) struct PathGrid {
+/// recorded since they were allocated (their memory is undefined until then). The record pass
+/// owns it ([`crate::passes::record::RecordPass::grid`]) and binds it to its gathers.
+#[derive(Debug)]
+pub struct PathGrid {
     pub(super) keys: Buffer,
     pub(super) sums: Buffer,
     epoch: AtomicU32,
@@ -28,7 +46,7 @@ pub(super) struct PathGrid {
 }
 
 impl PathGrid {
-    /// The grid's buffers (GPU-only, cleared by [`PathGrid::record_reset`] before use).
+    /// The grid's buffers (GPU-only, cleared by [`GridJob::Reset`] before use).
     pub(super) fn new(ctx: &Context) -> Result<PathGrid> {
         let cells = u64::from(PATH_GRID_CELLS);
         let buffer = |name, size| {
@@ -49,8 +67,16 @@ impl PathGrid {
         })
     }
 
+    /// Records `job`, the grid's step at the start of a frame.
+    pub fn record(&self, rec: &mut Recorder, job: GridJob) {
+        match job {
+            GridJob::Reset => self.record_reset(rec),
+            GridJob::Age { frame, life } => self.record_age(rec, frame, life),
+        }
+    }
+
     /// Clears every cell; the dispatches after it count their epochs from 1 again.
-    pub(super) fn record_reset(&self, rec: &mut Recorder) {
+    fn record_reset(&self, rec: &mut Recorder) {
         rec.fill_buffer(&self.keys, 0, vk::WHOLE_SIZE, 0);
         rec.fill_buffer(&self.sums, 0, vk::WHOLE_SIZE, 0);
         self.epoch.store(0, Ordering::Relaxed);
@@ -62,7 +88,7 @@ impl PathGrid {
     /// that became ready in an earlier frame is read by every dispatch of this one. A grid never
     /// cleared yet (a renderer whose first frame starts from records imported from a cache file)
     /// is cleared whole.
-    pub(super) fn record_age(&self, rec: &mut Recorder, frame: u32, life: u32) {
+    fn record_age(&self, rec: &mut Recorder, frame: u32, life: u32) {
         if !self.cleared.load(Ordering::Relaxed) {
             self.record_reset(rec);
             return;
