@@ -9,7 +9,10 @@ mod common;
 
 use common::{colour_image, compiler, expect_panic, fill_pipeline, finish, host_buffer};
 use common::{tri_pipeline, FillPush};
-use radcache_vk::{vk, ColorTarget, Context, ContextOptions, RenderTargets, Resource};
+use radcache_vk::{
+    vk, Buffer, ColorTarget, Context, ContextOptions, Image, Pipeline, Recorder, RenderTargets,
+    Resource,
+};
 
 const STORAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::STORAGE_BUFFER;
 const INDIRECT: vk::BufferUsageFlags = vk::BufferUsageFlags::INDIRECT_BUFFER;
@@ -80,75 +83,106 @@ fn dispatches_see_what_the_commands_before_them_wrote() {
     finish(ctx);
 }
 
+/// A triangle over an 8×8 target, its colour and its indirect arguments (written by transfers).
+struct Draw {
+    tri: Pipeline,
+    colour: Buffer,
+    args: Buffer,
+    target: Image,
+}
+
+impl Draw {
+    fn new(ctx: &Context) -> Draw {
+        Draw {
+            tri: tri_pipeline(ctx, &compiler()),
+            colour: host_buffer(ctx, "test.colour", STORAGE, &[0; 4]),
+            args: host_buffer(ctx, "test.draw_args", INDIRECT, &[0; 4]),
+            target: colour_image(ctx, "test.target", 8),
+        }
+    }
+
+    /// Records writing `colour` and the arguments of one triangle (transfers).
+    fn write_inputs(&self, rec: &mut Recorder, colour: [f32; 4]) {
+        rec.update_buffer(&self.colour, 0, &colour);
+        rec.update_buffer(&self.args, 0, &[3u32, 1, 0, 0]);
+    }
+
+    fn colors(&self) -> [ColorTarget<'_>; 1] {
+        [ColorTarget {
+            image: &self.target,
+            clear: None,
+        }]
+    }
+}
+
 #[test]
 fn images_change_layout_with_their_use_across_recordings() {
     let ctx = checked_context();
-    let shaders = compiler();
-    let tri = tri_pipeline(&ctx, &shaders);
-    let colour = host_buffer(&ctx, "test.colour", STORAGE, &[0; 4]);
-    let draw_args = host_buffer(&ctx, "test.draw_args", INDIRECT, &[0; 4]);
-    let target = colour_image(&ctx, "test.target", 8);
+    let d = Draw::new(&ctx);
     // Cleared by a transfer, then drawn into with the colour and the draw's arguments both
     // written by transfers in the same recording.
     let mut rec = ctx.begin("first").unwrap();
-    rec.clear_color(&target, [1.0; 4]);
-    rec.update_buffer(&colour, 0, &[0.25f32, 0.5, 0.75, 1.0]);
-    rec.update_buffer(&draw_args, 0, &[3u32, 1, 0, 0]);
-    rec.bind_pipeline(&tri);
-    rec.push_bindings(&[(0, Resource::Buffer(&colour))]);
+    rec.clear_color(&d.target, [1.0; 4]);
+    d.write_inputs(&mut rec, [0.25, 0.5, 0.75, 1.0]);
+    rec.bind_pipeline(&d.tri);
+    rec.push_bindings(&[(0, Resource::Buffer(&d.colour))]);
     rec.begin_rendering(&RenderTargets {
-        colors: &[ColorTarget {
-            image: &target,
-            clear: None,
-        }],
+        colors: &d.colors(),
         depth: None,
-        indirect: &[&draw_args],
+        indirect: &[&d.args],
     });
-    rec.draw_indirect(&draw_args, 0, 1);
+    rec.draw_indirect(&d.args, 0, 1);
     rec.end_rendering();
     ctx.submit(rec).unwrap().wait().unwrap();
     // Read back by another recording (TRANSFER_SRC), then cleared again by a third.
-    let drawn: Vec<[f32; 4]> = ctx.read_image(&target).unwrap();
+    let drawn: Vec<[f32; 4]> = ctx.read_image(&d.target).unwrap();
     assert!(
         drawn.iter().all(|t| *t == [0.25, 0.5, 0.75, 1.0]),
         "{:?}",
         drawn[0]
     );
     let mut rec = ctx.begin("third").unwrap();
-    rec.clear_color(&target, [2.0; 4]);
+    rec.clear_color(&d.target, [2.0; 4]);
     ctx.submit(rec).unwrap().wait().unwrap();
-    let cleared: Vec<[f32; 4]> = ctx.read_image(&target).unwrap();
+    let cleared: Vec<[f32; 4]> = ctx.read_image(&d.target).unwrap();
     assert!(cleared.iter().all(|t| *t == [2.0; 4]));
-    drop((tri, colour, draw_args, target));
+    drop(d);
     finish(ctx);
 }
 
 #[test]
 fn a_draw_whose_resource_was_not_prepared_is_refused() {
     let ctx = checked_context();
-    let shaders = compiler();
-    let tri = tri_pipeline(&ctx, &shaders);
-    let colour = host_buffer(&ctx, "test.colour", STORAGE, &[0; 4]);
-    let draw_args = host_buffer(&ctx, "test.draw_args", INDIRECT, &[0; 4]);
-    let target = colour_image(&ctx, "test.target", 8);
-    let mut rec = ctx.begin("test").unwrap();
-    rec.update_buffer(&colour, 0, &[1.0f32; 4]);
-    rec.update_buffer(&draw_args, 0, &[3u32, 1, 0, 0]);
+    let d = Draw::new(&ctx);
+    // The colour pushed inside the rendering, just after a transfer wrote it.
+    let mut rec = ctx.begin("inside").unwrap();
+    d.write_inputs(&mut rec, [1.0; 4]);
     rec.begin_rendering(&RenderTargets {
-        colors: &[ColorTarget {
-            image: &target,
-            clear: Some([0.0; 4]),
-        }],
+        colors: &d.colors(),
         ..Default::default()
     });
-    rec.bind_pipeline(&tri);
-    // Pushed inside the rendering, the colour written just before would need a barrier there.
+    rec.bind_pipeline(&d.tri);
     expect_panic(
-        "push_bindings in recording \"test\": \"test.colour\" needs a barrier",
-        || rec.push_bindings(&[(0, Resource::Buffer(&colour))]),
+        "push_bindings in recording \"inside\": \"test.colour\" needs a barrier",
+        || rec.push_bindings(&[(0, Resource::Buffer(&d.colour))]),
     );
     rec.end_rendering();
     drop(rec);
-    drop((tri, colour, draw_args, target));
+    // The arguments not named in the rendering's `indirect`.
+    let mut rec = ctx.begin("unnamed").unwrap();
+    d.write_inputs(&mut rec, [1.0; 4]);
+    rec.bind_pipeline(&d.tri);
+    rec.push_bindings(&[(0, Resource::Buffer(&d.colour))]);
+    rec.begin_rendering(&RenderTargets {
+        colors: &d.colors(),
+        ..Default::default()
+    });
+    expect_panic(
+        "draw_indirect in recording \"unnamed\": \"test.draw_args\" needs a barrier",
+        || rec.draw_indirect(&d.args, 0, 1),
+    );
+    rec.end_rendering();
+    drop(rec);
+    drop(d);
     finish(ctx);
 }
