@@ -26,7 +26,7 @@ pub use gpu_allocator::MemoryLocation;
 
 use crate::context::{Context, DeviceShared, Garbage};
 use crate::error::{Error, Result, VkResultExt};
-use crate::hazard::{Track, Tracked};
+use crate::hazard::Target;
 
 /// What to create.
 #[derive(Debug, Clone)]
@@ -53,8 +53,8 @@ pub struct Buffer {
     usage: vk::BufferUsageFlags,
     /// Indices of the recordings that took this buffer and had not ended when it was last taken.
     uses: Mutex<Vec<u64>>,
-    /// Its last use, from which the barrier of its next use is derived (`hazard.rs`).
-    pub(crate) track: Tracked,
+    /// Its track: its last use, from which the barrier of its next use is derived (`hazard.rs`).
+    pub(crate) target: Target,
     address: Option<u64>,
     name: String,
     alloc_id: u64,
@@ -122,7 +122,7 @@ impl Buffer {
             size,
             usage,
             uses: Mutex::new(Vec::new()),
-            track: Track::shared(),
+            target: Target::new(desc.name, None),
             address: None,
             name: desc.name.to_string(),
             alloc_id,

@@ -15,12 +15,19 @@
 //! must reach the queue in the order they were recorded (checked: a resource last used by a
 //! recording that is still open cannot be used by another). A pipeline barrier's first scope
 //! covers everything submitted earlier to the queue, so a dependency on a use in an earlier,
-//! submitted recording is sound. At the end of every recording one global barrier makes the
-//! device's writes visible to the host, for read-backs after the wait.
+//! submitted recording is sound. At the end of a recording that wrote anything, one global barrier
+//! makes the device's writes visible to the host, for read-backs after the wait. A transition into
+//! a read-only layout is made visible to every shader stage at once, so that readers in other
+//! stages need no second barrier. What the tracks do not see — acceleration structures, built and
+//! read through device addresses — keeps its explicit barriers in `accel.rs` and `tlas.rs`.
+//!
+//! The layer's synchronization validation (`RADCACHE_VALIDATION=sync`, on for `cargo xtask test`)
+//! checks the derivation: a hazard no derived barrier orders is a validation error.
 //!
 //! Inside a rendering no barrier may be recorded, so what the draws use is prepared before it
 //! begins: the attachments by `begin_rendering`, the bindings by pushing them before it, the
-//! indirect arguments by naming them in [`crate::RenderTargets::indirect`]. A draw whose resource
+//! indirect arguments by naming them in [`crate::RenderTargets::indirect`], the index buffer by
+//! binding it before it. A draw whose resource
 //! would still need a barrier panics with the name of the resource. Uses by several draws of one
 //! rendering are not ordered against each other (blending and the draws' own atomics are the
 //! shaders' business, as in any renderer).
@@ -225,32 +232,36 @@ impl Track {
     }
 }
 
-/// A tracked resource as a barrier names it.
+/// A tracked resource as a barrier names it: made once with the resource, so that a use clones two
+/// `Arc`s and allocates nothing.
 #[derive(Debug, Clone)]
 pub(crate) struct Target {
-    pub name: String,
+    pub name: Arc<str>,
     pub track: Tracked,
     /// The image and its subresources (`None` for a buffer).
     pub image: Option<(vk::Image, vk::ImageSubresourceRange)>,
 }
 
+impl Target {
+    /// A new resource's target, with a fresh track.
+    pub fn new(name: &str, image: Option<(vk::Image, vk::ImageSubresourceRange)>) -> Target {
+        Target {
+            name: name.into(),
+            track: Track::shared(),
+            image,
+        }
+    }
+}
+
 impl crate::buffer::Buffer {
     pub(crate) fn target(&self) -> Target {
-        Target {
-            name: self.name().to_string(),
-            track: self.track.clone(),
-            image: None,
-        }
+        self.target.clone()
     }
 }
 
 impl crate::image::Image {
     pub(crate) fn target(&self) -> Target {
-        Target {
-            name: self.name().to_string(),
-            track: self.track.clone(),
-            image: Some((self.raw(), self.subresource_range())),
-        }
+        self.target.clone()
     }
 }
 

@@ -8,7 +8,7 @@ use gpu_allocator::MemoryLocation;
 
 use crate::context::{Context, DeviceShared, Garbage};
 use crate::error::{Error, Result, VkResultExt};
-use crate::hazard::{Track, Tracked};
+use crate::hazard::Target;
 
 /// What to create.
 #[derive(Debug, Clone)]
@@ -36,8 +36,9 @@ pub struct Image {
     aspect: vk::ImageAspectFlags,
     /// The usage it was created with (`TRANSFER_SRC | TRANSFER_DST` included).
     usage: vk::ImageUsageFlags,
-    /// Its layout and last use, from which the barrier of its next use is derived (`hazard.rs`).
-    pub(crate) track: Tracked,
+    /// Its track: its layout and last use, from which the barrier of its next use is derived
+    /// (`hazard.rs`).
+    pub(crate) target: Target,
     name: String,
     alloc_id: u64,
 }
@@ -49,6 +50,17 @@ impl std::fmt::Debug for Image {
             .field("extent", &self.extent)
             .field("format", &self.format)
             .finish()
+    }
+}
+
+/// The one mip level and layer of an image with `aspect`.
+fn full_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange {
+        aspect_mask: aspect,
+        base_mip_level: 0,
+        level_count: 1,
+        base_array_layer: 0,
+        layer_count: 1,
     }
 }
 
@@ -130,7 +142,7 @@ impl Image {
             },
             aspect,
             usage,
-            track: Track::shared(),
+            target: Target::new(desc.name, Some((raw, full_range(aspect)))),
             name: desc.name.to_string(),
             alloc_id,
         };
@@ -162,13 +174,7 @@ impl Image {
     }
 
     pub(crate) fn subresource_range(&self) -> vk::ImageSubresourceRange {
-        vk::ImageSubresourceRange {
-            aspect_mask: self.aspect,
-            base_mip_level: 0,
-            level_count: 1,
-            base_array_layer: 0,
-            layer_count: 1,
-        }
+        full_range(self.aspect)
     }
 
     pub(crate) fn aspect(&self) -> vk::ImageAspectFlags {
