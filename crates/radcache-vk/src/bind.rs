@@ -158,7 +158,7 @@ impl Recorder {
                 let writes = bound.written.contains(binding);
                 shader_use(res, l.kind, stage, writes).map(|(target, use_)| Pushed {
                     binding: *binding,
-                    target,
+                    target: target.clone(),
                     use_,
                 })
             })
@@ -176,13 +176,8 @@ impl Recorder {
         if graphics {
             // The draws come inside a rendering, where no barrier may be recorded: derive them
             // now (outside one, for the next rendering), or check that none is needed.
-            let scope = if self.state.rendering.is_some() {
-                Scope::InRendering
-            } else {
-                Scope::NextRendering
-            };
-            let uses: Vec<_> = pushed.iter().map(|p| (p.target.clone(), p.use_)).collect();
-            self.sync("push_bindings", scope, &uses);
+            let uses: Vec<_> = pushed.iter().map(|p| (&p.target, p.use_)).collect();
+            self.sync("push_bindings", self.scope_or(Scope::NextRendering), &uses);
         }
         self.state
             .bound
@@ -312,12 +307,12 @@ impl Recorder {
 /// How a shader at `stage` uses the resource at a binding (`writes`: the binding is not
 /// `readonly` in some shader of the pipeline); `None` for what is not tracked (a TLAS: its
 /// builds order themselves against ray queries, `tlas.rs`).
-fn shader_use(
-    res: &Resource<'_>,
+fn shader_use<'a>(
+    res: &Resource<'a>,
     kind: BindingKind,
     stage: vk::PipelineStageFlags2,
     writes: bool,
-) -> Option<(Target, Use)> {
+) -> Option<(&'a Target, Use)> {
     type A = vk::AccessFlags2;
     let storage = |writes: bool| {
         if writes {

@@ -136,7 +136,7 @@ impl Recorder {
                 d.image.name()
             );
         }
-        let mut uses: Vec<(Target, Use)> = colors
+        let mut uses: Vec<(&Target, Use)> = colors
             .iter()
             .map(|c| {
                 let u = Use::write(Access::COLOR_ATTACHMENT)
@@ -213,8 +213,8 @@ impl Recorder {
             max_depth: 1.0,
         };
         // SAFETY: recording outside a rendering (checked above); every attachment has its usage,
-        // was transitioned to the layout named above (`sync`) and contains the render area (checked by `check_attachment`); the images outlive the recording (the
-        // graveyard).
+        // was transitioned to the layout named above (`sync`) and contains the render area
+        // (`check_attachment`); the images outlive the recording (the graveyard).
         unsafe {
             self.shared.device.cmd_begin_rendering(self.cmd, &info);
             self.shared
@@ -305,13 +305,12 @@ impl Recorder {
             indices.size()
         );
         indices.used_by(self.index);
-        let scope = if self.state.rendering.is_some() {
-            Scope::InRendering
-        } else {
-            Scope::NextRendering
-        };
         let uses = [(indices.target(), Use::read(Access::INDEX_READ))];
-        self.sync("bind_index_buffer", scope, &uses);
+        self.sync(
+            "bind_index_buffer",
+            self.scope_or(Scope::NextRendering),
+            &uses,
+        );
         // SAFETY: recording; the buffer has INDEX_BUFFER usage and `offset` is a multiple of the
         // index size inside it (checked above); it outlives the recording (the graveyard).
         unsafe {
@@ -383,19 +382,23 @@ impl Recorder {
     /// arguments) need before a dispatch, or checks that a draw needs none, then checks that
     /// every pushed image is in its descriptor's layout.
     fn sync_bound(&mut self, call: &str, args: Option<&Buffer>) {
-        let bound = self.bound_for(call);
-        let mut uses: Vec<(Target, Use)> = bound
-            .uses
-            .iter()
-            .map(|p| (p.target.clone(), p.use_))
-            .collect();
+        // The uses are taken out of the bound pipeline while `sync` needs the recorder.
+        let pushed = std::mem::take(
+            &mut self
+                .state
+                .bound
+                .as_mut()
+                .expect("check_dispatch or check_draw found it bound")
+                .uses,
+        );
+        let mut uses: Vec<(&Target, Use)> = pushed.iter().map(|p| (&p.target, p.use_)).collect();
         uses.extend(args.map(|a| (a.target(), Use::read(Access::INDIRECT))));
-        let scope = if self.state.rendering.is_some() {
-            Scope::InRendering
-        } else {
-            Scope::Outside
-        };
-        self.sync(call, scope, &uses);
+        self.sync(call, self.scope_or(Scope::Outside), &uses);
+        self.state
+            .bound
+            .as_mut()
+            .expect("check_dispatch or check_draw found it bound")
+            .uses = pushed;
         self.check_layouts(call);
     }
 }

@@ -232,8 +232,8 @@ impl Track {
     }
 }
 
-/// A tracked resource as a barrier names it: made once with the resource, so that a use clones two
-/// `Arc`s and allocates nothing.
+/// A tracked resource as a barrier names it: made once with the resource, so that a use borrows it
+/// and allocates nothing.
 #[derive(Debug, Clone)]
 pub(crate) struct Target {
     pub name: Arc<str>,
@@ -254,14 +254,14 @@ impl Target {
 }
 
 impl crate::buffer::Buffer {
-    pub(crate) fn target(&self) -> Target {
-        self.target.clone()
+    pub(crate) fn target(&self) -> &Target {
+        &self.target
     }
 }
 
 impl crate::image::Image {
-    pub(crate) fn target(&self) -> Target {
-        self.target.clone()
+    pub(crate) fn target(&self) -> &Target {
+        &self.target
     }
 }
 
@@ -277,18 +277,27 @@ pub(crate) enum Scope {
 }
 
 impl Recorder {
+    /// `outside` outside a rendering; inside one, [`Scope::InRendering`].
+    pub(crate) fn scope_or(&self, outside: Scope) -> Scope {
+        if self.state.rendering.is_some() {
+            Scope::InRendering
+        } else {
+            outside
+        }
+    }
+
     /// Records the barriers `uses` need after what their resources' tracks say, and updates the
     /// tracks. `call` names the command in a panic: inside a rendering (`Scope::InRendering`), a
     /// use that would need a barrier (its resource was not prepared before the rendering began).
-    pub(crate) fn sync(&mut self, call: &str, scope: Scope, uses: &[(Target, Use)]) {
+    pub(crate) fn sync(&mut self, call: &str, scope: Scope, uses: &[(&Target, Use)]) {
         let mut merged: Vec<(&Target, Use)> = Vec::with_capacity(uses.len());
-        for (t, u) in uses {
+        for &(t, u) in uses {
             match merged
                 .iter_mut()
                 .find(|(m, _)| Arc::ptr_eq(&m.track, &t.track))
             {
-                Some((_, m)) => *m = m.merge(*u),
-                None => merged.push((t, *u)),
+                Some((_, m)) => *m = m.merge(u),
+                None => merged.push((t, u)),
             }
         }
         let tag = match scope {
