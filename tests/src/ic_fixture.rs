@@ -4,7 +4,7 @@
 
 use glam::{DVec3, Mat3, Quat, Vec3};
 use radcache_render::{
-    passes::direct::DirectInputs, passes::direct::DirectOutputs, passes::direct::DirectPass,
+    passes::direct::DirectImage, passes::direct::DirectInputs, passes::direct::DirectPass,
     passes::gbuffer::GBuffer, passes::gbuffer::GBufferPass, passes::gbuffer::GBufferVariant,
     EnvMap, GpuScene,
 };
@@ -149,8 +149,7 @@ impl Gpu {
                 seed,
                 glossy: None,
             };
-            pass.record(&mut rec, &inputs, &DirectOutputs::Image)
-                .unwrap();
+            pass.record(&mut rec, &inputs, &DirectImage).unwrap();
         }
         names(&self.ctx.submit(rec).unwrap().wait().unwrap())
     }
@@ -174,9 +173,7 @@ impl Gpu {
             seed,
             glossy: None,
         };
-        direct
-            .record(&mut rec, &inputs, &DirectOutputs::Image)
-            .unwrap();
+        direct.record(&mut rec, &inputs, &DirectImage).unwrap();
         self.ctx.submit(rec).unwrap().wait().unwrap();
         (self.read(&self.gbuffer.direct), direct.rays().unwrap())
     }

@@ -10,13 +10,14 @@ use radcache_cache::sampling::{
     basis_from_normal, frame_to_world, normalize_or_z, stratum_direction_local, stratum_jitter,
 };
 use radcache_render::{
-    passes::gbuffer::GBuffer, passes::record::record_seed, passes::record::RecordInputs,
-    passes::record::RecordJob, passes::record::RecordOutputs, passes::record::RecordPass,
-    passes::record::R_EPS_REL, state::IcStateDesc, GpuScene, IcState,
+    passes::gbuffer::GBuffer, passes::record::record_seed, passes::record::RadianceBlocks,
+    passes::record::RecordInputs, passes::record::RecordJob, passes::record::RecordOutputs,
+    passes::record::RecordPass, passes::record::WithRadiance, passes::record::R_EPS_REL,
+    state::IcStateDesc, GpuScene, IcState,
 };
 use radcache_scene::Scene;
 use radcache_shared::gpu::{DispatchArgs, DrawArgs, GpuRecord, IcCounters};
-use radcache_vk::{vk, Buffer, Context, Pipeline, ShaderCompiler};
+use radcache_vk::{vk, Buffer, Context, Pipeline, Recorder, ShaderCompiler};
 
 use crate::geometry::intersect;
 use crate::ic_fixture::{fill_gbuffer_points, gbuffer_fill_pipeline, GbufferPoint};
@@ -131,14 +132,58 @@ pub fn create(seed: u32, level: u32, sub_frame: u32) -> RecordJob {
     }
 }
 
-/// Runs `job` over `batch`, dumping the strata's samples, with `radiance` for the records'
-/// radiance blocks.
+/// Runs `job` over `batch` with a pass made with radiance blocks, dumping the strata's samples,
+/// the blocks into `radiance`.
 pub fn run_with_radiance(
     f: &mut Fixture,
-    pass: &RecordPass,
+    pass: &RecordPass<WithRadiance>,
+    batch: &Batch<'_>,
+    job: RecordJob,
+    radiance: &Buffer,
+) -> Run {
+    run_pass(
+        f,
+        pass,
+        batch,
+        job,
+        Some(radiance),
+        |rec, inputs, records, samples| {
+            let outputs = RecordOutputs {
+                samples: Some(samples),
+                ..RecordOutputs::with_radiance(records, radiance)
+            };
+            pass.record(rec, inputs, &outputs).unwrap();
+        },
+    )
+}
+
+/// [`run_with_radiance`] for a pass without radiance coefficients.
+pub fn run(f: &mut Fixture, pass: &RecordPass, batch: &Batch<'_>, job: RecordJob) -> Run {
+    run_pass(
+        f,
+        pass,
+        batch,
+        job,
+        None,
+        |rec, inputs, records, samples| {
+            let outputs = RecordOutputs {
+                samples: Some(samples),
+                ..RecordOutputs::records(records)
+            };
+            pass.record(rec, inputs, &outputs).unwrap();
+        },
+    )
+}
+
+/// Runs `job` over `batch`: `record` records `pass` with the inputs into the records and the
+/// sample dump; `radiance` is read back.
+fn run_pass<R: RadianceBlocks>(
+    f: &mut Fixture,
+    pass: &RecordPass<R>,
     batch: &Batch<'_>,
     job: RecordJob,
     radiance: Option<&Buffer>,
+    record: impl FnOnce(&mut Recorder, &RecordInputs<'_>, &Buffer, &Buffer),
 ) -> Run {
     let Batch {
         points,
@@ -165,12 +210,7 @@ pub fn run_with_radiance(
         counters: &st.counters,
         job,
     };
-    let outputs = RecordOutputs {
-        records: &st.records,
-        radiance,
-        samples: Some(&samples),
-    };
-    pass.record(&mut rec, &inputs, &outputs).unwrap();
+    record(&mut rec, &inputs, &st.records, &samples);
     let timings = f.ctx.submit(rec).unwrap().wait().unwrap();
     assert!(timings.iter().any(|t| t.name == "records"), "no scope");
     Run {
@@ -180,11 +220,6 @@ pub fn run_with_radiance(
         rays: pass.rays().unwrap(),
         radiance: radiance.map(|b| read_all(&f.ctx, b)).unwrap_or_default(),
     }
-}
-
-/// [`run_with_radiance`] without radiance coefficients.
-pub fn run(f: &mut Fixture, pass: &RecordPass, batch: &Batch<'_>, job: RecordJob) -> Run {
-    run_with_radiance(f, pass, batch, job, None)
 }
 
 /// Every vec4 of `buffer`.

@@ -7,10 +7,10 @@ use radcache_render::{
     frame::settings::sub_frame_jitter, passes::composite::CentreSamples,
     passes::composite::CompositeInputs, passes::composite::CompositeJob,
     passes::composite::CompositePass, passes::composite::CompositeVariant,
-    passes::direct::CompositeSubFrame, passes::direct::CompositeTargets,
-    passes::direct::DirectCompositing, passes::direct::DirectInputs, passes::direct::DirectOutputs,
+    passes::composite::WithCentres, passes::direct::CompositeSubFrame, passes::direct::Composited,
+    passes::direct::DirectCompositing, passes::direct::DirectImage, passes::direct::DirectInputs,
     passes::direct::DirectPass, passes::direct::DirectShadows, passes::direct::DirectVariant,
-    passes::splat::SplatPass, EmitterLight, SkyLight,
+    passes::splat::SplatPass, passes::splat_glossy::GlossySplatPass, EmitterLight, SkyLight,
 };
 use radcache_tests::ic_fixture::{cornell, Gpu};
 
@@ -26,16 +26,16 @@ fn the_direct_pass_composites_as_the_composite_pass() {
     let gpu = Gpu::new(&cornell(), None, (w, h));
     let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
     let direct_variant = DirectVariant {
-        composite: Some(DirectCompositing { moments: true }),
         shadows: DirectShadows::Adaptive { pixels: w * h },
         ..DirectVariant::new(SkyLight::Direct, EmitterLight::Analytic)
-    };
+    }
+    .to(DirectCompositing { moments: true });
     let direct = || DirectPass::new(ctx, shaders, &gpu.scene, &direct_variant).unwrap();
     let variant = CompositeVariant {
         moments: true,
-        centres: true,
         ..CompositeVariant::new(w, h)
-    };
+    }
+    .with(WithCentres);
     let composite = || CompositePass::new(ctx, shaders, &gpu.scene, &variant).unwrap();
     // [fused, separate]
     let passes = [(direct(), composite()), (direct(), composite())];
@@ -49,13 +49,6 @@ fn the_direct_pass_composites_as_the_composite_pass() {
         seed,
         glossy: None,
     };
-    // A direct pass made to composite refuses the plain recording.
-    let mut rec = ctx.begin("test.refused").unwrap();
-    let plain = passes[0]
-        .0
-        .record(&mut rec, &inputs(0), &DirectOutputs::Image);
-    assert!(plain.is_err());
-    drop(rec);
     for k in 0..5 {
         let jitter = sub_frame_jitter(k);
         let mut rec = ctx.begin("test.sub_frame").unwrap();
@@ -71,11 +64,9 @@ fn the_direct_pass_composites_as_the_composite_pass() {
                 composite.record(&mut rec, CompositeJob::Clear).unwrap();
             }
             let fused = k > 0 && i == 0;
-            let outputs = DirectOutputs::Composited {
-                targets: CompositeTargets {
-                    composite,
-                    splat: &splat,
-                },
+            let outputs = Composited {
+                composite,
+                splat: &splat,
                 sub_frame: fused.then_some(CompositeSubFrame { jitter }),
             };
             direct.record(&mut rec, &inputs(k), &outputs).unwrap();
@@ -86,10 +77,7 @@ fn the_direct_pass_composites_as_the_composite_pass() {
                 } else {
                     CentreSamples::Match
                 };
-                let inputs = CompositeInputs {
-                    centre,
-                    ..CompositeInputs::own(&gpu.scene, g, &splat, jitter)
-                };
+                let inputs = CompositeInputs::own(&gpu.scene, g, &splat, jitter).at(centre);
                 composite
                     .record(&mut rec, CompositeJob::Add(&inputs))
                     .unwrap();
@@ -119,5 +107,66 @@ fn the_direct_pass_composites_as_the_composite_pass() {
         separate.read_unmatched().unwrap()
     );
     drop((passes, splat));
+    gpu.end();
+}
+
+/// A direct or composite pass made without radiance records has no glossy weights to write or
+/// glossy target to add: handed a glossy splat, each refuses with an error that names it (a
+/// silent recording would leave the glossy splat's weights unwritten), records nothing, and the
+/// same passes record without it.
+#[test]
+fn passes_made_without_radiance_refuse_a_glossy_splat() {
+    let (w, h) = (16, 12);
+    let gpu = Gpu::new(&cornell(), None, (w, h));
+    let (ctx, shaders) = (&gpu.ctx, &gpu.shaders);
+    let variant = DirectVariant::new(SkyLight::Direct, EmitterLight::Analytic);
+    let direct = DirectPass::new(ctx, shaders, &gpu.scene, &variant).unwrap();
+    let composite =
+        CompositePass::new(ctx, shaders, &gpu.scene, &CompositeVariant::new(w, h)).unwrap();
+    let splat = SplatPass::new(ctx, shaders, w, h).unwrap();
+    let glossy = GlossySplatPass::new(ctx, shaders, w, h, false).unwrap();
+    let inputs = |glossy| DirectInputs {
+        scene: &gpu.scene,
+        gbuffer: &gpu.gbuffer,
+        samples: 1,
+        sub_frame: 0,
+        seed: 1,
+        glossy,
+    };
+    let composited = |glossy| CompositeInputs {
+        glossy,
+        ..CompositeInputs::own(&gpu.scene, &gpu.gbuffer, &splat, [0.0; 2])
+    };
+    let mut rec = ctx.begin("test.refused").unwrap();
+    let err = direct
+        .record(&mut rec, &inputs(Some(&glossy)), &DirectImage)
+        .unwrap_err();
+    assert!(err.to_string().contains("direct pass"), "{err}");
+    assert!(err.to_string().contains("glossy splat"), "{err}");
+    let with_glossy = composited(Some(&glossy));
+    let err = composite
+        .record(&mut rec, CompositeJob::Add(&with_glossy))
+        .unwrap_err();
+    assert!(err.to_string().contains("composite pass"), "{err}");
+    assert!(err.to_string().contains("glossy splat"), "{err}");
+    gpu.pass
+        .record(&mut rec, &gpu.scene, &gpu.gbuffer, [0.0; 2])
+        .unwrap();
+    // No records: Σw = 0 everywhere.
+    rec.clear_color(&splat.sum, [0.0; 4]);
+    rec.clear_color(&splat.count, [0.0; 4]);
+    direct
+        .record(&mut rec, &inputs(None), &DirectImage)
+        .unwrap();
+    let plain = composited(None);
+    composite.record(&mut rec, CompositeJob::Clear).unwrap();
+    composite
+        .record(&mut rec, CompositeJob::Add(&plain))
+        .unwrap();
+    ctx.submit(rec).unwrap().wait().unwrap();
+    let (mean, dropped) = composite.read_mean(ctx).unwrap();
+    assert_eq!(dropped, 0);
+    assert!(mean.iter().any(|p| p[0] > 0.0), "the box is lit");
+    drop((direct, composite, splat, glossy));
     gpu.end();
 }

@@ -20,7 +20,10 @@ use radcache_cache::radiance::{
 use radcache_cache::record::wall_term;
 use radcache_cache::sampling::stratum_index;
 use radcache_cache::{IcParams, IC_FAR};
-use radcache_render::{passes::record::RecordPass, passes::record::RecordVariant, SkyLight};
+use radcache_render::{
+    passes::record::RecordPass, passes::record::RecordVariant, passes::record::WithRadiance,
+    GlossySpacing, SkyLight,
+};
 use radcache_shared::consts::{
     RADIANCE_VEC4S, RECORD_FLAG_GLOSSY, RECORD_RADIANCE_VEC4S, SH_COEFFS,
 };
@@ -117,7 +120,7 @@ fn radiance_coefficients_and_gradients_match_the_cpu_twin() {
     let (base, seed) = (2u32, 23u32);
     let c = counters(base, k, k, 64);
     let batch = Batch::new(&points, &requests, c);
-    let out = run_with_radiance(&mut f, &pass, &batch, create(seed, 1, 0), Some(&radiance));
+    let out = run_with_radiance(&mut f, &pass, &batch, create(seed, 1, 0), &radiance);
     let (m, n) = (params.strata_m, params.strata_n);
     let count = (m * n) as usize;
     let mut folded_any = false;
@@ -229,7 +232,7 @@ fn records_for_glossy_lobes_keep_the_full_strata_at_fine_levels() {
         .unwrap();
     let c = counters(0, 2, 2, 64);
     let batch = Batch::new(&points, &requests, c);
-    let out = run_with_radiance(&mut f, &pass, &batch, create(5, level, 0), Some(&radiance));
+    let out = run_with_radiance(&mut f, &pass, &batch, create(5, level, 0), &radiance);
     let per = params.sample_count() as usize;
     // A stratum the pass traced has a positive distance (the room is closed); the others keep
     // the dump's zeros.
@@ -247,9 +250,8 @@ fn records_for_glossy_lobes_keep_the_full_strata_at_fine_levels() {
 }
 
 /// Records with radiance coefficients, for `params`.
-fn radiance_variant(params: IcParams) -> RecordVariant {
-    RecordVariant {
-        radiance: true,
-        ..RecordVariant::new(params, SkyLight::Records)
-    }
+fn radiance_variant(params: IcParams) -> RecordVariant<WithRadiance> {
+    RecordVariant::new(params, SkyLight::Records).with(WithRadiance {
+        glossy_spacing: GlossySpacing::Lobe,
+    })
 }

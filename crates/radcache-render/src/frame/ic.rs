@@ -16,16 +16,18 @@ use crate::frame::path::{FrameOutput, Progress};
 use crate::frame::settings::{
     EmitterShadows, GlossyLight, IcDebug, IcSettings, IcStats, SplatMode,
 };
-use crate::passes::composite::{CompositePass, CompositeVariant};
+use crate::passes::composite::{CompositePass, CompositeVariant, WithCentres};
 use crate::passes::direct::{DirectCompositing, DirectPass, DirectShadows, DirectVariant};
 use crate::passes::emission::EmissionPass;
 use crate::passes::gbuffer::{GBuffer, GBufferPass, GBufferVariant};
 use crate::passes::holes::HolePass;
 use crate::passes::neighbours::NeighbourPass;
-use crate::passes::record::{RecordPass, RecordVariant};
+use crate::passes::record::{
+    PathGrid, RecordInputs, RecordOutputs, RecordPass, RecordVariant, WithRadiance,
+};
 use crate::passes::splat::SplatPass;
 use crate::passes::splat_glossy::GlossySplatPass;
-use crate::passes::temporal::{TemporalPass, TemporalVariant};
+use crate::passes::temporal::{NoLifespans, TemporalPass, TemporalVariant, WithLifespans};
 use crate::scene::GpuScene;
 use crate::state::{IcState, IcStateDesc};
 
@@ -36,6 +38,110 @@ mod temporal;
 
 use phases::FrameRun;
 
+/// The passes that shade a sub-frame, as the splat mode makes them: splatting once
+/// ([`SplatMode::Once`]), the composite keeps the centre samples and the direct pass composites
+/// the later sub-frames against them (docs/cache-frame.md §6.5).
+enum Shading {
+    /// [`SplatMode::PerSubFrame`].
+    PerSubFrame {
+        direct: DirectPass,
+        composite: CompositePass,
+    },
+    /// [`SplatMode::Once`].
+    Once {
+        direct: DirectPass<DirectCompositing>,
+        composite: CompositePass<WithCentres>,
+    },
+}
+
+/// The record pass, as the frame's radiance records make it.
+enum Records {
+    /// Irradiance records alone.
+    Irradiance(RecordPass),
+    /// Records with radiance blocks ([`crate::scene::ScenePlan::radiance_cache`]).
+    Radiance(RecordPass<WithRadiance>),
+}
+
+impl Records {
+    /// Records `inputs`' job into `records`, with `radiance` the buffer of the blocks for a
+    /// pass made with them (and only then).
+    fn record(
+        &self,
+        rec: &mut radcache_vk::Recorder,
+        inputs: &RecordInputs<'_>,
+        records: &radcache_vk::Buffer,
+        radiance: Option<&radcache_vk::Buffer>,
+    ) -> Result<()> {
+        match (self, radiance) {
+            (Records::Irradiance(pass), None) => {
+                pass.record(rec, inputs, &RecordOutputs::records(records))
+            }
+            (Records::Radiance(pass), Some(blocks)) => {
+                let outputs = RecordOutputs::with_radiance(records, blocks);
+                pass.record(rec, inputs, &outputs)
+            }
+            (Records::Irradiance(_), Some(_)) => Err(Error::Invalid(
+                "the record pass was made without radiance blocks to write".into(),
+            )),
+            (Records::Radiance(_), None) => Err(Error::Invalid(
+                "the record pass writes radiance blocks, and no buffer holds them".into(),
+            )),
+        }
+    }
+
+    /// Ray queries of the last submitted dispatch.
+    fn rays(&self) -> Result<u64> {
+        match self {
+            Records::Irradiance(pass) => pass.rays(),
+            Records::Radiance(pass) => pass.rays(),
+        }
+    }
+
+    /// The radiance grid the gathers share, if any.
+    fn grid(&self) -> Option<&PathGrid> {
+        match self {
+            Records::Irradiance(pass) => pass.grid(),
+            Records::Radiance(pass) => pass.grid(),
+        }
+    }
+}
+
+/// The temporal pass, as the frame's records are kept: with lifespans (a time step) or only
+/// re-clamped to new views (`settle_records`, imported records).
+enum Temporal {
+    /// Records without lifespans.
+    Kept(TemporalPass<NoLifespans>),
+    /// Records with lifespans, evaluated one frame ahead.
+    Lifespans(TemporalPass<WithLifespans>),
+}
+
+impl Temporal {
+    /// The records carry lifespans.
+    fn lifespans(&self) -> bool {
+        matches!(self, Temporal::Lifespans(_))
+    }
+
+    /// Forgets the previous frame's instances and any pending look-ahead.
+    fn forget(&mut self) {
+        match self {
+            Temporal::Kept(t) => t.forget(),
+            Temporal::Lifespans(t) => t.forget(),
+        }
+    }
+}
+
+/// `$body` with `$c` bound to the composite pass of `$shading`, whichever its kind (the
+/// accumulators' reads and the emission do not depend on it).
+macro_rules! with_composite {
+    ($shading:expr, |$c:ident| $body:expr) => {
+        match $shading {
+            Shading::PerSubFrame { composite: $c, .. } => $body,
+            Shading::Once { composite: $c, .. } => $body,
+        }
+    };
+}
+use with_composite;
+
 /// The cache's passes and state for one image size and one set of cache parameters.
 pub struct IcRenderer {
     width: u32,
@@ -43,7 +149,8 @@ pub struct IcRenderer {
     params: IcParams,
     gbuffer: GBuffer,
     gbuffer_pass: GBufferPass,
-    direct: DirectPass,
+    /// The direct and composite passes.
+    shading: Shading,
     splat: SplatPass,
     /// Radiance records for glossy lobes (docs/radiance-caching.md §6): in scenes with
     /// materials rough enough ([`radcache_scene::ScenePlan::radiance_cache`]); the blocks are
@@ -54,12 +161,11 @@ pub struct IcRenderer {
     glossy_valid: bool,
     holes: HolePass,
     neighbours: NeighbourPass,
-    records: RecordPass,
-    composite: CompositePass,
+    records: Records,
     emission: EmissionPass,
     state: IcState,
     /// Records kept across frames (created for sequences: `settle_records` or a time step).
-    temporal: Option<TemporalPass>,
+    temporal: Option<Temporal>,
     /// The previous frame's `clip_from_world` (kept records are re-clamped when it changes).
     last_view: Option<[[f32; 4]; 4]>,
     /// Re-clamp the kept records at the next frame whatever its view (imported records, made
@@ -122,54 +228,26 @@ impl IcRenderer {
             params,
             gbuffer: GBuffer::new(ctx, w, h)?,
             gbuffer_pass: GBufferPass::new(ctx, shaders, gpu, GBufferVariant::planned(gpu.plan()))?,
-            // Splatting once, the later sub-frames' composite is the direct pass's.
-            direct: DirectPass::new(
-                ctx,
-                shaders,
-                gpu,
-                &DirectVariant {
-                    sky: settings.sky,
-                    emitters: settings.emitters,
-                    radiance,
-                    composite: (settings.splat == SplatMode::Once).then_some(DirectCompositing {
-                        moments: settings.anti_aliasing.is_some(),
-                    }),
-                    shadows: match settings.emitter_shadows {
-                        EmitterShadows::Adaptive => DirectShadows::Adaptive { pixels: w * h },
-                        EmitterShadows::Fixed => DirectShadows::Fixed,
-                    },
-                    specular_paths: settings.specular_paths,
-                },
-            )?,
+            shading: Self::shading(ctx, shaders, gpu, settings, radiance)?,
             splat: SplatPass::new(ctx, shaders, w, h)?,
             glossy,
             glossy_valid: true,
             holes: HolePass::new(ctx, shaders)?,
             neighbours: NeighbourPass::new(ctx, shaders)?,
-            records: RecordPass::new(
-                ctx,
-                shaders,
-                gpu,
-                &RecordVariant {
-                    params,
-                    sky: settings.sky,
-                    radiance,
-                    glossy_spacing: settings.glossy_spacing,
+            records: {
+                let variant = RecordVariant {
                     path_grid: settings.path_grid,
-                },
-            )?,
-            composite: CompositePass::new(
-                ctx,
-                shaders,
-                gpu,
-                &CompositeVariant {
-                    width: w,
-                    height: h,
-                    radiance,
-                    moments: settings.anti_aliasing.is_some(),
-                    centres: settings.splat == SplatMode::Once,
-                },
-            )?,
+                    ..RecordVariant::new(params, settings.sky)
+                };
+                if radiance {
+                    let radiance = WithRadiance {
+                        glossy_spacing: settings.glossy_spacing,
+                    };
+                    Records::Radiance(RecordPass::new(ctx, shaders, gpu, &variant.with(radiance))?)
+                } else {
+                    Records::Irradiance(RecordPass::new(ctx, shaders, gpu, &variant)?)
+                }
+            },
             emission: EmissionPass::new(ctx, shaders, gpu)?,
             state: IcState::new(
                 ctx,
@@ -180,12 +258,22 @@ impl IcRenderer {
                 },
             )?,
             temporal: if temporal {
-                let variant = TemporalVariant {
-                    record_capacity: capacity,
-                    lifespans: settings.time_step_s > 0.0,
-                    radiance,
-                };
-                Some(TemporalPass::new(ctx, shaders, gpu, &variant)?)
+                let record_capacity = capacity;
+                Some(if settings.time_step_s > 0.0 {
+                    let variant = TemporalVariant {
+                        record_capacity,
+                        lifespans: WithLifespans,
+                        radiance,
+                    };
+                    Temporal::Lifespans(TemporalPass::new(ctx, shaders, gpu, &variant)?)
+                } else {
+                    let variant = TemporalVariant {
+                        record_capacity,
+                        lifespans: NoLifespans,
+                        radiance,
+                    };
+                    Temporal::Kept(TemporalPass::new(ctx, shaders, gpu, &variant)?)
+                })
             } else {
                 None
             },
@@ -199,6 +287,49 @@ impl IcRenderer {
                 .is_some(),
             splat_mode: settings.splat,
             made_with: settings.clone(),
+        })
+    }
+
+    /// The direct and composite passes for `settings`' splat mode (`radiance`: the frame has
+    /// radiance records).
+    fn shading(
+        ctx: &Context,
+        shaders: &ShaderCompiler,
+        gpu: &GpuScene,
+        settings: &IcSettings,
+        radiance: bool,
+    ) -> Result<Shading> {
+        let (w, h) = (settings.width, settings.height);
+        let moments = settings.anti_aliasing.is_some();
+        let direct = DirectVariant {
+            radiance,
+            shadows: match settings.emitter_shadows {
+                EmitterShadows::Adaptive => DirectShadows::Adaptive { pixels: w * h },
+                EmitterShadows::Fixed => DirectShadows::Fixed,
+            },
+            specular_paths: settings.specular_paths,
+            ..DirectVariant::new(settings.sky, settings.emitters)
+        };
+        let composite = CompositeVariant {
+            radiance,
+            moments,
+            ..CompositeVariant::new(w, h)
+        };
+        Ok(match settings.splat {
+            SplatMode::PerSubFrame => Shading::PerSubFrame {
+                direct: DirectPass::new(ctx, shaders, gpu, &direct)?,
+                composite: CompositePass::new(ctx, shaders, gpu, &composite)?,
+            },
+            // Splatting once, the later sub-frames' composite is the direct pass's.
+            SplatMode::Once => Shading::Once {
+                direct: DirectPass::new(
+                    ctx,
+                    shaders,
+                    gpu,
+                    &direct.to(DirectCompositing { moments }),
+                )?,
+                composite: CompositePass::new(ctx, shaders, gpu, &composite.with(WithCentres))?,
+            },
         })
     }
 
@@ -269,7 +400,7 @@ impl IcRenderer {
 
     fn read_debug(&self, ctx: &Context, sub_frames: u32, records: u64) -> Result<IcDebug> {
         let (indirect, weight_sum, records_per_pixel) =
-            self.composite.read_debug(ctx, sub_frames)?;
+            with_composite!(&self.shading, |c| c.read_debug(ctx, sub_frames))?;
         let mut record_positions = vec![0.0f32; (self.width * self.height) as usize];
         let all: Vec<GpuRecord> = ctx.read_buffer(&self.state.records, records as usize)?;
         for r in &all {

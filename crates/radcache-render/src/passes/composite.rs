@@ -57,12 +57,81 @@ pub enum CentreSamples {
     Match,
 }
 
+/// Whether a composite pass keeps the frame's centre samples, fixed when it is made: the type
+/// parameter of [`CompositeVariant`], [`CompositePass`] and [`CompositeInputs`], whose
+/// [`CompositeInputs::centre`] is [`Centres::Samples`]. [`OwnSamples`]: each sub-frame's splat
+/// is its own, and the pass holds no centre samples; [`WithCentres`] (splatting once per frame):
+/// it stores them at sub-frame 0 and matches the later sub-frames against them
+/// ([`CentreSamples`]). A pass made without them cannot be asked to store or match —
+///
+/// ```compile_fail,E0308
+/// use radcache_render::passes::composite::{CentreSamples, CompositeInputs};
+///
+/// // `CompositeInputs<'_>` (for `CompositePass<OwnSamples>`) takes `OwnSamples` only.
+/// fn matching(inputs: CompositeInputs<'_>) -> CompositeInputs<'_> {
+///     CompositeInputs { centre: CentreSamples::Match, ..inputs }
+/// }
+/// ```
+///
+/// — while inputs for a pass that keeps them can:
+///
+/// ```
+/// use radcache_render::passes::composite::{CentreSamples, CompositeInputs, WithCentres};
+///
+/// fn matching(inputs: CompositeInputs<'_, WithCentres>) -> CompositeInputs<'_, WithCentres> {
+///     CompositeInputs { centre: CentreSamples::Match, ..inputs }
+/// }
+/// ```
+pub trait Centres: sealed::Sealed + Copy + std::fmt::Debug + PartialEq + Eq {
+    /// Whose samples a sub-frame's splat holds, as the pass's inputs name them.
+    type Samples: Copy + std::fmt::Debug + PartialEq + Eq;
+    /// The pass keeps centre samples (allocates their buffer).
+    const KEPT: bool;
+    /// `samples` as the shader's choice.
+    fn samples(samples: Self::Samples) -> CentreSamples;
+}
+
+mod sealed {
+    /// Only this file's choices are [`super::Centres`].
+    pub trait Sealed {}
+    impl Sealed for super::OwnSamples {}
+    impl Sealed for super::WithCentres {}
+}
+
+/// Each sub-frame's splat was made at its own samples ([`CentreSamples::Own`]): a pass that
+/// keeps no centre samples, and the only samples its inputs name.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OwnSamples;
+
+impl Centres for OwnSamples {
+    type Samples = OwnSamples;
+    const KEPT: bool = false;
+
+    fn samples(_: OwnSamples) -> CentreSamples {
+        CentreSamples::Own
+    }
+}
+
+/// A pass that keeps the frame's centre samples (splatting once per frame): its inputs name
+/// any [`CentreSamples`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WithCentres;
+
+impl Centres for WithCentres {
+    type Samples = CentreSamples;
+    const KEPT: bool = true;
+
+    fn samples(samples: CentreSamples) -> CentreSamples {
+        samples
+    }
+}
+
 /// Bytes a pixel of the centre samples (two vec4: position and surface flag, normal and
 /// footprint).
 const CENTRE_BYTES: u64 = 32;
 
 /// The buffers of a [`CompositePass`] that a direct pass made to composite binds
-/// ([`crate::passes::direct::CompositeTargets`]).
+/// ([`crate::passes::direct::Composited`]).
 pub(crate) struct CompositeResources<'a> {
     pub accum: &'a Buffer,
     pub nonfinite: &'a Buffer,
@@ -70,8 +139,9 @@ pub(crate) struct CompositeResources<'a> {
     pub centre: &'a Buffer,
 }
 
-/// The composite pipeline and the frame accumulator.
-pub struct CompositePass {
+/// The composite pipeline and the frame accumulator; `C`, whether it keeps centre samples
+/// ([`Centres`]).
+pub struct CompositePass<C: Centres = OwnSamples> {
     pipeline: Pipeline,
     pub(crate) accum: Buffer,
     pub(crate) emission_accum: Buffer,
@@ -79,16 +149,19 @@ pub struct CompositePass {
     /// With moments the accumulator holds a second vec4 array after the first: Σ radiance²
     /// per pixel.
     moments: bool,
-    /// The centre samples (32 bytes a pixel when the pass was made for them, one vec4
-    /// otherwise).
+    /// Made with radiance ([`CompositeVariant::radiance`]): it may add a glossy splat's target.
+    radiance: bool,
+    /// The centre samples (32 bytes a pixel when the pass keeps them, [`Centres::KEPT`]; one
+    /// vec4 otherwise).
     centre: Buffer,
     /// Non-finite values dropped, then samples no centre matched (two `uint`s).
     nonfinite: Buffer,
     width: u32,
     height: u32,
+    centres: std::marker::PhantomData<C>,
 }
 
-impl std::fmt::Debug for CompositePass {
+impl<C: Centres> std::fmt::Debug for CompositePass<C> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("CompositePass")
             .field("width", &self.width)
@@ -97,9 +170,10 @@ impl std::fmt::Debug for CompositePass {
     }
 }
 
-/// What the composite pass is compiled for: its accumulators' size and shader variant.
+/// What the composite pass is compiled for: its accumulators' size and shader variant; `C`,
+/// whether it keeps centre samples ([`Centres`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct CompositeVariant {
+pub struct CompositeVariant<C: Centres = OwnSamples> {
     /// Accumulator width in pixels.
     pub width: u32,
     /// Accumulator height in pixels.
@@ -110,8 +184,28 @@ pub struct CompositeVariant {
     /// It also sums the squares of the radiance (`IC_AA_MOMENTS`,
     /// [`CompositePass::read_moments`]).
     pub moments: bool,
-    /// It can store and match centre samples ([`CentreSamples`]).
-    pub centres: bool,
+    /// It can store and match centre samples ([`WithCentres`]) or not ([`OwnSamples`]).
+    pub centres: C,
+}
+
+impl<C: Centres> CompositeVariant<C> {
+    /// The same variant, keeping centre samples as `centres` says.
+    pub fn with<D: Centres>(self, centres: D) -> CompositeVariant<D> {
+        let CompositeVariant {
+            width,
+            height,
+            radiance,
+            moments,
+            ..
+        } = self;
+        CompositeVariant {
+            width,
+            height,
+            radiance,
+            moments,
+            centres,
+        }
+    }
 }
 
 impl CompositeVariant {
@@ -123,27 +217,26 @@ impl CompositeVariant {
             height,
             radiance: false,
             moments: false,
-            centres: false,
+            centres: OwnSamples,
         }
     }
 }
 
 /// What a composite recording does.
 #[derive(Debug, Clone, Copy)]
-pub enum CompositeJob<'a> {
+pub enum CompositeJob<'a, C: Centres = OwnSamples> {
     /// Zero the accumulators and the non-finite counter (the start of a frame).
     Clear,
     /// Add the sub-frame rendered with the inputs' jitter to the accumulator: with
     /// `glossy`, the glossy target's `rgb/a` where its weight is positive; `centre` says whose
-    /// samples the splat targets hold (anything but [`CentreSamples::Own`] needs a pass made
-    /// with `centres`).
-    Add(&'a CompositeInputs<'a>),
+    /// samples the splat targets hold.
+    Add(&'a CompositeInputs<'a, C>),
 }
 
 /// What one composite dispatch reads: the G-buffer's samples, the splat's targets, and the
 /// sub-frame's parameters.
 #[derive(Debug, Clone, Copy)]
-pub struct CompositeInputs<'a> {
+pub struct CompositeInputs<'a, C: Centres = OwnSamples> {
     /// The scene.
     pub scene: &'a GpuScene,
     /// The sub-frame's samples and direct light.
@@ -154,10 +247,36 @@ pub struct CompositeInputs<'a> {
     pub glossy: Option<&'a GlossySplatPass>,
     /// The sub-frame's jitter.
     pub jitter: [f32; 2],
-    /// Whose samples the splat targets hold.
-    pub centre: CentreSamples,
+    /// Whose samples the splat targets hold (for a pass without centre samples, its own:
+    /// [`OwnSamples`]).
+    pub centre: C::Samples,
     /// Also accumulate the debug AOVs.
     pub debug: bool,
+}
+
+impl<'a, C: Centres> CompositeInputs<'a, C> {
+    /// The same inputs for a pass that keeps centre samples as `D` says, whose splat holds
+    /// `centre`'s.
+    pub fn at<D: Centres>(self, centre: D::Samples) -> CompositeInputs<'a, D> {
+        let CompositeInputs {
+            scene,
+            gbuffer,
+            splat,
+            glossy,
+            jitter,
+            debug,
+            ..
+        } = self;
+        CompositeInputs {
+            scene,
+            gbuffer,
+            splat,
+            glossy,
+            jitter,
+            centre,
+            debug,
+        }
+    }
 }
 
 impl<'a> CompositeInputs<'a> {
@@ -174,17 +293,17 @@ impl<'a> CompositeInputs<'a> {
             splat,
             glossy: None,
             jitter,
-            centre: CentreSamples::Own,
+            centre: OwnSamples,
             debug: false,
         }
     }
 }
 
-impl CompositePass {
+impl<C: Centres> CompositePass<C> {
     /// The shader module the pass compiles for a scene with `features` and `variant`.
     pub(crate) fn modules(
         features: &SceneFeatures,
-        variant: &CompositeVariant,
+        variant: &CompositeVariant<C>,
     ) -> Vec<ShaderModule> {
         let mut defines = features.defines();
         if variant.radiance {
@@ -201,13 +320,12 @@ impl CompositePass {
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
-        variant: &CompositeVariant,
-    ) -> Result<CompositePass> {
+        variant: &CompositeVariant<C>,
+    ) -> Result<CompositePass<C>> {
         let CompositeVariant {
             width,
             height,
             moments,
-            centres,
             ..
         } = *variant;
         let module = &Self::modules(&scene.features(), variant)[0];
@@ -242,20 +360,22 @@ impl CompositePass {
             emission_accum: buffer("composite.emission", pixels * 16, MemoryLocation::GpuOnly)?,
             debug_accum: buffer("composite.debug", pixels * 32, MemoryLocation::GpuOnly)?,
             moments,
+            radiance: variant.radiance,
             centre: buffer(
                 "composite.centre",
-                if centres { pixels * CENTRE_BYTES } else { 16 },
+                if C::KEPT { pixels * CENTRE_BYTES } else { 16 },
                 MemoryLocation::GpuOnly,
             )?,
             nonfinite: buffer("composite.nonfinite", 16, MemoryLocation::GpuToCpu)?,
             width,
             height,
+            centres: std::marker::PhantomData,
         })
     }
 
     /// Records `job`: zeroing the accumulators and the non-finite counter, or adding a
     /// sub-frame.
-    pub fn record(&self, rec: &mut Recorder, job: CompositeJob<'_>) -> Result<()> {
+    pub fn record(&self, rec: &mut Recorder, job: CompositeJob<'_, C>) -> Result<()> {
         let inputs = match job {
             CompositeJob::Clear => {
                 rec.fill_buffer(&self.accum, 0, vk::WHOLE_SIZE, 0);
@@ -275,9 +395,10 @@ impl CompositePass {
             centre,
             debug,
         } = *inputs;
-        if centre != CentreSamples::Own && !self.has_centres() {
+        if glossy.is_some() && !self.radiance {
             return Err(crate::error::Error::Invalid(
-                "the composite pass was made without centre samples".into(),
+                "the composite pass was made without radiance records: it takes no glossy splat"
+                    .into(),
             ));
         }
         // Without a glossy splat the target is not read; the splat's own stands in.
@@ -298,7 +419,7 @@ impl CompositePass {
             jitter,
             debug: u32::from(debug),
             glossy: u32::from(glossy.is_some()),
-            centre: match centre {
+            centre: match C::samples(centre) {
                 CentreSamples::Own => 0,
                 CentreSamples::Store => 1,
                 CentreSamples::Match => 2,
@@ -350,11 +471,6 @@ impl CompositePass {
             emission_accum: &self.emission_accum,
             centre: &self.centre,
         }
-    }
-
-    /// Whether the pass holds the centre samples ([`CentreSamples`]: made with `centres`).
-    pub fn has_centres(&self) -> bool {
-        self.centre.size() >= u64::from(self.width) * u64::from(self.height) * CENTRE_BYTES
     }
 
     /// Width and height of the accumulator.

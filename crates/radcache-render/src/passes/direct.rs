@@ -2,7 +2,7 @@
 //! MIS per surface pixel, compiled with the plan's defines (only the scene's light sources; a
 //! constant environment only where the sky does not go through the records, [`SkyLight`]).
 //!
-//! Made to composite ([`DirectVariant::composite`], `DIRECT_COMPOSITE`), the pass can also add
+//! Made to composite ([`DirectCompositing`], `DIRECT_COMPOSITE`), the pass can also add
 //! a sub-frame's samples to the frame's accumulators itself, against the centre samples of a
 //! splat made once per frame ([`crate::passes::composite::CentreSamples::Match`]), instead of writing the direct
 //! image for [`CompositePass`]: the composite's own pass would load the G-buffer and that image
@@ -15,7 +15,7 @@ use radcache_vk::{
 
 use crate::bindings::{direct as b, direct_composite as c, direct_composite_layout};
 use crate::error::{Error, Result};
-use crate::passes::composite::CompositePass;
+use crate::passes::composite::{CompositePass, WithCentres};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::splat::SplatPass;
 use crate::passes::splat_glossy::GlossySplatPass;
@@ -48,7 +48,7 @@ radcache_shared::gpu_struct! {
         /// overlap its own ([`DirectVariant::specular_paths`]; docs/materials.md §10).
         pub specular_pool: u32 => "uint",
         /// 1: the samples go to the frame's accumulators against the stored centre samples
-        /// instead of the direct image (a pass made to composite, [`DirectVariant::composite`]).
+        /// instead of the direct image (a pass made to composite, [`DirectCompositing`]).
         pub composite: u32 => "uint",
         /// The sub-frame's jitter (read where `composite` is set).
         pub jitter: [f32; 2] => "vec2",
@@ -59,15 +59,108 @@ radcache_shared::gpu_struct! {
     }
 }
 
-/// What a pass made to composite reads and writes beside the direct pass's own resources: the
-/// composite's accumulators and centre samples, the splat's targets (and the glossy splat's
-/// target, [`DirectInputs::glossy`]).
+/// Where a direct pass's light goes, fixed when the pass is made: the type parameter of
+/// [`DirectVariant`] and [`DirectPass`], and the type of what [`DirectPass::record`] writes to
+/// ([`DirectTarget::Outputs`]). [`DirectImage`]: the G-buffer's direct image;
+/// [`DirectCompositing`]: the composite's accumulators ([`Composited`]). A pass is given only
+/// the outputs its target takes: one made for the image cannot be handed the composite's
+/// resources, nor one made to composite the bare image —
+///
+/// ```compile_fail,E0308
+/// use radcache_render::passes::direct::{Composited, DirectInputs, DirectPass};
+/// use radcache_vk::Recorder;
+///
+/// // A pass made for the direct image (`DirectPass<DirectImage>`) takes no composite.
+/// fn shade(pass: &DirectPass, rec: &mut Recorder, inputs: &DirectInputs<'_>, to: &Composited<'_>) {
+///     pass.record(rec, inputs, to).unwrap();
+/// }
+/// ```
+///
+/// — while the same call on a pass made to composite compiles:
+///
+/// ```
+/// use radcache_render::passes::direct::{Composited, DirectCompositing, DirectInputs, DirectPass};
+/// use radcache_vk::Recorder;
+///
+/// fn shade(
+///     pass: &DirectPass<DirectCompositing>,
+///     rec: &mut Recorder,
+///     inputs: &DirectInputs<'_>,
+///     to: &Composited<'_>,
+/// ) {
+///     pass.record(rec, inputs, to).unwrap();
+/// }
+/// ```
+pub trait DirectTarget: sealed::Sealed + Copy + std::fmt::Debug + PartialEq + Eq + 'static {
+    /// What one recording writes to.
+    type Outputs<'a>: DirectOutputs<'a>;
+    /// The compositing the pass is compiled for (`DIRECT_COMPOSITE`); `None`: the image.
+    fn compositing(&self) -> Option<DirectCompositing>;
+}
+
+/// What [`DirectTarget::Outputs`] name: the composite's resources and the sub-frame a
+/// recording composites, if any.
+pub trait DirectOutputs<'a>: sealed::Sealed + Copy {
+    /// The composite's resources (`None`: the direct image).
+    fn composite(self) -> Option<Composited<'a>>;
+}
+
+impl<'a> DirectOutputs<'a> for DirectImage {
+    fn composite(self) -> Option<Composited<'a>> {
+        None
+    }
+}
+
+impl<'a> DirectOutputs<'a> for Composited<'a> {
+    fn composite(self) -> Option<Composited<'a>> {
+        Some(self)
+    }
+}
+
+mod sealed {
+    /// Only this file's targets and outputs are [`super::DirectTarget`]s and
+    /// [`super::DirectOutputs`].
+    pub trait Sealed {}
+    impl Sealed for super::DirectImage {}
+    impl Sealed for super::DirectCompositing {}
+    impl Sealed for super::Composited<'_> {}
+}
+
+/// The G-buffer's direct image: the target of a pass made without compositing, and its
+/// outputs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DirectImage;
+
+impl DirectTarget for DirectImage {
+    type Outputs<'a> = DirectImage;
+
+    fn compositing(&self) -> Option<DirectCompositing> {
+        None
+    }
+}
+
+impl DirectTarget for DirectCompositing {
+    type Outputs<'a> = Composited<'a>;
+
+    fn compositing(&self) -> Option<DirectCompositing> {
+        Some(*self)
+    }
+}
+
+/// Where a pass made to composite ([`DirectCompositing`]) records: beside the direct pass's own
+/// resources, the composite's accumulators and centre samples and the splat's targets (and the
+/// glossy splat's target, [`DirectInputs::glossy`]). With `sub_frame` the sub-frame's samples
+/// go to the frame's accumulators against the centre samples stored by the composite pass at
+/// sub-frame 0 ([`crate::passes::composite::CentreSamples::Match`]), as the composite pass would add them, and the
+/// direct image is left as it is; without it the pass writes the direct image as any other.
 #[derive(Clone, Copy, Debug)]
-pub struct CompositeTargets<'a> {
+pub struct Composited<'a> {
     /// The accumulators and the centre samples.
-    pub composite: &'a CompositePass,
+    pub composite: &'a CompositePass<WithCentres>,
     /// The splat made at the centre samples.
     pub splat: &'a SplatPass,
+    /// What this sub-frame composites.
+    pub sub_frame: Option<CompositeSubFrame>,
 }
 
 /// A sub-frame composited by the direct pass (never one with the debug AOVs, whose
@@ -78,9 +171,10 @@ pub struct CompositeSubFrame {
     pub jitter: [f32; 2],
 }
 
-/// What the direct pass is compiled for: its shader variant and its own buffers.
+/// What the direct pass is compiled for: its shader variant and its own buffers; `T`, where
+/// its light goes ([`DirectTarget`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct DirectVariant {
+pub struct DirectVariant<T: DirectTarget = DirectImage> {
     /// With [`SkyLight::Records`] the pass leaves a constant environment out (the records bring
     /// it).
     pub sky: SkyLight,
@@ -91,23 +185,46 @@ pub struct DirectVariant {
     /// (`HAS_RADIANCE_CACHE`), writing each such pixel's glossy world weights
     /// ([`DirectInputs::glossy`]).
     pub radiance: bool,
-    /// Made to composite (`DIRECT_COMPOSITE`): every recording binds the composite's resources
-    /// ([`DirectOutputs::Composited`]), and a sub-frame composited against the centre samples
-    /// adds its samples to the frame's accumulators itself instead of writing the direct image.
-    pub composite: Option<DirectCompositing>,
+    /// Where its light goes: the direct image ([`DirectImage`]), or, made to composite
+    /// ([`DirectCompositing`], `DIRECT_COMPOSITE`), every recording binds the composite's
+    /// resources ([`Composited`]), and a sub-frame composited against the centre samples adds
+    /// its samples to the frame's accumulators itself instead of writing the direct image.
+    pub target: T,
     /// How many shadow rays the emitters and punctual lights cast after sub-frame 0.
     pub shadows: DirectShadows,
     /// Whose paths a pixel's specular lobe takes its indirect light from.
     pub specular_paths: SpecularPaths,
 }
 
-impl DirectVariant {
+impl<T: DirectTarget> DirectVariant<T> {
     /// Whether the pass takes the emitters' light in closed form in a scene whose plan allows
     /// it (`analytic_allowed`).
     fn analytic(&self, analytic_allowed: bool) -> bool {
         self.emitters.define(analytic_allowed).is_some()
     }
 
+    /// The same variant with its light going to `target`.
+    pub fn to<U: DirectTarget>(self, target: U) -> DirectVariant<U> {
+        let DirectVariant {
+            sky,
+            emitters,
+            radiance,
+            shadows,
+            specular_paths,
+            ..
+        } = self;
+        DirectVariant {
+            sky,
+            emitters,
+            radiance,
+            target,
+            shadows,
+            specular_paths,
+        }
+    }
+}
+
+impl DirectVariant {
     /// Writing the direct image, every shadow ray at every sub-frame, no radiance records, the
     /// specular paths pooled.
     pub fn new(sky: SkyLight, emitters: EmitterLight) -> DirectVariant {
@@ -115,14 +232,14 @@ impl DirectVariant {
             sky,
             emitters,
             radiance: false,
-            composite: None,
+            target: DirectImage,
             shadows: DirectShadows::Fixed,
             specular_paths: SpecularPaths::Pooled,
         }
     }
 }
 
-/// A direct pass made to composite ([`DirectVariant::composite`]).
+/// A direct pass made to composite ([`DirectVariant::target`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DirectCompositing {
     /// The composite pass sums the squares of the radiance too (`IC_AA_MOMENTS`, adaptive
@@ -163,24 +280,6 @@ pub struct DirectInputs<'a> {
     pub glossy: Option<&'a GlossySplatPass>,
 }
 
-/// Where a direct dispatch's light goes.
-#[derive(Clone, Copy, Debug)]
-pub enum DirectOutputs<'a> {
-    /// The G-buffer's direct image (a pass made without compositing).
-    Image,
-    /// A pass made to composite, with the composite's resources: with `sub_frame` the
-    /// sub-frame's samples go to the frame's accumulators against the centre samples stored by
-    /// [`CompositePass`] at sub-frame 0 ([`crate::passes::composite::CentreSamples::Match`]), as the composite
-    /// pass would add them, and the direct image is left as it is; without it the pass writes
-    /// the direct image as any other.
-    Composited {
-        /// The composite's accumulators and the splat.
-        targets: CompositeTargets<'a>,
-        /// What this sub-frame composites.
-        sub_frame: Option<CompositeSubFrame>,
-    },
-}
-
 /// Paths per pixel and sub-frame that trace the specular lobe's indirect light (scenes with
 /// specular materials): as many as the direct samples, at least one. A path costs a few rays
 /// (a gather path's length), a direct sample one, but the paths carry the noise: on
@@ -192,8 +291,9 @@ pub fn specular_paths(direct_samples: u32) -> u32 {
     direct_samples.max(1)
 }
 
-/// The direct-lighting pipeline and its ray counter.
-pub struct DirectPass {
+/// The direct-lighting pipeline and its ray counter; `T`, where its light goes
+/// ([`DirectTarget`]).
+pub struct DirectPass<T: DirectTarget = DirectImage> {
     pipeline: Pipeline,
     rays: Buffer,
     /// Bound for the glossy weights and table when the pass has no glossy splat to write for.
@@ -209,26 +309,31 @@ pub struct DirectPass {
     shadows: Option<Buffer>,
     /// The specular paths are pooled over the neighbourhood ([`DirectVariant::specular_paths`]).
     specular_pool: bool,
-    /// Made to composite ([`DirectVariant::composite`]).
-    composites: bool,
+    /// Where its light goes ([`DirectVariant::target`]).
+    target: T,
+    /// Made with radiance ([`DirectVariant::radiance`]): it may take a glossy splat.
+    radiance: bool,
 }
 
-impl std::fmt::Debug for DirectPass {
+impl<T: DirectTarget> std::fmt::Debug for DirectPass<T> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("DirectPass").finish_non_exhaustive()
     }
 }
 
-impl DirectPass {
+impl<T: DirectTarget> DirectPass<T> {
     /// The shader module the pass compiles for a scene with `features` and `variant`.
-    pub(crate) fn modules(features: &SceneFeatures, variant: &DirectVariant) -> Vec<ShaderModule> {
+    pub(crate) fn modules(
+        features: &SceneFeatures,
+        variant: &DirectVariant<T>,
+    ) -> Vec<ShaderModule> {
         let mut defines = features.defines();
         defines.extend(variant.sky.define(features.env_constant));
         defines.extend(variant.emitters.define(features.analytic_emitters));
         if variant.radiance {
             defines.push(("HAS_RADIANCE_CACHE", "1"));
         }
-        if let Some(DirectCompositing { moments }) = variant.composite {
+        if let Some(DirectCompositing { moments }) = variant.target.compositing() {
             defines.push(("DIRECT_COMPOSITE", "1"));
             if moments {
                 defines.push(("IC_AA_MOMENTS", "1"));
@@ -242,17 +347,17 @@ impl DirectPass {
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
-        variant: &DirectVariant,
-    ) -> Result<DirectPass> {
+        variant: &DirectVariant<T>,
+    ) -> Result<DirectPass<T>> {
         let DirectVariant {
-            composite,
+            target,
             shadows,
             specular_paths,
             ..
         } = *variant;
         let module = &Self::modules(&scene.features(), variant)[0];
         let spirv = module.compile(shaders)?;
-        let layout = match composite {
+        let layout = match target.compositing() {
             Some(_) => direct_composite_layout(),
             None => b::layout(),
         };
@@ -291,7 +396,8 @@ impl DirectPass {
             punctual: scene.plan().has_punctual_lights(),
             shadows: None,
             specular_pool: specular_paths == SpecularPaths::Pooled,
-            composites: composite.is_some(),
+            target,
+            radiance: variant.radiance,
         };
         match shadows {
             DirectShadows::Adaptive { pixels } => pass.with_adaptive_shadows(ctx, pixels),
@@ -312,7 +418,7 @@ impl DirectPass {
     /// hidden pixels, mark the penumbrae their rays find, and take the stored irradiance where
     /// the sample lies on the first one's surface with its normal (docs/cache-frame.md §8.2).
     /// Other passes are returned as they are.
-    fn with_adaptive_shadows(mut self, ctx: &Context, pixels: u32) -> Result<DirectPass> {
+    fn with_adaptive_shadows(mut self, ctx: &Context, pixels: u32) -> Result<DirectPass<T>> {
         if self.analytic || self.punctual {
             self.shadows = Some(Buffer::new(
                 ctx,
@@ -343,41 +449,15 @@ impl DirectPass {
 
     /// Records `inputs.samples` estimates per pixel for sub-frame `inputs.sub_frame` of the
     /// frame's `inputs.seed` (the pixel's low-discrepancy sequences continue from one sub-frame
-    /// to the next: sub-frame k takes their samples `k × count ..`) into `outputs`. With
-    /// `inputs.glossy` (a pass built with radiance), pixels whose lobe is rough enough leave
-    /// their specular indirect light to the radiance records and write their world weights into
-    /// `glossy.weights`.
+    /// to the next: sub-frame k takes their samples `k × count ..`) into `outputs` (the direct
+    /// image, or for a pass made to composite [`Composited`]). With `inputs.glossy` (a pass
+    /// built with radiance), pixels whose lobe is rough enough leave their specular indirect
+    /// light to the radiance records and write their world weights into `glossy.weights`.
     pub fn record(
         &self,
         rec: &mut Recorder,
         inputs: &DirectInputs<'_>,
-        outputs: &DirectOutputs<'_>,
-    ) -> Result<()> {
-        let composite = match (*outputs, self.composites) {
-            (DirectOutputs::Image, false) => None,
-            (DirectOutputs::Composited { targets, sub_frame }, true) => Some((targets, sub_frame)),
-            (DirectOutputs::Image, true) => {
-                return Err(Error::Invalid(
-                    "the direct pass made to composite records with the composite's resources"
-                        .into(),
-                ))
-            }
-            (DirectOutputs::Composited { .. }, false) => {
-                return Err(Error::Invalid(
-                    "the direct pass was made without the composite".into(),
-                ))
-            }
-        };
-        self.record_inner(rec, inputs, composite)
-    }
-
-    /// Records the pass over `inputs`, and for a pass made to composite its resources and what
-    /// this sub-frame composites.
-    fn record_inner(
-        &self,
-        rec: &mut Recorder,
-        inputs: &DirectInputs<'_>,
-        composite: Option<(CompositeTargets<'_>, Option<CompositeSubFrame>)>,
+        outputs: &T::Outputs<'_>,
     ) -> Result<()> {
         let DirectInputs {
             scene,
@@ -387,6 +467,13 @@ impl DirectPass {
             seed,
             glossy,
         } = *inputs;
+        if glossy.is_some() && !self.radiance {
+            // Its shader has no radiance records: the glossy weights would never be written.
+            return Err(Error::Invalid(
+                "the direct pass was made without radiance records: it takes no glossy splat"
+                    .into(),
+            ));
+        }
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
         let mut bindings = scene.bindings();
         bindings.extend(gbuffer.bindings());
@@ -411,13 +498,10 @@ impl DirectPass {
             b::SHADOWS,
             Resource::Buffer(shadows.unwrap_or(&self.placeholder)),
         ));
-        let sub_frame_composite = composite.and_then(|(_, s)| s);
-        if let Some((targets, _)) = composite {
-            bindings.extend(composite_bindings(
-                targets,
-                glossy,
-                sub_frame_composite.is_some(),
-            )?);
+        let composite = outputs.composite();
+        let sub_frame_composite = composite.and_then(|c| c.sub_frame);
+        if let Some(targets) = composite {
+            bindings.extend(composite_bindings(targets, glossy));
         }
         let push = DirectPush {
             samples: samples.max(1),
@@ -442,6 +526,11 @@ impl DirectPass {
         Ok(())
     }
 
+    /// Where the pass's light goes ([`DirectVariant::target`]).
+    pub fn target(&self) -> T {
+        self.target
+    }
+
     /// Ray queries of the last submitted pass.
     pub fn rays(&self) -> Result<u64> {
         Ok(u64::from(self.rays.read::<u32>(1)?[0]))
@@ -449,28 +538,23 @@ impl DirectPass {
 }
 
 /// The composite's resources at the bindings of the pass made to composite, with `glossy`'s
-/// target where the frame has one (`matching`: this sub-frame composites against the centre
-/// samples, which the composite pass must hold).
+/// target where the frame has one.
 fn composite_bindings<'a>(
-    targets: CompositeTargets<'a>,
+    targets: Composited<'a>,
     glossy: Option<&'a GlossySplatPass>,
-    matching: bool,
-) -> Result<Vec<(u32, Resource<'a>)>> {
-    let CompositeTargets { composite, splat } = targets;
-    if matching && !composite.has_centres() {
-        return Err(Error::Invalid(
-            "the composite pass was made without centre samples".into(),
-        ));
-    }
+) -> Vec<(u32, Resource<'a>)> {
+    let Composited {
+        composite, splat, ..
+    } = targets;
     // Without a glossy splat the target is not read; the splat's own stands in.
     let glossy_sum = glossy.map_or(&splat.sum, |g| &g.sum);
     let r = composite.resources();
-    Ok(vec![
+    vec![
         (c::SPLAT_SUM, Resource::StorageImage(&splat.sum)),
         (c::ACCUM, Resource::Buffer(r.accum)),
         (c::NONFINITE, Resource::Buffer(r.nonfinite)),
         (c::EMISSION_ACCUM, Resource::Buffer(r.emission_accum)),
         (c::GLOSSY_SUM, Resource::StorageImage(glossy_sum)),
         (c::CENTRE, Resource::Buffer(r.centre)),
-    ])
+    ]
 }

@@ -11,7 +11,7 @@ use radcache_vk::{
 
 use crate::bindings::emission as b;
 use crate::error::Result;
-use crate::passes::composite::CompositePass;
+use crate::passes::composite::{Centres, CompositePass};
 use crate::scene::features::{SceneFeatures, ShaderModule};
 use crate::scene::GpuScene;
 
@@ -55,11 +55,11 @@ impl EmissionPass {
 
     /// Records adding the box-filtered emission to `composite`'s accumulator (once, after the
     /// last sub-frame; the scene's view must be the unjittered one of this image).
-    pub fn record(
+    pub fn record<C: Centres>(
         &self,
         rec: &mut Recorder,
         scene: &GpuScene,
-        composite: &CompositePass,
+        composite: &CompositePass<C>,
     ) -> Result<()> {
         rec.fill_buffer(&self.rays, 0, vk::WHOLE_SIZE, 0);
         let mut bindings = scene.bindings();

@@ -34,34 +34,25 @@ pub fn every_shader_module() -> Vec<ShaderModule> {
     for sky in values::<SkyLight>() {
         for emitters in values::<EmitterLight>() {
             for radiance in bools {
-                for composite in [None, Some(false), Some(true)] {
-                    directs.push(direct::DirectVariant {
-                        radiance,
-                        composite: composite.map(|moments| direct::DirectCompositing { moments }),
-                        ..direct::DirectVariant::new(sky, emitters)
-                    });
-                }
+                directs.push(direct::DirectVariant {
+                    radiance,
+                    ..direct::DirectVariant::new(sky, emitters)
+                });
             }
         }
     }
     let mut records = Vec::new();
     for error_control in [ErrorControl::SplitSphere, ErrorControl::Hessian] {
         for sky in values::<SkyLight>() {
-            for radiance in bools {
-                for glossy_spacing in values::<GlossySpacing>() {
-                    for path_grid in values::<PathGridMode>() {
-                        let params = IcParams {
-                            error_control,
-                            ..IcParams::default()
-                        };
-                        records.push(record::RecordVariant {
-                            radiance,
-                            glossy_spacing,
-                            path_grid,
-                            ..record::RecordVariant::new(params, sky)
-                        });
-                    }
-                }
+            for path_grid in values::<PathGridMode>() {
+                let params = IcParams {
+                    error_control,
+                    ..IcParams::default()
+                };
+                records.push(record::RecordVariant {
+                    path_grid,
+                    ..record::RecordVariant::new(params, sky)
+                });
             }
         }
     }
@@ -70,9 +61,22 @@ pub fn every_shader_module() -> Vec<ShaderModule> {
         let f = &features;
         let made = |radiance: bool| !radiance || f.radiance_cache;
         let directs = directs.iter().filter(|v| made(v.radiance));
-        modules.extend(directs.flat_map(|v| direct::DirectPass::modules(f, v)));
-        let records = records.iter().filter(|v| made(v.radiance));
-        modules.extend(records.flat_map(|v| record::RecordPass::modules(f, v)));
+        for v in directs {
+            modules.extend(direct::DirectPass::modules(f, v));
+            for moments in bools {
+                let v = v.to(direct::DirectCompositing { moments });
+                modules.extend(direct::DirectPass::modules(f, &v));
+            }
+        }
+        for v in &records {
+            modules.extend(record::RecordPass::modules(f, v));
+            if made(true) {
+                for glossy_spacing in values::<GlossySpacing>() {
+                    let v = v.with(record::WithRadiance { glossy_spacing });
+                    modules.extend(record::RecordPass::modules(f, &v));
+                }
+            }
+        }
         for (radiance, moments) in [(false, false), (false, true), (true, false), (true, true)] {
             if !made(radiance) {
                 continue;

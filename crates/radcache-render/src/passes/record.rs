@@ -57,19 +57,121 @@ pub use radcache_shared::consts::{
     RECORD_INSTANCE_SHIFT,
 };
 
-/// The record pipeline, its parameters and its ray counter.
-pub struct RecordPass {
+/// Whether a record pass projects its strata onto radiance coefficients too, fixed when the
+/// pass is made: the type parameter of [`RecordVariant`], [`RecordPass`] and [`RecordOutputs`],
+/// whose [`RecordOutputs::radiance`] is [`RadianceBlocks::Blocks`]. [`NoRadiance`]: irradiance
+/// records alone; [`WithRadiance`] (`HAS_RADIANCE_CACHE`, docs/radiance-caching.md §6.1): each
+/// record writes its radiance block too, into the buffer the outputs must name. A pass made
+/// without them cannot be handed a buffer of blocks to write —
+///
+/// ```compile_fail,E0308
+/// use radcache_render::passes::record::RecordOutputs;
+/// use radcache_vk::Buffer;
+///
+/// // `RecordOutputs<'_>` (for `RecordPass<NoRadiance>`) holds no radiance blocks.
+/// fn with_blocks<'a>(records: &'a Buffer, blocks: &'a Buffer) -> RecordOutputs<'a> {
+///     RecordOutputs { radiance: blocks, ..RecordOutputs::records(records) }
+/// }
+/// ```
+///
+/// — nor one made with them be recorded without:
+///
+/// ```compile_fail,E0308
+/// use radcache_render::passes::record::{RecordOutputs, WithRadiance};
+/// use radcache_vk::Buffer;
+///
+/// fn without_blocks(records: &Buffer) -> RecordOutputs<'_, WithRadiance> {
+///     RecordOutputs::records(records)
+/// }
+/// ```
+///
+/// — while outputs for a pass made with them compile:
+///
+/// ```
+/// use radcache_render::passes::record::{RecordOutputs, WithRadiance};
+/// use radcache_vk::Buffer;
+///
+/// fn with_blocks<'a>(records: &'a Buffer, blocks: &'a Buffer) -> RecordOutputs<'a, WithRadiance> {
+///     RecordOutputs::with_radiance(records, blocks)
+/// }
+/// ```
+pub trait RadianceBlocks: sealed::Sealed + Copy + std::fmt::Debug + PartialEq + 'static {
+    /// What a recording's outputs name for the blocks.
+    type Blocks<'a>: BlocksBuffer<'a>;
+    /// How records for glossy lobes are spaced (`None`: no radiance).
+    fn glossy_spacing(&self) -> Option<GlossySpacing>;
+}
+
+/// What [`RadianceBlocks::Blocks`] names: the buffer of blocks, if any.
+pub trait BlocksBuffer<'a>: sealed::Sealed + Copy + std::fmt::Debug {
+    /// The buffer the blocks go to.
+    fn buffer(self) -> Option<&'a Buffer>;
+}
+
+impl<'a> BlocksBuffer<'a> for NoRadiance {
+    fn buffer(self) -> Option<&'a Buffer> {
+        None
+    }
+}
+
+impl<'a> BlocksBuffer<'a> for &'a Buffer {
+    fn buffer(self) -> Option<&'a Buffer> {
+        Some(self)
+    }
+}
+
+mod sealed {
+    /// Only this file's choices are [`super::RadianceBlocks`] and [`super::BlocksBuffer`].
+    pub trait Sealed {}
+    impl Sealed for super::NoRadiance {}
+    impl Sealed for super::WithRadiance {}
+    impl Sealed for &radcache_vk::Buffer {}
+}
+
+/// Irradiance records alone: a pass made without radiance coefficients, and what its outputs
+/// name for the blocks (nothing).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NoRadiance;
+
+impl RadianceBlocks for NoRadiance {
+    type Blocks<'a> = NoRadiance;
+
+    fn glossy_spacing(&self) -> Option<GlossySpacing> {
+        None
+    }
+}
+
+/// Records with radiance coefficients (`HAS_RADIANCE_CACHE`): their outputs name the buffer
+/// of blocks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WithRadiance {
+    /// How records for glossy lobes are spaced (docs/radiance-caching.md §9:
+    /// `GLOSSY_DENSITY` with [`GlossySpacing::Lobe`]).
+    pub glossy_spacing: GlossySpacing,
+}
+
+impl RadianceBlocks for WithRadiance {
+    type Blocks<'a> = &'a Buffer;
+
+    fn glossy_spacing(&self) -> Option<GlossySpacing> {
+        Some(self.glossy_spacing)
+    }
+}
+
+/// The record pipeline, its parameters and its ray counter; `R`, whether it writes radiance
+/// blocks ([`RadianceBlocks`]).
+pub struct RecordPass<R: RadianceBlocks = NoRadiance> {
     pipeline: Pipeline,
     rays: Buffer,
     no_samples: Buffer,
     /// One vec4: too small for any record's radiance, so nothing is written there.
     no_radiance: Buffer,
     params: IcParams,
-    radiance: bool,
+    radiance: std::marker::PhantomData<R>,
     grid: Option<PathGrid>,
 }
 
-impl std::fmt::Debug for RecordPass {
+impl<R: RadianceBlocks> std::fmt::Debug for RecordPass<R> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("RecordPass")
             .field("params", &self.params)
@@ -77,22 +179,20 @@ impl std::fmt::Debug for RecordPass {
     }
 }
 
-/// What the record pass is compiled for: its shader variant and its own buffers.
+/// What the record pass is compiled for: its shader variant and its own buffers; `R`, whether
+/// it writes radiance blocks ([`RadianceBlocks`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RecordVariant {
+pub struct RecordVariant<R: RadianceBlocks = NoRadiance> {
     /// The cache parameters: strata, spacing limits and weight kind (which sets the validity
     /// scale of `R⁻`/`R⁺`); the Hessian error control is compiled in (`IC_HESSIAN`).
     pub params: IcParams,
     /// With [`SkyLight::Records`] a gather ray that escapes brings a constant environment's
     /// radiance.
     pub sky: SkyLight,
-    /// The records also project their strata onto the SH coefficients of the incoming radiance
-    /// (`HAS_RADIANCE_CACHE`, docs/radiance-caching.md §6.1), written to
+    /// With [`WithRadiance`] the records also project their strata onto the SH coefficients of
+    /// the incoming radiance (`HAS_RADIANCE_CACHE`, docs/radiance-caching.md §6.1), written to
     /// [`RecordOutputs::radiance`].
-    pub radiance: bool,
-    /// How records for glossy lobes are spaced (with `radiance`; docs/radiance-caching.md §9:
-    /// `GLOSSY_DENSITY` with [`GlossySpacing::Lobe`]).
-    pub glossy_spacing: GlossySpacing,
+    pub radiance: R,
     /// With [`PathGridMode::On`] and a scene whose plan allows it (`ScenePlan::path_grid`: some
     /// material is Lambertian) the gathers share a radiance grid (`PATH_GRID`,
     /// docs/cache-frame.md §4.1), which the frame readies at the start ([`RecordPass::grid`])
@@ -106,9 +206,26 @@ impl RecordVariant {
         RecordVariant {
             params,
             sky,
-            radiance: false,
-            glossy_spacing: GlossySpacing::Lobe,
+            radiance: NoRadiance,
             path_grid: PathGridMode::Off,
+        }
+    }
+}
+
+impl<R: RadianceBlocks> RecordVariant<R> {
+    /// The same variant, with radiance blocks as `radiance` says.
+    pub fn with<S: RadianceBlocks>(self, radiance: S) -> RecordVariant<S> {
+        let RecordVariant {
+            params,
+            sky,
+            path_grid,
+            ..
+        } = self;
+        RecordVariant {
+            params,
+            sky,
+            radiance,
+            path_grid,
         }
     }
 
@@ -129,9 +246,9 @@ impl RecordVariant {
             // estimate of its hidden part (`shaders/common/path.glsl`).
             defines.push(("PATH_CLOSED_FORM_EMITTERS", "1"));
         }
-        if self.radiance {
+        if let Some(spacing) = self.radiance.glossy_spacing() {
             defines.push(("HAS_RADIANCE_CACHE", "1"));
-            if self.glossy_spacing == GlossySpacing::Lobe {
+            if spacing == GlossySpacing::Lobe {
                 defines.push(("GLOSSY_DENSITY", "1"));
             }
         }
@@ -189,12 +306,12 @@ pub struct RecordInputs<'a> {
 
 /// What a record dispatch writes.
 #[derive(Debug, Clone, Copy)]
-pub struct RecordOutputs<'a> {
+pub struct RecordOutputs<'a, R: RadianceBlocks = NoRadiance> {
     /// `GpuRecord[]`.
     pub records: &'a Buffer,
-    /// The records' radiance blocks (a pass whose variant has `radiance`): record `r` writes its
+    /// The records' radiance blocks (a pass made [`WithRadiance`]): record `r` writes its
     /// `RECORD_RADIANCE_VEC4S` vec4 of coefficients and gradients at `radiance[r·48..]`.
-    pub radiance: Option<&'a Buffer>,
+    pub radiance: R::Blocks<'a>,
     /// For tests and diagnostics: request `i` also writes the samples of its strata,
     /// `(L_jk.rgb, r_jk)` as `[f32; 4]`, at `samples[i·M·N + j·N + k]`, when the buffer holds at
     /// least `(i + 1)·M·N` of them.
@@ -206,15 +323,29 @@ impl<'a> RecordOutputs<'a> {
     pub fn records(records: &'a Buffer) -> RecordOutputs<'a> {
         RecordOutputs {
             records,
-            radiance: None,
+            radiance: NoRadiance,
             samples: None,
         }
     }
 }
 
-impl RecordPass {
+impl<'a> RecordOutputs<'a, WithRadiance> {
+    /// Records and their radiance blocks, no sample dump.
+    pub fn with_radiance(records: &'a Buffer, radiance: &'a Buffer) -> Self {
+        RecordOutputs {
+            records,
+            radiance,
+            samples: None,
+        }
+    }
+}
+
+impl<R: RadianceBlocks> RecordPass<R> {
     /// The shader module the pass compiles for a scene with `features` and `variant`.
-    pub(crate) fn modules(features: &SceneFeatures, variant: &RecordVariant) -> Vec<ShaderModule> {
+    pub(crate) fn modules(
+        features: &SceneFeatures,
+        variant: &RecordVariant<R>,
+    ) -> Vec<ShaderModule> {
         vec![ShaderModule::new(SHADER, variant.defines(features))]
     }
 
@@ -223,8 +354,8 @@ impl RecordPass {
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
-        variant: &RecordVariant,
-    ) -> Result<RecordPass> {
+        variant: &RecordVariant<R>,
+    ) -> Result<RecordPass<R>> {
         let params = &variant.params;
         let strata = [
             (params.strata_m, params.strata_n),
@@ -267,7 +398,7 @@ impl RecordPass {
             no_samples: buffer("records.no_samples", MemoryLocation::GpuOnly)?,
             no_radiance: buffer("records.no_radiance", MemoryLocation::GpuOnly)?,
             params: *params,
-            radiance: variant.radiance,
+            radiance: std::marker::PhantomData,
             grid: if grid {
                 Some(PathGrid::new(ctx)?)
             } else {
@@ -292,18 +423,13 @@ impl RecordPass {
         &self.params
     }
 
-    /// Whether the pass projects radiance coefficients ([`RecordVariant::radiance`]).
-    pub fn radiance(&self) -> bool {
-        self.radiance
-    }
-
     /// Records the dispatch of `inputs.job` in a pass named `records`: one workgroup per
     /// request, dispatched from the counters' indirect arguments.
     pub fn record(
         &self,
         rec: &mut Recorder,
         inputs: &RecordInputs<'_>,
-        outputs: &RecordOutputs<'_>,
+        outputs: &RecordOutputs<'_, R>,
     ) -> Result<()> {
         let (level, sub_frame, seed, source) = match inputs.job {
             RecordJob::Create {
@@ -317,11 +443,6 @@ impl RecordPass {
             return Err(Error::Invalid(format!(
                 "record level {level} / sub-frame {sub_frame}: both must fit 16 bits"
             )));
-        }
-        if outputs.radiance.is_some() && !self.radiance {
-            return Err(Error::Invalid(
-                "the record pass was made without radiance coefficients to write".into(),
-            ));
         }
         let p = &self.params;
         let push = RecordPush {
@@ -357,7 +478,7 @@ impl RecordPass {
             ),
             (
                 b::RADIANCE,
-                Resource::Buffer(outputs.radiance.unwrap_or(&self.no_radiance)),
+                Resource::Buffer(outputs.radiance.buffer().unwrap_or(&self.no_radiance)),
             ),
             (b::PATH_GRID, Resource::Buffer(grid(|g| &g.keys))),
             (b::PATH_GRID_SUMS, Resource::Buffer(grid(|g| &g.sums))),

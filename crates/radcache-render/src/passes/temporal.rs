@@ -85,9 +85,108 @@ radcache_shared::gpu_struct! {
 
 use radcache_shared::consts::TemporalStep as Mode;
 
+/// Whether a temporal pass's records carry lifespans, fixed when the pass is made: the type
+/// parameter of [`TemporalVariant`] and [`TemporalPass`], and what [`TemporalPass::record`]
+/// takes ([`RecordLifespans::Job`]). [`NoLifespans`] (records kept under unchanged lighting, or
+/// imported): the only step is re-clamping the kept records to a new view ([`KeptJob`]), and the
+/// pass allocates no look-ahead copy; [`WithLifespans`] (a scene whose lighting changes, a time
+/// step): every [`TemporalJob`]. A pass without lifespans cannot be given a step that needs them
+/// (its look-ahead buffer holds one record) —
+///
+/// ```compile_fail,E0308
+/// use radcache_render::passes::temporal::{TemporalInputs, TemporalJob, TemporalPass};
+/// use radcache_vk::Recorder;
+///
+/// // `TemporalPass<NoLifespans>` takes a `KeptJob`.
+/// fn adopt(pass: &mut TemporalPass, rec: &mut Recorder, io: &TemporalInputs<'_>) {
+///     let job = TemporalJob::Adopt { frame: 1, first: 0, records: 8, listed: 8 };
+///     pass.record(rec, io, job).unwrap();
+/// }
+/// ```
+///
+/// — while a pass made with them can:
+///
+/// ```
+/// use radcache_render::passes::temporal::{TemporalInputs, TemporalJob, TemporalPass, WithLifespans};
+/// use radcache_vk::Recorder;
+///
+/// fn adopt(pass: &mut TemporalPass<WithLifespans>, rec: &mut Recorder, io: &TemporalInputs<'_>) {
+///     let job = TemporalJob::Adopt { frame: 1, first: 0, records: 8, listed: 8 };
+///     pass.record(rec, io, job).unwrap();
+/// }
+/// ```
+pub trait RecordLifespans:
+    sealed::Sealed + Copy + std::fmt::Debug + PartialEq + Eq + 'static
+{
+    /// The steps a pass of this kind records.
+    type Job<'a>: Copy + std::fmt::Debug + Into<TemporalJob<'a>>;
+    /// Records carry lifespans: the look-ahead copy of the records is allocated.
+    const LIFESPANS: bool;
+}
+
+mod sealed {
+    /// Only this file's kinds are [`super::RecordLifespans`].
+    pub trait Sealed {}
+    impl Sealed for super::NoLifespans {}
+    impl Sealed for super::WithLifespans {}
+}
+
+/// Records kept without lifespans (unchanged lighting; imported records): the pass re-clamps
+/// them to a new view and nothing else.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NoLifespans;
+
+impl RecordLifespans for NoLifespans {
+    type Job<'a> = KeptJob<'a>;
+    const LIFESPANS: bool = false;
+}
+
+/// Records with lifespans, evaluated one frame ahead (a time step).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WithLifespans;
+
+impl RecordLifespans for WithLifespans {
+    type Job<'a> = TemporalJob<'a>;
+    const LIFESPANS: bool = true;
+}
+
+/// The step of a temporal pass whose records carry no lifespans ([`NoLifespans`]).
+#[derive(Debug, Clone, Copy)]
+pub enum KeptJob<'a> {
+    /// Empties the list, then clamps the radius of every one of the `records` kept from earlier
+    /// frames to `reclamp`'s [R⁻, R⁺] at the record's pixel footprint in the current view (the
+    /// camera moved). The neighbour grid must be rebuilt afterwards.
+    Advance {
+        /// The frame.
+        frame: u32,
+        /// Records kept.
+        records: u32,
+        /// The parameters.
+        reclamp: &'a IcParams,
+    },
+}
+
+impl<'a> From<KeptJob<'a>> for TemporalJob<'a> {
+    fn from(job: KeptJob<'a>) -> TemporalJob<'a> {
+        match job {
+            KeptJob::Advance {
+                frame,
+                records,
+                reclamp,
+            } => TemporalJob::Advance {
+                frame,
+                records,
+                lifespans: None,
+                reclamp: Some(reclamp),
+            },
+        }
+    }
+}
+
 /// The temporal pipeline, the list of records to evaluate this frame, the look-ahead copy of the
-/// records, the previous frame's instances and the moving instances' bounding spheres.
-pub struct TemporalPass {
+/// records, the previous frame's instances and the moving instances' bounding spheres; `L`,
+/// whether its records carry lifespans ([`RecordLifespans`]).
+pub struct TemporalPass<L: RecordLifespans = NoLifespans> {
     pipeline: Pipeline,
     /// Record indices to evaluate this frame (`uint[capacity]`).
     pub list: Buffer,
@@ -107,11 +206,11 @@ pub struct TemporalPass {
     moving: Buffer,
     moving_count: u32,
     has_previous: bool,
-    lifespans: bool,
+    lifespans: std::marker::PhantomData<L>,
     capacity: u32,
 }
 
-impl std::fmt::Debug for TemporalPass {
+impl<L: RecordLifespans> std::fmt::Debug for TemporalPass<L> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("TemporalPass")
             .field("capacity", &self.capacity)
@@ -130,7 +229,8 @@ pub struct TemporalInputs<'a> {
     pub state: &'a IcState,
 }
 
-/// One step of a frame's temporal bookkeeping, in the frame's order.
+/// One step of a frame's temporal bookkeeping, in the frame's order (a pass made
+/// [`WithLifespans`]).
 #[derive(Debug, Clone, Copy)]
 pub enum TemporalJob<'a> {
     /// Empties the list, then, over the `records` kept from earlier frames: with `lifespans`
@@ -202,40 +302,44 @@ pub struct Lifespans {
     pub max_age: f32,
 }
 
-/// What the temporal pass is made for: its buffers.
+/// What the temporal pass is made for: its buffers; `L`, whether its records carry lifespans.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct TemporalVariant {
+pub struct TemporalVariant<L: RecordLifespans = NoLifespans> {
     /// Records of the cache.
     pub record_capacity: u32,
-    /// Records carry lifespans (a scene whose lighting changes): the look-ahead copy of the
+    /// With [`WithLifespans`] (a scene whose lighting changes) the look-ahead copy of the
     /// records is allocated.
-    pub lifespans: bool,
-    /// With `lifespans`, the cache has radiance blocks: their look-ahead copy too.
+    pub lifespans: L,
+    /// With lifespans, the cache has radiance blocks: their look-ahead copy too.
     pub radiance: bool,
 }
 
 impl TemporalPass {
-    /// The shader module the pass compiles for a scene with `features`.
+    /// The shader module the pass compiles for a scene with `features` (with lifespans or
+    /// without).
     pub(crate) fn modules(features: &SceneFeatures) -> Vec<ShaderModule> {
         vec![ShaderModule::new(
             "passes/temporal.comp",
             features.defines(),
         )]
     }
+}
 
+impl<L: RecordLifespans> TemporalPass<L> {
     /// Compiles the pass for `scene` and allocates its buffers for `variant`.
     pub fn new(
         ctx: &Context,
         shaders: &ShaderCompiler,
         scene: &GpuScene,
-        variant: &TemporalVariant,
-    ) -> Result<TemporalPass> {
+        variant: &TemporalVariant<L>,
+    ) -> Result<TemporalPass<L>> {
         let TemporalVariant {
             record_capacity,
-            lifespans,
             radiance,
+            ..
         } = *variant;
-        let spirv = Self::modules(&scene.features())[0].compile(shaders)?;
+        let lifespans = L::LIFESPANS;
+        let spirv = TemporalPass::<NoLifespans>::modules(&scene.features())[0].compile(shaders)?;
         let pipeline = Pipeline::compute(
             ctx,
             "temporal",
@@ -306,7 +410,7 @@ impl TemporalPass {
             )?,
             moving_count: 0,
             has_previous: false,
-            lifespans,
+            lifespans: std::marker::PhantomData,
             capacity,
         })
     }
@@ -346,15 +450,15 @@ impl TemporalPass {
         Ok(())
     }
 
-    /// Records one step of the frame's temporal bookkeeping ([`TemporalJob`]) over `io`'s
-    /// records.
+    /// Records one step of the frame's temporal bookkeeping ([`TemporalJob`]; [`KeptJob`]
+    /// for a pass without lifespans) over `io`'s records.
     pub fn record(
         &mut self,
         rec: &mut Recorder,
         io: &TemporalInputs<'_>,
-        job: TemporalJob<'_>,
+        job: L::Job<'_>,
     ) -> Result<()> {
-        match job {
+        match job.into() {
             TemporalJob::Advance {
                 frame,
                 records,
@@ -553,11 +657,6 @@ impl TemporalPass {
             rec.copy_buffer(buffer, 0, &self.previous, 0, bytes);
             self.has_previous = true;
         }
-    }
-
-    /// Whether records carry lifespans (the pass was made for a scene whose lighting changes).
-    pub fn lifespans(&self) -> bool {
-        self.lifespans
     }
 
     /// Forgets the previous frame's instances and any pending look-ahead (the next frame starts

@@ -4,7 +4,7 @@
 use radcache_vk::Context;
 
 use super::phases::FrameRun;
-use super::IcRenderer;
+use super::{with_composite, IcRenderer, Shading};
 use crate::error::Result;
 use crate::frame::aa::{mean_count, next_sub_frames, plan_pixels, sampling_relmse};
 use crate::frame::settings::{AntiAliasing, IcSettings};
@@ -40,7 +40,8 @@ impl IcRenderer {
         run: &mut FrameRun<'_>,
     ) -> Result<()> {
         loop {
-            let Some((sums, squares)) = self.composite.read_moments(ctx)? else {
+            let Some((sums, squares)) = with_composite!(&self.shading, |c| c.read_moments(ctx))?
+            else {
                 return Ok(());
             };
             let estimate = sampling_relmse(&sums, &squares);

@@ -8,15 +8,15 @@
 use radcache_cache::cache_file::CacheRecords;
 use radcache_vk::{Context, ShaderCompiler};
 
-use super::IcRenderer;
+use super::{IcRenderer, Temporal};
 use crate::error::{Error, Result};
-use crate::passes::temporal::{TemporalPass, TemporalVariant};
+use crate::passes::temporal::{NoLifespans, TemporalPass, TemporalVariant};
 use crate::scene::GpuScene;
 
 impl IcRenderer {
     /// The records left by the last frame (none before a frame or after [`Self::forget`]).
     pub fn export_cache(&self, ctx: &Context) -> Result<CacheRecords> {
-        let lifespans = self.temporal.as_ref().is_some_and(|t| t.lifespans());
+        let lifespans = self.temporal.as_ref().is_some_and(Temporal::lifespans);
         if !self.has_records {
             return Ok(CacheRecords {
                 frames: self.frames,
@@ -58,7 +58,7 @@ impl IcRenderer {
         gpu: &GpuScene,
         cache: &CacheRecords,
     ) -> Result<()> {
-        let lifespans = self.temporal.as_ref().is_some_and(|t| t.lifespans());
+        let lifespans = self.temporal.as_ref().is_some_and(Temporal::lifespans);
         if cache.lifespans != lifespans {
             return Err(Error::Invalid(format!(
                 "the cache's records {} lifespans, the renderer's {}",
@@ -89,10 +89,12 @@ impl IcRenderer {
         if self.temporal.is_none() {
             let variant = TemporalVariant {
                 record_capacity: self.state.record_capacity(),
-                lifespans: false,
+                lifespans: NoLifespans,
                 radiance,
             };
-            self.temporal = Some(TemporalPass::new(ctx, shaders, gpu, &variant)?);
+            self.temporal = Some(Temporal::Kept(TemporalPass::new(
+                ctx, shaders, gpu, &variant,
+            )?));
         }
         let marks: Vec<u32> = cache
             .last_used

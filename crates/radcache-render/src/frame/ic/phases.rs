@@ -9,18 +9,20 @@ use std::time::Instant;
 use radcache_scene::{CameraView, Scene};
 use radcache_vk::Context;
 
-use super::IcRenderer;
+use super::{with_composite, IcRenderer, Shading, Temporal};
 use crate::error::Result;
 use crate::frame::clock::FrameClock;
 use crate::frame::path::{FrameOutput, Progress};
 use crate::frame::settings::{sub_frame_jitter, IcSettings, IcStats, SplatMode};
-use crate::passes::composite::{CentreSamples, CompositeInputs, CompositeJob};
-use crate::passes::direct::{CompositeSubFrame, CompositeTargets, DirectInputs, DirectOutputs};
+use crate::passes::composite::{
+    CentreSamples, CompositeInputs, CompositeJob, OwnSamples, WithCentres,
+};
+use crate::passes::direct::{CompositeSubFrame, Composited, DirectImage, DirectInputs};
 use crate::passes::holes::HoleSelection;
 use crate::passes::neighbours::NeighbourJob;
-use crate::passes::record::{creation_seed, GridJob, RecordInputs, RecordJob, RecordOutputs};
+use crate::passes::record::{creation_seed, GridJob, RecordInputs, RecordJob};
 use crate::passes::splat::{SplatDraw, SplatInputs, SplatOutput, SplatScope, SplatWeights};
-use crate::passes::temporal::{expires_at, TemporalInputs, TemporalJob};
+use crate::passes::temporal::{expires_at, KeptJob, TemporalInputs, TemporalJob};
 use crate::scene::GpuScene;
 
 /// Most passes of the cache phase over the sub-frames (see [`IcRenderer::cache_phase`]).
@@ -136,7 +138,7 @@ impl IcRenderer {
         gpu.record_update(ctx, &mut rec)?;
         // Records kept with lifespans keep the radiance grid too: the frame ages it by a slice,
         // so that no cell is older than a record may be (`Δt_max`, docs/temporal.md §3.8).
-        let lifespans = self.temporal.as_ref().is_some_and(|t| t.lifespans());
+        let lifespans = self.temporal.as_ref().is_some_and(Temporal::lifespans);
         let life = self.params.max_age_frames.round().max(1.0) as u32;
         if let Some(grid) = self.records.grid() {
             let job = if temporal && lifespans && self.has_records {
@@ -158,27 +160,40 @@ impl IcRenderer {
             if !self.has_records {
                 t.forget();
             }
-            if temporal || view_changed {
-                let reclamp = view_changed.then_some(&self.params);
-                let lifespans = temporal.then_some((scene, settings.time, &self.params));
-                let kept = run.kept;
-                let io = TemporalInputs {
-                    scene: gpu,
-                    state: &self.state,
-                };
-                let job = TemporalJob::Advance {
-                    frame: now,
-                    records: kept,
-                    lifespans,
-                    reclamp,
-                };
-                t.record(&mut rec, &io, job)?;
+            let (frame, records) = (now, run.kept);
+            let io = TemporalInputs {
+                scene: gpu,
+                state: &self.state,
+            };
+            let reclamp = view_changed.then_some(&self.params);
+            match t {
+                Temporal::Lifespans(t) if temporal || view_changed => {
+                    let lifespans = temporal.then_some((scene, settings.time, &self.params));
+                    let job = TemporalJob::Advance {
+                        frame,
+                        records,
+                        lifespans,
+                        reclamp,
+                    };
+                    t.record(&mut rec, &io, job)?;
+                }
+                Temporal::Kept(t) => {
+                    if let Some(reclamp) = reclamp {
+                        let job = KeptJob::Advance {
+                            frame,
+                            records,
+                            reclamp,
+                        };
+                        t.record(&mut rec, &io, job)?;
+                    }
+                }
+                Temporal::Lifespans(_) => {}
             }
         }
         let scale = gpu.scene_scale();
         self.neighbours
             .record(&mut rec, &self.state, scale, NeighbourJob::Rebuild)?;
-        self.composite.record(&mut rec, CompositeJob::Clear)?;
+        with_composite!(&self.shading, |c| c.record(&mut rec, CompositeJob::Clear))?;
         run.clock.submit(ctx, rec)?;
         run.stats.records_kept = u64::from(self.state.read_counters()?.record_count);
         run.clock.lap("setup");
@@ -313,11 +328,9 @@ impl IcRenderer {
                     seed,
                 },
             };
-            let outputs = RecordOutputs {
-                radiance: state.radiance.as_ref(),
-                ..RecordOutputs::records(&state.records)
-            };
-            self.records.record(&mut rec, &inputs, &outputs)?;
+            let radiance = state.radiance.as_ref();
+            self.records
+                .record(&mut rec, &inputs, &state.records, radiance)?;
             self.state.record_end_batch(&mut rec)?;
             let scale = gpu.scene_scale();
             self.neighbours
@@ -353,10 +366,9 @@ impl IcRenderer {
         let jitter = sub_frame_jitter(k);
         let (gbuffer, state) = (&self.gbuffer, &self.state);
         let splats = k == 0 || self.splat_mode == SplatMode::PerSubFrame;
-        let centre = match (self.splat_mode, k) {
-            (SplatMode::PerSubFrame, _) => CentreSamples::Own,
-            (SplatMode::Once, 0) => CentreSamples::Store,
-            (SplatMode::Once, _) => CentreSamples::Match,
+        let centre = match k {
+            0 => CentreSamples::Store,
+            _ => CentreSamples::Match,
         };
         let mut rec = ctx.begin("ic.shade")?;
         // Sub-frame 0 after a cache phase that ended on it (splatting once) has its G-buffer.
@@ -369,7 +381,10 @@ impl IcRenderer {
         // Splatting once, the direct pass composites the later sub-frames itself (it has their
         // samples loaded; docs/cache-frame.md §6.5) but for the debug AOVs; sub-frame 0 writes
         // the direct image for the composite after the splat.
-        let composited = centre == CentreSamples::Match && !debug;
+        let composited = match &self.shading {
+            Shading::Once { .. } => centre == CentreSamples::Match && !debug,
+            Shading::PerSubFrame { .. } => false,
+        };
         let inputs = DirectInputs {
             scene: gpu,
             gbuffer,
@@ -378,17 +393,19 @@ impl IcRenderer {
             seed: settings.seed,
             glossy,
         };
-        let outputs = match self.splat_mode {
-            SplatMode::Once => DirectOutputs::Composited {
-                targets: CompositeTargets {
-                    composite: &self.composite,
+        match &self.shading {
+            Shading::Once { direct, composite } => {
+                let outputs = Composited {
+                    composite,
                     splat: &self.splat,
-                },
-                sub_frame: composited.then_some(CompositeSubFrame { jitter }),
-            },
-            SplatMode::PerSubFrame => DirectOutputs::Image,
-        };
-        self.direct.record(&mut rec, &inputs, &outputs)?;
+                    sub_frame: composited.then_some(CompositeSubFrame { jitter }),
+                };
+                direct.record(&mut rec, &inputs, &outputs)?
+            }
+            Shading::PerSubFrame { direct, .. } => {
+                direct.record(&mut rec, &inputs, &DirectImage)?
+            }
+        }
         if splats {
             // The records per pixel only for the debug AOVs (a second blended target).
             let output = if settings.debug_aovs {
@@ -425,14 +442,25 @@ impl IcRenderer {
                 splat: &self.splat,
                 glossy,
                 jitter,
-                centre,
+                centre: OwnSamples,
                 debug,
             };
-            self.composite
-                .record(&mut rec, CompositeJob::Add(&inputs))?;
+            match &self.shading {
+                Shading::PerSubFrame { composite, .. } => {
+                    composite.record(&mut rec, CompositeJob::Add(&inputs))?
+                }
+                Shading::Once { composite, .. } => {
+                    let inputs = inputs.at::<WithCentres>(centre);
+                    composite.record(&mut rec, CompositeJob::Add(&inputs))?
+                }
+            }
         }
         run.clock.submit(ctx, rec)?;
-        run.add_rays("direct", self.direct.rays()?);
+        let direct_rays = match &self.shading {
+            Shading::Once { direct, .. } => direct.rays()?,
+            Shading::PerSubFrame { direct, .. } => direct.rays()?,
+        };
+        run.add_rays("direct", direct_rays);
         if splats {
             let c = self.state.read_counters()?;
             run.stats.holes_left += u64::from(c.holes);
@@ -456,8 +484,8 @@ impl IcRenderer {
         mut run: FrameRun<'_>,
     ) -> Result<(FrameOutput, IcStats)> {
         let mut rec = ctx.begin("ic.emission")?;
-        self.emission.record(&mut rec, gpu, &self.composite)?;
-        if let Some(t) = self
+        with_composite!(&self.shading, |c| self.emission.record(&mut rec, gpu, c))?;
+        if let Some(Temporal::Lifespans(t)) = self
             .temporal
             .as_mut()
             .filter(|_| settings.time_step_s > 0.0)
@@ -472,7 +500,7 @@ impl IcRenderer {
         run.clock.submit(ctx, rec)?;
         run.add_rays("emission", self.emission.rays()?);
         run.clock.lap("emission");
-        let (pixels, nonfinite_pixels) = self.composite.read_mean(ctx)?;
+        let (pixels, nonfinite_pixels) = with_composite!(&self.shading, |c| c.read_mean(ctx))?;
         if settings.debug_aovs {
             let debug = self.read_debug(ctx, run.shaded, run.stats.records)?;
             run.stats.debug = Some(debug);
@@ -482,7 +510,7 @@ impl IcRenderer {
         if settings.anti_aliasing.is_none() || run.stats.mean_pixel_sub_frames == 0.0 {
             run.stats.mean_pixel_sub_frames = f64::from(run.shaded);
         }
-        run.stats.unmatched_samples = self.composite.read_unmatched()?;
+        run.stats.unmatched_samples = with_composite!(&self.shading, |c| c.read_unmatched())?;
         let mut clock = run.clock;
         run.stats.phases_s = std::mem::take(&mut clock.phases_s);
         let output = FrameOutput {

@@ -4,16 +4,22 @@
 use radcache_scene::{CameraView, Scene};
 use radcache_vk::Context;
 
-use super::{FrameRun, IcRenderer};
+use super::{FrameRun, IcRenderer, Temporal};
 use crate::error::{Error, Result};
 use crate::frame::settings::{IcSettings, IcStats};
-use crate::passes::record::{RecordInputs, RecordJob, RecordOutputs};
-use crate::passes::temporal::{Lifespans, TemporalInputs, TemporalJob, TemporalPass};
+use crate::passes::record::{RecordInputs, RecordJob};
+use crate::passes::temporal::{
+    Lifespans, TemporalInputs, TemporalJob, TemporalPass, WithLifespans,
+};
 use crate::scene::GpuScene;
 
 impl IcRenderer {
-    fn temporal_pass(&self) -> Result<&TemporalPass> {
-        self.temporal.as_ref().ok_or_else(no_time_step)
+    /// The temporal pass of a renderer made with a time step.
+    fn temporal_pass(&self) -> Result<&TemporalPass<WithLifespans>> {
+        match &self.temporal {
+            Some(Temporal::Lifespans(t)) => Ok(t),
+            _ => Err(no_time_step()),
+        }
     }
 
     /// The records the advance listed as expired (evaluated again by [`Self::look_ahead`]).
@@ -38,7 +44,9 @@ impl IcRenderer {
         // The refresh binds the G-buffer without reading or writing it, and the scene returns
         // to the frame's time and view below: `run.gbuffer_at` stays true.
         let (expired, stats, clock) = (run.expired, &mut run.stats, &mut run.clock);
-        let t = self.temporal.as_mut().ok_or_else(no_time_step)?;
+        let Some(Temporal::Lifespans(t)) = self.temporal.as_mut() else {
+            return Err(no_time_step());
+        };
         let count = self.state.read_counters()?.record_count;
         let first = stats.records_kept as u32;
         let listed = expired
@@ -81,11 +89,9 @@ impl IcRenderer {
                 frame_seed: settings.seed,
             },
         };
-        let outputs = RecordOutputs {
-            radiance: t.lookahead_radiance.as_ref(),
-            ..RecordOutputs::records(&t.lookahead)
-        };
-        self.records.record(&mut rec, &inputs, &outputs)?;
+        let radiance = t.lookahead_radiance.as_ref();
+        self.records
+            .record(&mut rec, &inputs, &t.lookahead, radiance)?;
         let lifespans = Lifespans {
             accuracy: self.params.temporal_accuracy,
             max_age: self.params.max_age_frames,
