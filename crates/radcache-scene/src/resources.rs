@@ -299,6 +299,9 @@ const SUPPORTED_REQUIRED: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_specular",
+    // Integer attributes (normalized or not) are read by `accessor.rs` like any other; the
+    // dequantization is the node's transform and `KHR_texture_transform`.
+    "KHR_mesh_quantization",
     "KHR_texture_transform",
 ];
 
@@ -307,9 +310,6 @@ fn unsupported_reason(name: &str) -> &'static str {
     match name {
         "KHR_draco_mesh_compression" => "Draco-compressed meshes cannot be decoded",
         "EXT_meshopt_compression" => "meshopt-compressed buffers cannot be decoded",
-        "KHR_mesh_quantization" => {
-            "quantized (integer) positions, normals and texture coordinates cannot be read"
-        }
         "KHR_texture_basisu" => "KTX2 / Basis Universal textures cannot be decoded",
         "EXT_texture_webp" => "WebP textures cannot be decoded",
         "EXT_texture_avif" => "AVIF textures cannot be decoded",

@@ -373,7 +373,6 @@ fn refused_required_extensions_name_the_file_and_the_extension() {
     for (name, why) in [
         ("KHR_draco_mesh_compression", "Draco"),
         ("EXT_meshopt_compression", "meshopt"),
-        ("KHR_mesh_quantization", "quantized"),
         ("KHR_texture_basisu", "Basis Universal"),
         ("EXT_texture_webp", "WebP"),
     ] {
