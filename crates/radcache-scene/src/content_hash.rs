@@ -169,11 +169,10 @@ impl Scene {
             h.usize(i.rgba8.len());
             h.bytes(&i.rgba8);
         }
-        let world = self.world_transforms(0.0);
         h.usize(self.instances.len());
-        for i in &self.instances {
+        for (i, m) in self.instances.iter().zip(&self.instance_transforms(0.0)) {
             h.usize(i.mesh);
-            mat4(&mut h, &world[i.node]);
+            mat4(&mut h, m);
         }
         h.usize(self.lights.len());
         for l in &self.lights {
@@ -193,6 +192,7 @@ impl Scene {
             h.f32(l.intensity);
             h.f32(l.range.unwrap_or(-1.0));
         }
+        let world = self.world_transforms(0.0);
         h.usize(self.light_instances.len());
         for l in &self.light_instances {
             h.usize(l.light);

@@ -10,6 +10,12 @@
 //! Units: 1 glTF unit = 1 m; colours and radiometry are linear RGB; emission in W/(sr·m²); light
 //! intensities in the KHR_lights_punctual units (cd, lx) used as radiometric values.
 //!
+//! **Delivery formats** (what gltfpack and gltf-transform write): `KHR_mesh_quantization`
+//! (integer attributes, dequantized by the node's transform), `EXT_meshopt_compression` (each
+//! compressed buffer view decoded on load into its fallback buffer; the KHR version's vertex codec
+//! 1 is refused by name) and `EXT_mesh_gpu_instancing` (one [`Instance`] per element, its
+//! transform under the node's).
+//!
 //! **For a GPU uploader.** Geometry: `scene.meshes[m]` holds `positions`, `normals`,
 //! `texcoords` (one entry per vertex; `tangents` too where a material has a normal map, and
 //! `texcoords1` where one samples TEXCOORD_1),
@@ -57,6 +63,7 @@ mod load;
 pub mod material;
 pub mod math;
 pub mod mesh;
+mod meshopt;
 pub mod node;
 pub mod plan;
 mod resources;

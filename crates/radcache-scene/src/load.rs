@@ -6,8 +6,9 @@
 
 use std::path::Path;
 
-use glam::Vec3;
+use glam::{Mat4, Quat, Vec3, Vec4};
 
+use crate::accessor;
 use crate::animation::load_animations;
 use crate::camera::{camera_defs, Camera, CameraDef};
 use crate::environment::{scene_radiance, EnvOverride, Environment};
@@ -16,7 +17,7 @@ use crate::light::{load_lights, LightInstance};
 use crate::material::{load_materials, Material};
 use crate::mesh::{load_mesh, VertexNeeds};
 use crate::node::{load_nodes, traversal_order, Node};
-use crate::resources::Source;
+use crate::resources::{RawInstancing, Source};
 use crate::scene::{Instance, Scene};
 use crate::texture::TextureLoader;
 
@@ -87,16 +88,23 @@ impl Scene {
                 dynamic: dynamic[node],
             })
             .collect();
-        let instances = order
+        let mut instances = Vec::new();
+        let placed = order
             .iter()
             .filter_map(|&n| nodes[n].mesh.map(|mesh| (n, mesh)))
-            .filter(|&(_, mesh)| meshes.get(mesh).is_some_and(|m| m.triangle_count() > 0))
-            .map(|(node, mesh)| Instance {
+            .filter(|&(_, mesh)| meshes.get(mesh).is_some_and(|m| m.triangle_count() > 0));
+        for (node, mesh) in placed {
+            let instance = |local| Instance {
                 mesh,
                 node,
+                local,
                 dynamic: dynamic[node],
-            })
-            .collect();
+            };
+            match src.raw_instancing.get(node).copied().flatten() {
+                Some(raw) => instances.extend(gpu_instances(&src, node, &raw)?.map(instance)),
+                None => instances.push(instance(Mat4::IDENTITY)),
+            }
+        }
         let material_emission = materials
             .iter()
             .map(|m| {
@@ -270,4 +278,77 @@ fn warn_if_unlit(scene: &Scene, w: &mut Warnings) {
         scene.path.display()
     );
     w.push(WarningKind::NoLight, 1, msg);
+}
+
+/// The `node_from_object` transforms of node `node`'s `EXT_mesh_gpu_instancing` instances
+/// (`T · R · S` of each one's TRANSLATION, ROTATION and SCALE, an absent attribute the identity):
+/// the attributes must have one element per instance, the same number each; a rotation is
+/// normalized, and a non-finite or zero one is an error naming the node.
+fn gpu_instances(
+    src: &Source,
+    node: usize,
+    raw: &RawInstancing,
+) -> Result<impl Iterator<Item = Mat4>> {
+    let gltf_node = src.doc.nodes().nth(node);
+    let user = label("node", node, gltf_node.as_ref().and_then(|n| n.name()));
+    let invalid = |reason: String| Error::Invalid {
+        path: src.path(),
+        element: user.clone(),
+        reason: format!("EXT_mesh_gpu_instancing: {reason}"),
+    };
+    let read = |index: Option<usize>, key: &str, comps: usize| -> Result<Option<Vec<Vec4>>> {
+        let Some(index) = index else {
+            return Ok(None);
+        };
+        let acc = src.doc.accessors().nth(index).ok_or_else(|| {
+            invalid(format!(
+                "{key} names accessor {index}, which does not exist"
+            ))
+        })?;
+        let u = format!("{user} EXT_mesh_gpu_instancing {key}");
+        let v = accessor::read_any_vec(src, &acc, &u, comps)?;
+        if let Some(bad) = v.iter().position(|v| !v.is_finite()) {
+            return Err(invalid(format!("{key} of instance {bad} is not finite")));
+        }
+        Ok(Some(v))
+    };
+    let t = read(raw.translation, "TRANSLATION", 3)?;
+    let r = read(raw.rotation, "ROTATION", 4)?;
+    let s = read(raw.scale, "SCALE", 3)?;
+    let counts: Vec<(&str, usize)> = [("TRANSLATION", &t), ("ROTATION", &r), ("SCALE", &s)]
+        .into_iter()
+        .filter_map(|(k, v)| v.as_ref().map(|v| (k, v.len())))
+        .collect();
+    let Some(&(_, count)) = counts.first() else {
+        return Err(invalid(
+            "no TRANSLATION, ROTATION or SCALE attribute".into(),
+        ));
+    };
+    if let Some((k, n)) = counts.iter().find(|(_, n)| *n != count) {
+        return Err(invalid(format!(
+            "{k} has {n} elements but {} has {count}",
+            counts[0].0
+        )));
+    }
+    let mut rotations = Vec::with_capacity(count);
+    for i in 0..count {
+        let q = r.as_ref().map_or(Quat::IDENTITY, |r| Quat::from_vec4(r[i]));
+        if q.length_squared() < 1e-12 {
+            return Err(invalid(format!("ROTATION of instance {i} is zero")));
+        }
+        rotations.push(q.normalize());
+    }
+    let at = |v: &Option<Vec<Vec4>>, i: usize, default: Vec3| {
+        v.as_ref().map_or(default, |v| v[i].truncate())
+    };
+    let transforms: Vec<Mat4> = (0..count)
+        .map(|i| {
+            Mat4::from_scale_rotation_translation(
+                at(&s, i, Vec3::ONE),
+                rotations[i],
+                at(&t, i, Vec3::ZERO),
+            )
+        })
+        .collect();
+    Ok(transforms.into_iter())
 }

@@ -13,6 +13,7 @@ use base64::engine::{DecodePaddingMode, GeneralPurpose, GeneralPurposeConfig};
 use base64::Engine as _;
 
 use crate::error::{label, Error, Result};
+use crate::meshopt;
 
 /// Standard base64 (RFC 4648, `+/` alphabet) for data URIs: padding optional, no whitespace.
 const BASE64: GeneralPurpose = GeneralPurpose::new(
@@ -36,6 +37,19 @@ pub(crate) struct Source {
     /// Per material (index-aligned with `doc.materials()`): what the raw JSON says that the gltf
     /// crate does not give (see [`RawMaterial`]).
     pub(crate) raw_materials: Vec<RawMaterial>,
+    /// Per node (index-aligned with `doc.nodes()`): the accessors of its
+    /// `EXT_mesh_gpu_instancing` attributes, where it has the extension (the gltf crate does not
+    /// read it).
+    pub(crate) raw_instancing: Vec<Option<RawInstancing>>,
+}
+
+/// A node's `EXT_mesh_gpu_instancing` attributes: accessor indices of the instances'
+/// translations, rotations and scales (each optional; other attributes are not read).
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct RawInstancing {
+    pub(crate) translation: Option<usize>,
+    pub(crate) rotation: Option<usize>,
+    pub(crate) scale: Option<usize>,
 }
 
 /// What a material's raw JSON holds beyond the gltf crate's view of it.
@@ -83,20 +97,35 @@ impl Source {
         precheck(path, &root)?;
         let doc = gltf::Document::from_json(root).map_err(parse_err)?;
         let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let raw = raw_json(&bytes);
+        let compressed = compressed_views(path, &raw, doc.views().len())?;
         let mut source = Source {
             path: path.to_path_buf(),
             base,
-            raw_materials: raw_materials(&bytes, doc.materials().len()),
+            raw_materials: raw_materials(&raw, doc.materials().len()),
+            raw_instancing: raw_instancing(path, &raw, doc.nodes().len())?,
             doc,
             buffers: Vec::new(),
         };
-        source.buffers = source.load_buffers(blob)?;
+        let placeholders = placeholder_buffers(&raw, &source.doc, &compressed, blob.is_some());
+        source.buffers = source.load_buffers(blob, &placeholders)?;
+        source.decompress(&compressed, &placeholders)?;
         Ok(source)
     }
 
-    fn load_buffers(&self, mut blob: Option<Vec<u8>>) -> Result<Vec<gltf::buffer::Data>> {
+    /// Each buffer's data; a placeholder buffer (see [`placeholder_buffers`]) is left empty, to be
+    /// filled by [`Source::decompress`].
+    fn load_buffers(
+        &self,
+        mut blob: Option<Vec<u8>>,
+        placeholders: &[bool],
+    ) -> Result<Vec<gltf::buffer::Data>> {
         let mut out = Vec::new();
         for buffer in self.doc.buffers() {
+            if placeholders[buffer.index()] {
+                out.push(gltf::buffer::Data(Vec::new()));
+                continue;
+            }
             let element = label("buffer", buffer.index(), buffer.name());
             let (uri, data) = match buffer.source() {
                 gltf::buffer::Source::Bin => ("<GLB BIN chunk>".to_string(), blob.take()),
@@ -127,6 +156,92 @@ impl Source {
             out.push(gltf::buffer::Data(data));
         }
         Ok(out)
+    }
+
+    /// Decodes every `EXT_meshopt_compression` buffer view into the bytes its parent view
+    /// describes, where that view lies: a placeholder buffer is sized to the views in it (zeros
+    /// between them), a buffer with data of its own (an uncompressed fallback) is overwritten.
+    /// A view in a placeholder buffer must be compressed, and compressed data must not come from
+    /// one.
+    fn decompress(
+        &mut self,
+        compressed: &[Option<CompressedView>],
+        placeholders: &[bool],
+    ) -> Result<()> {
+        let views: Vec<(usize, usize, usize)> = self
+            .doc
+            .views()
+            .map(|v| (v.buffer().index(), v.offset(), v.length()))
+            .collect();
+        let invalid = |view: usize, reason: String| Error::Invalid {
+            path: self.path.clone(),
+            element: label(
+                "buffer view",
+                view,
+                self.doc.views().nth(view).and_then(|v| v.name()),
+            ),
+            reason,
+        };
+        for (i, &(buffer, offset, length)) in views.iter().enumerate() {
+            if placeholders[buffer] && compressed[i].is_none() {
+                return Err(invalid(
+                    i,
+                    format!(
+                        "lies in buffer {buffer}, which has no data of its own (an \
+                         EXT_meshopt_compression fallback), but is not compressed"
+                    ),
+                ));
+            }
+            if placeholders[buffer] {
+                let end = offset.checked_add(length).ok_or_else(|| {
+                    invalid(i, format!("offset {offset} + length {length} overflows"))
+                })?;
+                let data = &mut self.buffers[buffer].0;
+                if data.len() < end {
+                    data.resize(end, 0);
+                }
+            }
+        }
+        for (i, c) in compressed.iter().enumerate() {
+            let Some(c) = c else { continue };
+            let (buffer, offset, length) = views[i];
+            let err = |reason: String| invalid(i, format!("EXT_meshopt_compression: {reason}"));
+            if placeholders.get(c.buffer).copied().unwrap_or(false) {
+                return Err(err(format!(
+                    "its compressed data is in buffer {}, a fallback buffer",
+                    c.buffer
+                )));
+            }
+            let source = self
+                .buffers
+                .get(c.buffer)
+                .ok_or_else(|| err(format!("buffer {} does not exist", c.buffer)))?;
+            let end = c.offset.checked_add(c.length);
+            let bytes = end
+                .and_then(|end| source.0.get(c.offset..end))
+                .ok_or_else(|| {
+                    err(format!(
+                        "compressed data (offset {}, length {}) exceeds buffer {} ({} bytes)",
+                        c.offset,
+                        c.length,
+                        c.buffer,
+                        source.0.len()
+                    ))
+                })?;
+            let decoded =
+                meshopt::decode(c.mode, c.filter, c.count, c.stride, bytes).map_err(err)?;
+            let target = self.buffers[buffer]
+                .0
+                .get_mut(offset..offset + length)
+                .ok_or_else(|| {
+                    invalid(
+                        i,
+                        format!("(offset {offset}, length {length}) exceeds buffer {buffer}"),
+                    )
+                })?;
+            target.copy_from_slice(&decoded);
+        }
+        Ok(())
     }
 
     /// Reads a buffer URI: `data:...;base64,...` or a relative (percent-encoded) file path.
@@ -303,13 +418,18 @@ const SUPPORTED_REQUIRED: &[&str] = &[
     // dequantization is the node's transform and `KHR_texture_transform`.
     "KHR_mesh_quantization",
     "KHR_texture_transform",
+    "EXT_mesh_gpu_instancing",
+    // Decoded on load by `meshopt.rs` into the views' fallback buffers.
+    "EXT_meshopt_compression",
 ];
 
 /// Why a required extension cannot be honoured, for the error message.
 fn unsupported_reason(name: &str) -> &'static str {
     match name {
         "KHR_draco_mesh_compression" => "Draco-compressed meshes cannot be decoded",
-        "EXT_meshopt_compression" => "meshopt-compressed buffers cannot be decoded",
+        "KHR_meshopt_compression" => {
+            "its vertex codec 1 is not decoded (EXT_meshopt_compression is: gltfpack -ce ext)"
+        }
         "KHR_texture_basisu" => "KTX2 / Basis Universal textures cannot be decoded",
         "EXT_texture_webp" => "WebP textures cannot be decoded",
         "EXT_texture_avif" => "AVIF textures cannot be decoded",
@@ -327,17 +447,201 @@ const TEXTURE_SLOTS: &[&[&str]] = &[
     &["emissiveTexture"],
 ];
 
-/// The [`RawMaterial`] of each of the first `count` materials, from the JSON text or the GLB
-/// JSON chunk in `bytes`.
-fn raw_materials(bytes: &[u8], count: usize) -> Vec<RawMaterial> {
+/// The JSON of the text file or of the GLB JSON chunk in `bytes` (`Null` where it does not
+/// parse: the gltf crate has parsed it already).
+fn raw_json(bytes: &[u8]) -> serde_json::Value {
     let json = if bytes.starts_with(b"glTF") {
         gltf::Glb::from_slice(bytes).ok().map(|glb| glb.json)
     } else {
         Some(std::borrow::Cow::Borrowed(bytes))
     };
-    let root: serde_json::Value = json
-        .and_then(|j| serde_json::from_slice(&j).ok())
-        .unwrap_or_default();
+    json.and_then(|j| serde_json::from_slice(&j).ok())
+        .unwrap_or_default()
+}
+
+/// A buffer view's `EXT_meshopt_compression` object: where its compressed bytes are and how
+/// they are coded.
+#[derive(Debug, Clone, Copy)]
+struct CompressedView {
+    buffer: usize,
+    offset: usize,
+    length: usize,
+    stride: usize,
+    count: usize,
+    mode: meshopt::Mode,
+    filter: meshopt::Filter,
+}
+
+/// The [`CompressedView`] of each of the first `count` buffer views of `root`, checked against the
+/// extension's rules (stride, count and filter for the mode; `count · byteStride` equal to the
+/// view's length; a length the compressed bytes can hold); any fault is an error naming the view.
+fn compressed_views(
+    path: &Path,
+    root: &serde_json::Value,
+    count: usize,
+) -> Result<Vec<Option<CompressedView>>> {
+    (0..count)
+        .map(|i| {
+            let view = root.get("bufferViews").and_then(|list| list.get(i));
+            let Some(ext) = view
+                .and_then(|v| v.get("extensions"))
+                .and_then(|e| e.get("EXT_meshopt_compression"))
+            else {
+                return Ok(None);
+            };
+            let name = view.and_then(|v| v.get("name")).and_then(|n| n.as_str());
+            let err = |reason: String| Error::Invalid {
+                path: path.to_path_buf(),
+                element: label("buffer view", i, name),
+                reason: format!("EXT_meshopt_compression: {reason}"),
+            };
+            let int = |v: Option<&serde_json::Value>, key: &str| -> Result<usize> {
+                v.and_then(|v| v.get(key))
+                    .and_then(|v| v.as_u64())
+                    .and_then(|v| usize::try_from(v).ok())
+                    .ok_or_else(|| err(format!("{key} is missing or not a non-negative integer")))
+            };
+            let text = |key: &str, default: &'static str| -> Result<String> {
+                match ext.get(key) {
+                    None => Ok(default.to_string()),
+                    Some(v) => v
+                        .as_str()
+                        .map(str::to_string)
+                        .ok_or_else(|| err(format!("{key} is {v}, not a string"))),
+                }
+            };
+            let mode_name = text("mode", "")?;
+            let mode = meshopt::Mode::parse(&mode_name).ok_or_else(|| {
+                err(format!(
+                    "mode \"{mode_name}\" is not ATTRIBUTES, TRIANGLES or INDICES"
+                ))
+            })?;
+            let filter_name = text("filter", "NONE")?;
+            let filter = meshopt::Filter::parse(&filter_name).ok_or_else(|| {
+                err(format!(
+                    "filter \"{filter_name}\" is not NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL"
+                ))
+            })?;
+            let c = CompressedView {
+                buffer: int(Some(ext), "buffer")?,
+                offset: if ext.get("byteOffset").is_some() {
+                    int(Some(ext), "byteOffset")?
+                } else {
+                    0
+                },
+                length: int(Some(ext), "byteLength")?,
+                stride: int(Some(ext), "byteStride")?,
+                count: int(Some(ext), "count")?,
+                mode,
+                filter,
+            };
+            meshopt::check_layout(mode, filter, c.count, c.stride).map_err(err)?;
+            if let Some(parent) = view.and_then(|v| v.get("byteStride")) {
+                if parent.as_u64() != Some(c.stride as u64) {
+                    return Err(err(format!(
+                        "byteStride {} differs from the view's {parent}",
+                        c.stride
+                    )));
+                }
+            }
+            let decoded = c.count.checked_mul(c.stride);
+            let parent = int(view, "byteLength")?;
+            if decoded != Some(parent) {
+                return Err(err(format!(
+                    "count {} × byteStride {} is not the view's byteLength {parent}",
+                    c.count, c.stride
+                )));
+            }
+            if parent > meshopt::max_decoded_len(mode, c.length) {
+                return Err(err(format!(
+                    "{parent} bytes cannot be coded in {} compressed bytes",
+                    c.length
+                )));
+            }
+            Ok(Some(c))
+        })
+        .collect()
+}
+
+/// Which buffers have no data to load: those tagged `EXT_meshopt_compression.fallback`, and those
+/// without a URI (and not the GLB BIN chunk) that compressed views decode into. The extension lets
+/// a loader that decodes skip a tagged fallback even where it has a URI.
+fn placeholder_buffers(
+    root: &serde_json::Value,
+    doc: &gltf::Document,
+    compressed: &[Option<CompressedView>],
+    has_blob: bool,
+) -> Vec<bool> {
+    let mut targets = vec![false; doc.buffers().len()];
+    for view in doc.views() {
+        if compressed.get(view.index()).is_some_and(Option::is_some) {
+            targets[view.buffer().index()] = true;
+        }
+    }
+    // The first buffer without a URI is the GLB BIN chunk, where there is one.
+    let mut blob = has_blob;
+    doc.buffers()
+        .map(|b| {
+            let tagged = root
+                .get("buffers")
+                .and_then(|list| list.get(b.index()))
+                .and_then(|b| b.get("extensions"))
+                .and_then(|e| e.get("EXT_meshopt_compression"))
+                .and_then(|e| e.get("fallback"))
+                .and_then(|f| f.as_bool())
+                .unwrap_or(false);
+            let uri_less = matches!(b.source(), gltf::buffer::Source::Bin);
+            let is_blob = uri_less && std::mem::take(&mut blob);
+            tagged || (uri_less && !is_blob && targets[b.index()])
+        })
+        .collect()
+}
+
+/// The [`RawInstancing`] of each of the first `count` nodes of `root`; an attribute that is not
+/// an accessor index is an error naming the node.
+fn raw_instancing(
+    path: &Path,
+    root: &serde_json::Value,
+    count: usize,
+) -> Result<Vec<Option<RawInstancing>>> {
+    (0..count)
+        .map(|i| {
+            let node = root.get("nodes").and_then(|list| list.get(i));
+            let Some(ext) = node
+                .and_then(|n| n.get("extensions"))
+                .and_then(|e| e.get("EXT_mesh_gpu_instancing"))
+            else {
+                return Ok(None);
+            };
+            let name = node.and_then(|n| n.get("name")).and_then(|n| n.as_str());
+            let attributes = ext.get("attributes");
+            let index = |key: &str| -> Result<Option<usize>> {
+                match attributes.and_then(|a| a.get(key)) {
+                    None => Ok(None),
+                    Some(v) => match v.as_u64() {
+                        Some(a) => Ok(Some(a as usize)),
+                        None => Err(Error::Invalid {
+                            path: path.to_path_buf(),
+                            element: label("node", i, name),
+                            reason: format!(
+                                "EXT_mesh_gpu_instancing attribute {key} is {v}, not an accessor \
+                                 index"
+                            ),
+                        }),
+                    },
+                }
+            };
+            Ok(Some(RawInstancing {
+                translation: index("TRANSLATION")?,
+                rotation: index("ROTATION")?,
+                scale: index("SCALE")?,
+            }))
+        })
+        .collect()
+}
+
+/// The [`RawMaterial`] of each of the first `count` materials of `root`.
+fn raw_materials(root: &serde_json::Value, count: usize) -> Vec<RawMaterial> {
     let keys = |v: Option<&serde_json::Value>| -> Vec<String> {
         v.and_then(|v| v.get("extensions"))
             .and_then(|e| e.as_object())

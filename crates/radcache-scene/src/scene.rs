@@ -19,13 +19,16 @@ use crate::mesh::Mesh;
 use crate::node::{LocalTransform, Node};
 use crate::texture::{Image, Texture};
 
-/// A mesh placed by a node.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// A mesh placed by a node (once, or once per instance of its `EXT_mesh_gpu_instancing`).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Instance {
     /// Index into `Scene::meshes`.
     pub mesh: usize,
     /// Index into `Scene::nodes`.
     pub node: usize,
+    /// `node_from_object`: the instance's own transform under its node (its
+    /// `EXT_mesh_gpu_instancing` translation, rotation and scale; identity for a plain node).
+    pub local: Mat4,
     /// True when the world transform changes over the animation range (TLAS refit needed).
     pub dynamic: bool,
 }
@@ -134,7 +137,10 @@ impl Scene {
     /// `world_from_object` of each instance at time `t` (same order as `instances`).
     pub fn instance_transforms(&self, t: f32) -> Vec<Mat4> {
         let world = self.world_transforms(t);
-        self.instances.iter().map(|i| world[i.node]).collect()
+        self.instances
+            .iter()
+            .map(|i| world[i.node] * i.local)
+            .collect()
     }
 
     /// The selected camera's frame at time `t`.

@@ -372,7 +372,7 @@ fn a_plain_scene_has_no_material_notes() {
 fn refused_required_extensions_name_the_file_and_the_extension() {
     for (name, why) in [
         ("KHR_draco_mesh_compression", "Draco"),
-        ("EXT_meshopt_compression", "meshopt"),
+        ("KHR_meshopt_compression", "vertex codec 1"),
         ("KHR_texture_basisu", "Basis Universal"),
         ("EXT_texture_webp", "WebP"),
     ] {
