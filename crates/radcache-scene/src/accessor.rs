@@ -58,8 +58,17 @@ impl Reader<'_> {
         }
     }
 
-    /// Returns the bytes of a buffer view after checking it lies inside its buffer.
+    /// Returns the bytes of a buffer view: decoded, where it is `EXT_meshopt_compression`
+    /// compressed, or its buffer's after checking it lies inside.
     fn view_bytes(&self, view: &gltf::buffer::View<'_>) -> Result<&[u8]> {
+        if let Some(decoded) = self
+            .src
+            .decoded_views
+            .get(view.index())
+            .and_then(Option::as_deref)
+        {
+            return Ok(decoded);
+        }
         let data = self
             .src
             .buffers

@@ -12,9 +12,9 @@
 //!
 //! **Delivery formats** (what gltfpack and gltf-transform write): `KHR_mesh_quantization`
 //! (integer attributes, dequantized by the node's transform), `EXT_meshopt_compression` (each
-//! compressed buffer view decoded on load into its fallback buffer; the KHR version's vertex codec
-//! 1 is refused by name) and `EXT_mesh_gpu_instancing` (one [`Instance`] per element, its
-//! transform under the node's).
+//! compressed buffer view decoded on load, its fallback buffer never read; the KHR version's
+//! vertex codec 1 is refused by name) and `EXT_mesh_gpu_instancing` (one [`Instance`] per
+//! element, its transform under the node's).
 //!
 //! **For a GPU uploader.** Geometry: `scene.meshes[m]` holds `positions`, `normals`,
 //! `texcoords` (one entry per vertex; `tangents` too where a material has a normal map, and

@@ -2,8 +2,10 @@
 //! and the three filters of the extension's Appendices A and B, decoded without trusting the input.
 //!
 //! A compressed buffer view names its source bytes, its element count and stride, a mode and a
-//! filter; [`decode`] returns the `count · stride` bytes the view holds, which the loader writes
-//! where the view lies (its fallback buffer, which has no data of its own). Every read is bounds
+//! filter; [`decode`] returns the `count · stride` bytes the view holds, which the loader keeps per
+//! view for the accessors to read (the view's fallback buffer has no data of its own and is never
+//! loaded). A view declares at most [`max_decoded_len`] of its compressed bytes, so a file decodes
+//! to at most 64 times its size. Every read is bounds
 //! checked and every stream must be consumed exactly to its tail, so a damaged file is refused with
 //! the reason instead of decoded into garbage; out-of-range indices it may still produce are caught
 //! where the mesh is read, as for an uncompressed file.

@@ -32,8 +32,12 @@ pub(crate) struct Source {
     pub(crate) base: PathBuf,
     /// The validated document.
     pub(crate) doc: gltf::Document,
-    /// Buffer contents, index-aligned with `doc.buffers()`; each is at least `byteLength` long.
+    /// Buffer contents, index-aligned with `doc.buffers()`; each is at least `byteLength` long,
+    /// except a placeholder (an `EXT_meshopt_compression` fallback), which is empty.
     pub(crate) buffers: Vec<gltf::buffer::Data>,
+    /// Per buffer view (index-aligned with `doc.views()`): its bytes decoded, where it is
+    /// `EXT_meshopt_compression` compressed; accessors read these instead of the buffer.
+    pub(crate) decoded_views: Vec<Option<Vec<u8>>>,
     /// Per material (index-aligned with `doc.materials()`): what the raw JSON says that the gltf
     /// crate does not give (see [`RawMaterial`]).
     pub(crate) raw_materials: Vec<RawMaterial>,
@@ -106,15 +110,16 @@ impl Source {
             raw_instancing: raw_instancing(path, &raw, doc.nodes().len())?,
             doc,
             buffers: Vec::new(),
+            decoded_views: Vec::new(),
         };
         let placeholders = placeholder_buffers(&raw, &source.doc, &compressed, blob.is_some());
         source.buffers = source.load_buffers(blob, &placeholders)?;
-        source.decompress(&compressed, &placeholders)?;
+        source.decoded_views = source.decompress(&compressed, &placeholders)?;
         Ok(source)
     }
 
-    /// Each buffer's data; a placeholder buffer (see [`placeholder_buffers`]) is left empty, to be
-    /// filled by [`Source::decompress`].
+    /// Each buffer's data; a placeholder buffer (see [`placeholder_buffers`]) is left empty (its
+    /// views are decoded by [`Source::decompress`]).
     fn load_buffers(
         &self,
         mut blob: Option<Vec<u8>>,
@@ -158,90 +163,63 @@ impl Source {
         Ok(out)
     }
 
-    /// Decodes every `EXT_meshopt_compression` buffer view into the bytes its parent view
-    /// describes, where that view lies: a placeholder buffer is sized to the views in it (zeros
-    /// between them), a buffer with data of its own (an uncompressed fallback) is overwritten.
-    /// A view in a placeholder buffer must be compressed, and compressed data must not come from
-    /// one.
+    /// Decodes every `EXT_meshopt_compression` buffer view into the bytes its view describes
+    /// (index-aligned with `doc.views()`; `None` for a view that is not compressed). A view in a
+    /// placeholder buffer must be compressed, and compressed data must not come from one.
     fn decompress(
-        &mut self,
+        &self,
         compressed: &[Option<CompressedView>],
         placeholders: &[bool],
-    ) -> Result<()> {
-        let views: Vec<(usize, usize, usize)> = self
-            .doc
-            .views()
-            .map(|v| (v.buffer().index(), v.offset(), v.length()))
-            .collect();
-        let invalid = |view: usize, reason: String| Error::Invalid {
+    ) -> Result<Vec<Option<Vec<u8>>>> {
+        let invalid = |view: &gltf::buffer::View<'_>, reason: String| Error::Invalid {
             path: self.path.clone(),
-            element: label(
-                "buffer view",
-                view,
-                self.doc.views().nth(view).and_then(|v| v.name()),
-            ),
+            element: label("buffer view", view.index(), view.name()),
             reason,
         };
-        for (i, &(buffer, offset, length)) in views.iter().enumerate() {
-            if placeholders[buffer] && compressed[i].is_none() {
-                return Err(invalid(
-                    i,
-                    format!(
-                        "lies in buffer {buffer}, which has no data of its own (an \
-                         EXT_meshopt_compression fallback), but is not compressed"
-                    ),
-                ));
-            }
-            if placeholders[buffer] {
-                let end = offset.checked_add(length).ok_or_else(|| {
-                    invalid(i, format!("offset {offset} + length {length} overflows"))
-                })?;
-                let data = &mut self.buffers[buffer].0;
-                if data.len() < end {
-                    data.resize(end, 0);
+        self.doc
+            .views()
+            .map(|view| {
+                let buffer = view.buffer().index();
+                let Some(c) = compressed[view.index()] else {
+                    if placeholders[buffer] {
+                        return Err(invalid(
+                            &view,
+                            format!(
+                                "lies in buffer {buffer}, which has no data of its own (an \
+                                 EXT_meshopt_compression fallback), but is not compressed"
+                            ),
+                        ));
+                    }
+                    return Ok(None);
+                };
+                let err =
+                    |reason: String| invalid(&view, format!("EXT_meshopt_compression: {reason}"));
+                if placeholders.get(c.buffer).copied().unwrap_or(false) {
+                    return Err(err(format!(
+                        "its compressed data is in buffer {}, a fallback buffer",
+                        c.buffer
+                    )));
                 }
-            }
-        }
-        for (i, c) in compressed.iter().enumerate() {
-            let Some(c) = c else { continue };
-            let (buffer, offset, length) = views[i];
-            let err = |reason: String| invalid(i, format!("EXT_meshopt_compression: {reason}"));
-            if placeholders.get(c.buffer).copied().unwrap_or(false) {
-                return Err(err(format!(
-                    "its compressed data is in buffer {}, a fallback buffer",
-                    c.buffer
-                )));
-            }
-            let source = self
-                .buffers
-                .get(c.buffer)
-                .ok_or_else(|| err(format!("buffer {} does not exist", c.buffer)))?;
-            let end = c.offset.checked_add(c.length);
-            let bytes = end
-                .and_then(|end| source.0.get(c.offset..end))
-                .ok_or_else(|| {
-                    err(format!(
-                        "compressed data (offset {}, length {}) exceeds buffer {} ({} bytes)",
-                        c.offset,
-                        c.length,
-                        c.buffer,
-                        source.0.len()
-                    ))
-                })?;
-            let decoded =
-                meshopt::decode(c.mode, c.filter, c.count, c.stride, bytes).map_err(err)?;
-            let target = self.buffers[buffer]
-                .0
-                .get_mut(offset..offset + length)
-                .ok_or_else(|| {
-                    invalid(
-                        i,
-                        format!("(offset {offset}, length {length}) exceeds buffer {buffer}"),
-                    )
-                })?;
-            target.copy_from_slice(&decoded);
-        }
-        Ok(())
+                let source = self
+                    .buffers
+                    .get(c.buffer)
+                    .ok_or_else(|| err(format!("buffer {} does not exist", c.buffer)))?;
+                let end = c.offset.checked_add(c.length);
+                let bytes = end
+                    .and_then(|end| source.0.get(c.offset..end))
+                    .ok_or_else(|| {
+                        err(format!(
+                            "compressed data (offset {}, length {}) exceeds buffer {} ({} bytes)",
+                            c.offset,
+                            c.length,
+                            c.buffer,
+                            source.0.len()
+                        ))
+                    })?;
+                let decoded = meshopt::decode(c.mode, c.filter, c.count, c.stride, bytes);
+                Ok(Some(decoded.map_err(err)?))
+            })
+            .collect()
     }
 
     /// Reads a buffer URI: `data:...;base64,...` or a relative (percent-encoded) file path.
@@ -283,6 +261,18 @@ impl Source {
         let mut file = None;
         match image.source() {
             gltf::image::Source::View { view, .. } => {
+                if self
+                    .decoded_views
+                    .get(view.index())
+                    .is_some_and(Option::is_some)
+                {
+                    return Err(invalid(format!(
+                        "an image in a meshopt-compressed buffer view ({}) is not read (the \
+                         extension compresses geometry and animation; encoders leave images as \
+                         they are)",
+                        view.index()
+                    )));
+                }
                 let len = self
                     .buffers
                     .get(view.buffer().index())
@@ -419,7 +409,7 @@ const SUPPORTED_REQUIRED: &[&str] = &[
     "KHR_mesh_quantization",
     "KHR_texture_transform",
     "EXT_mesh_gpu_instancing",
-    // Decoded on load by `meshopt.rs` into the views' fallback buffers.
+    // Each compressed view decoded on load by `meshopt.rs`; its fallback buffer is not loaded.
     "EXT_meshopt_compression",
 ];
 

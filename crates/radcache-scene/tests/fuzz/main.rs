@@ -1,7 +1,8 @@
 //! Seeded mutation test of the loader (a bounded stand-in for a fuzzer).
 //!
-//! Sources: the three bundled assets, a small textured scene and a "kitchen sink" document
-//! (`sources.rs`). Each iteration takes one source and either
+//! Sources: the three bundled assets, a small textured scene, a "kitchen sink" document
+//! (`sources.rs`), and two gltfpack files of `tests/data/` (meshopt's triangle and attribute
+//! codecs with all three filters; `EXT_mesh_gpu_instancing`). Each iteration takes one source and either
 //! - writes it as `.gltf` + `.bin` after 1–3 JSON-level mutations (accessor/view fields, deleted
 //!   members, replaced numbers and strings, new references, byte flips and truncation of the
 //!   `.bin`), or
@@ -134,6 +135,11 @@ fn mutated_files_never_panic() {
         ("animated", animated_builder().to_json(Some("f.bin"))),
         ("textured", sources::textured()),
         ("kitchen_sink", sources::kitchen_sink()),
+        ("meshopt_filters", sources::glb("animated-cc.glb")),
+        (
+            "meshopt_instancing",
+            sources::glb("cornell-instanced-cc.glb"),
+        ),
     ];
     let (mut loaded, mut rejected) = (0usize, 0usize);
     let mut failures = Vec::new();

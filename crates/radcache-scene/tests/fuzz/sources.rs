@@ -188,3 +188,19 @@ pub fn kitchen_sink() -> (Value, Vec<u8>) {
     });
     (root, bin)
 }
+
+/// A GLB file of `tests/data/` (gltfpack output) as its JSON and BIN chunks, buffer 0 given the
+/// URI `f.bin` so that it can be written as `.gltf` too.
+pub fn glb(name: &str) -> (Value, Vec<u8>) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name);
+    let bytes = std::fs::read(&path).unwrap();
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    let json_len = word(12);
+    let mut root: Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    let bin_at = 20 + json_len;
+    let bin = bytes[bin_at + 8..bin_at + 8 + word(bin_at)].to_vec();
+    root["buffers"][0]["uri"] = json!("f.bin");
+    (root, bin)
+}
