@@ -75,6 +75,11 @@ fn take_turn() {
 /// A context with validation on; panics with a clear message if the layer is missing. Contexts
 /// of one test process are used one test at a time ([`take_turn`]).
 pub fn context() -> Context {
+    context_with(|_| {})
+}
+
+/// [`context`] with its options changed by `f` first.
+pub fn context_with(f: impl FnOnce(&mut ContextOptions)) -> Context {
     take_turn();
     init_log();
     let mut opts = ContextOptions::from_env();
@@ -83,6 +88,7 @@ pub fn context() -> Context {
     if std::env::var_os(radcache_vk::PIPELINE_CACHE_ENV).is_none() {
         opts.pipeline_cache_dir = None;
     }
+    f(&mut opts);
     let ctx =
         Context::with_options(&opts).unwrap_or_else(|e| panic!("creating the Vulkan context: {e}"));
     if opts.validation {

@@ -22,6 +22,10 @@ pub enum Error {
     /// The request is not valid for this scene or device.
     #[error("{0}")]
     Invalid(String),
+    /// The scene needs more device memory than the device has (checked before any upload; the
+    /// message names the parts and the sizes).
+    #[error("{0}")]
+    SceneTooLarge(String),
 }
 
 /// Result with [`Error`].

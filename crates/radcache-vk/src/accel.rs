@@ -216,15 +216,89 @@ pub(crate) fn scratch(ctx: &Context, name: &str, size: u64) -> Result<Buffer> {
     )
 }
 
+/// What a BLAS's sizes depend on, for an estimate before any buffer exists.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BlasShape {
+    /// Vertices the triangles index.
+    pub vertex_count: u32,
+    /// Triangles.
+    pub triangle_count: u32,
+}
+
+/// Device bytes of one acceleration-structure build, as the driver states them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BuildSizes {
+    /// The structure before compaction.
+    pub structure: u64,
+    /// Scratch for a build.
+    pub scratch: u64,
+    /// Scratch for an update (a refit).
+    pub update_scratch: u64,
+}
+
+pub(crate) const BLAS_FLAGS: vk::BuildAccelerationStructureFlagsKHR =
+    vk::BuildAccelerationStructureFlagsKHR::from_raw(
+        vk::BuildAccelerationStructureFlagsKHR::PREFER_FAST_TRACE.as_raw()
+            | vk::BuildAccelerationStructureFlagsKHR::ALLOW_COMPACTION.as_raw(),
+    );
+
 impl Context {
+    /// `vkGetAccelerationStructureBuildSizesKHR` for a device build of `info` (its geometries
+    /// with `counts` primitives each).
+    pub(crate) fn build_sizes(
+        &self,
+        info: &vk::AccelerationStructureBuildGeometryInfoKHR<'_>,
+        counts: &[u32],
+    ) -> BuildSizes {
+        let mut sizes = vk::AccelerationStructureBuildSizesInfoKHR::default();
+        // SAFETY: `info` describes valid geometry with one count per geometry (the sizes query
+        // reads formats, counts and `maxVertex`, not the data); `sizes` is an output struct.
+        unsafe {
+            self.shared.accel.get_acceleration_structure_build_sizes(
+                vk::AccelerationStructureBuildTypeKHR::DEVICE,
+                info,
+                counts,
+                &mut sizes,
+            )
+        };
+        BuildSizes {
+            structure: sizes.acceleration_structure_size,
+            scratch: sizes.build_scratch_size,
+            update_scratch: sizes.update_scratch_size,
+        }
+    }
+
+    /// The build sizes of BLASes of these shapes (as [`Context::build_blases`] builds them:
+    /// float3 positions, 32-bit indices, fast trace, compactable), without building anything.
+    pub fn blas_sizes(&self, shapes: &[BlasShape]) -> Vec<BuildSizes> {
+        shapes
+            .iter()
+            .map(|s| {
+                let tri = vk::AccelerationStructureGeometryTrianglesDataKHR::default()
+                    .vertex_format(vk::Format::R32G32B32_SFLOAT)
+                    .vertex_stride(12)
+                    .max_vertex(s.vertex_count.saturating_sub(1))
+                    .index_type(vk::IndexType::UINT32);
+                let geometry = [vk::AccelerationStructureGeometryKHR::default()
+                    .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
+                    .geometry(vk::AccelerationStructureGeometryDataKHR { triangles: tri })
+                    .flags(vk::GeometryFlagsKHR::OPAQUE)];
+                let info = vk::AccelerationStructureBuildGeometryInfoKHR::default()
+                    .ty(vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL)
+                    .flags(BLAS_FLAGS)
+                    .mode(vk::BuildAccelerationStructureModeKHR::BUILD)
+                    .geometries(&geometry);
+                self.build_sizes(&info, &[s.triangle_count])
+            })
+            .collect()
+    }
+
     /// Builds and compacts one BLAS per geometry, waiting for the GPU.
     pub fn build_blases(&self, geoms: &[BlasGeometry<'_>]) -> Result<(Vec<Blas>, BlasBuildStats)> {
         let mut stats = BlasBuildStats::default();
         if geoms.is_empty() {
             return Ok((Vec::new(), stats));
         }
-        let flags = vk::BuildAccelerationStructureFlagsKHR::PREFER_FAST_TRACE
-            | vk::BuildAccelerationStructureFlagsKHR::ALLOW_COMPACTION;
         let geometries: Vec<[vk::AccelerationStructureGeometryKHR<'_>; 1]> = geoms
             .iter()
             .map(|g| triangles(g).map(|t| [t]))
@@ -235,26 +309,17 @@ impl Context {
         for (g, geometry) in geoms.iter().zip(&geometries) {
             let mut info = vk::AccelerationStructureBuildGeometryInfoKHR::default()
                 .ty(vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL)
-                .flags(flags)
+                .flags(BLAS_FLAGS)
                 .mode(vk::BuildAccelerationStructureModeKHR::BUILD)
                 .geometries(geometry);
-            let mut sizes = vk::AccelerationStructureBuildSizesInfoKHR::default();
-            // SAFETY: `info` describes valid geometry; sizes is an output struct.
-            unsafe {
-                self.shared.accel.get_acceleration_structure_build_sizes(
-                    vk::AccelerationStructureBuildTypeKHR::DEVICE,
-                    &info,
-                    &[g.triangle_count],
-                    &mut sizes,
-                )
-            };
+            let sizes = self.build_sizes(&info, &[g.triangle_count]);
             let blas = AccelerationStructure::new(
                 self,
                 g.name,
                 vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL,
-                sizes.acceleration_structure_size,
+                sizes.structure,
             )?;
-            let s = scratch(self, "accel.blas_scratch", sizes.build_scratch_size)?;
+            let s = scratch(self, "accel.blas_scratch", sizes.scratch)?;
             info = info.dst_acceleration_structure(blas.raw).scratch_data(
                 vk::DeviceOrHostAddressKHR {
                     device_address: s.device_address()?,

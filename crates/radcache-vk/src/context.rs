@@ -339,7 +339,8 @@ impl Context {
         let pd = pds[chosen];
         let (queue_family, ts_bits) = device::universal_queue_family(instance, pd)
             .ok_or_else(|| Error::MissingFeature("universal queue".into()))?;
-        let info = device::device_info(instance, pd, ts_bits, inst_ref.validation);
+        let mut info = device::device_info(instance, pd, ts_bits, inst_ref.validation);
+        info.memory_limit = opts.memory_limit;
         log::info!(
             "Vulkan device: {} ({}, {}), validation {}",
             info.name,

@@ -53,6 +53,21 @@ pub struct DeviceInfo {
     pub driver_version: u32,
     /// `pipelineCacheUUID`: pipeline cache data is exchangeable between devices with equal ids.
     pub pipeline_cache_uuid: [u8; 16],
+    /// Bytes of the largest `DEVICE_LOCAL` memory heap (on a CPU device such as lavapipe, the
+    /// host memory it reports).
+    pub memory_bytes: u64,
+    /// A smaller budget asked for by [`crate::ContextOptions::memory_limit`]
+    /// (`RADCACHE_DEVICE_MEMORY`).
+    pub memory_limit: Option<u64>,
+}
+
+impl DeviceInfo {
+    /// The bytes of device memory a scene may plan for: the largest device-local heap, or the
+    /// limit asked for where that is smaller.
+    pub fn usable_memory(&self) -> u64 {
+        self.memory_limit
+            .map_or(self.memory_bytes, |l| l.min(self.memory_bytes))
+    }
 }
 
 fn kind_of(t: vk::PhysicalDeviceType) -> DeviceKind {
@@ -181,6 +196,15 @@ pub(crate) fn device_info(
     // SAFETY: the device supports Vulkan 1.3 and VK_KHR_acceleration_structure (checked by select).
     unsafe { instance.get_physical_device_properties2(pd, &mut p2) };
     let p = p2.properties;
+    // SAFETY: `pd` is a physical device of `instance`.
+    let memory = unsafe { instance.get_physical_device_memory_properties(pd) };
+    let memory_bytes = memory
+        .memory_heaps_as_slice()
+        .iter()
+        .filter(|h| h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
+        .map(|h| h.size)
+        .max()
+        .unwrap_or(0);
     let text = |r: std::result::Result<&CStr, _>| {
         r.map(|c: &CStr| c.to_string_lossy().into_owned())
             .unwrap_or_default()
@@ -214,6 +238,8 @@ pub(crate) fn device_info(
         device_id: p.device_id,
         driver_version: p.driver_version,
         pipeline_cache_uuid: p.pipeline_cache_uuid,
+        memory_bytes,
+        memory_limit: None,
     }
 }
 

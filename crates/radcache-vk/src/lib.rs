@@ -38,7 +38,7 @@ mod sync;
 mod tlas;
 mod transfer;
 
-pub use accel::{Blas, BlasBuildStats, BlasGeometry};
+pub use accel::{Blas, BlasBuildStats, BlasGeometry, BlasShape, BuildSizes};
 pub use ash::vk;
 pub use bind::Resource;
 pub use buffer::{Buffer, BufferDesc, MemoryLocation};
@@ -48,7 +48,9 @@ pub use device::DeviceInfo;
 pub use draw::{ColorTarget, DepthTarget, RenderTargets};
 pub use error::{Error, Result};
 pub use image::{Image, ImageDesc, Sampler};
-pub use options::{pipeline_cache_dir_from_env, ContextOptions, PIPELINE_CACHE_ENV};
+pub use options::{
+    parse_size, pipeline_cache_dir_from_env, ContextOptions, DEVICE_MEMORY_ENV, PIPELINE_CACHE_ENV,
+};
 pub use pcache::PipelineStats;
 pub use pipeline::{BindingKind, BindingLayout, Blend, DepthState, GraphicsDesc, Pipeline};
 pub use profiler::PassTiming;

@@ -5,7 +5,7 @@
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
-use crate::accel::{scratch, AccelerationStructure, Blas};
+use crate::accel::{scratch, AccelerationStructure, Blas, BuildSizes};
 use crate::buffer::{Buffer, BufferDesc, MemoryLocation};
 use crate::commands::Recorder;
 use crate::context::Context;
@@ -86,6 +86,18 @@ fn instance_geometry<'a>(address: u64) -> vk::AccelerationStructureGeometryKHR<'
 }
 
 impl Tlas {
+    /// The device bytes of a TLAS for `capacity` instances: its structure and the scratch it
+    /// keeps (its instance buffer holds 64 bytes an instance on top).
+    pub fn sizes(ctx: &Context, capacity: u32) -> BuildSizes {
+        let geometry = [instance_geometry(0)];
+        let info = vk::AccelerationStructureBuildGeometryInfoKHR::default()
+            .ty(vk::AccelerationStructureTypeKHR::TOP_LEVEL)
+            .flags(TLAS_FLAGS)
+            .mode(vk::BuildAccelerationStructureModeKHR::BUILD)
+            .geometries(&geometry);
+        ctx.build_sizes(&info, &[capacity.max(1)])
+    }
+
     /// Allocates a TLAS for up to `capacity` instances (not built yet).
     pub fn new(ctx: &Context, name: &str, capacity: u32) -> Result<Self> {
         let capacity = capacity.max(1);
@@ -100,32 +112,17 @@ impl Tlas {
                 alignment: 16,
             },
         )?;
-        let geometry = [instance_geometry(instances.device_address()?)];
-        let info = vk::AccelerationStructureBuildGeometryInfoKHR::default()
-            .ty(vk::AccelerationStructureTypeKHR::TOP_LEVEL)
-            .flags(TLAS_FLAGS)
-            .mode(vk::BuildAccelerationStructureModeKHR::BUILD)
-            .geometries(&geometry);
-        let mut sizes = vk::AccelerationStructureBuildSizesInfoKHR::default();
-        // SAFETY: `info` describes an instance geometry; sizes is an output struct.
-        unsafe {
-            ctx.shared.accel.get_acceleration_structure_build_sizes(
-                vk::AccelerationStructureBuildTypeKHR::DEVICE,
-                &info,
-                &[capacity],
-                &mut sizes,
-            )
-        };
+        let sizes = Self::sizes(ctx, capacity);
         let structure = AccelerationStructure::new(
             ctx,
             name,
             vk::AccelerationStructureTypeKHR::TOP_LEVEL,
-            sizes.acceleration_structure_size,
+            sizes.structure,
         )?;
         let scratch = scratch(
             ctx,
             "accel.tlas_scratch",
-            sizes.build_scratch_size.max(sizes.update_scratch_size),
+            sizes.scratch.max(sizes.update_scratch),
         )?;
         Ok(Tlas {
             structure,

@@ -14,16 +14,18 @@ use radcache_shared::gpu::{
     FrameConstants, GpuAlias, GpuEmitter, GpuInstance, GpuLight, GpuMesh, GpuVertex,
 };
 use radcache_vk::{
-    vk, Blas, BlasBuildStats, BlasGeometry, Buffer, Context, Recorder, Tlas, TlasInstance,
-    TlasUpdate,
+    vk, Blas, BlasBuildStats, BlasGeometry, BlasShape, Buffer, Context, Recorder, Tlas,
+    TlasInstance, TlasUpdate,
 };
 
 use crate::error::Result;
+use crate::scene::budget::MemoryNeed;
 use crate::scene::env_map::{gpu_alias, EnvMap};
 use crate::scene::lights::{gpu_emitters, gpu_lights};
 use crate::scene::pack::{mesh_is_opaque, pack_geometry, pack_materials, PackedGeometry};
 use crate::scene::upload::{cols, host_buffer, rows3x4, storage};
 
+pub mod budget;
 pub(crate) mod env_map;
 pub mod features;
 pub(crate) mod lights;
@@ -43,6 +45,8 @@ pub struct UploadStats {
     pub buffer_bytes: u64,
     /// Number of BLASes (meshes with triangles).
     pub blas_count: usize,
+    /// The device memory the upload was planned for (checked against the device before it).
+    pub memory_need: MemoryNeed,
 }
 
 /// The scene's GPU resources at one time.
@@ -96,6 +100,8 @@ impl std::fmt::Debug for GpuScene {
 impl GpuScene {
     /// Uploads `scene` (and the environment map, when the scene uses one) and builds its BLASes.
     /// The TLAS is built by the first [`GpuScene::set_time`] + [`GpuScene::record_update`].
+    /// A scene that needs more device memory than the device has ([`MemoryNeed`]) is refused
+    /// before anything is uploaded.
     pub fn new(ctx: &Context, scene: &Scene, env_map: Option<&EnvMap>) -> Result<GpuScene> {
         let plan = scene.plan();
         let mut stats = UploadStats::default();
@@ -107,6 +113,25 @@ impl GpuScene {
             tri_materials,
             meshes,
         } = pack_geometry(scene, plan.normal_maps, plan.texcoord1);
+        let (materials, textures, texels) = pack_materials(scene);
+        let bytes = |n: usize| n as u64;
+        let need = memory_need(
+            ctx,
+            scene,
+            env_map,
+            bytes(
+                size_of_val(&vertices[..])
+                    + size_of_val(&tangents[..])
+                    + size_of_val(&texcoords1[..])
+                    + size_of_val(&indices[..])
+                    + size_of_val(&tri_materials[..]),
+            ),
+            bytes(
+                size_of_val(&materials[..]) + size_of_val(&textures[..]) + size_of_val(&texels[..]),
+            ),
+        );
+        need.check(ctx.info(), &scene.path)?;
+        stats.memory_need = need;
         let geometry_usage = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
             | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
         let none = vk::BufferUsageFlags::empty();
@@ -138,7 +163,6 @@ impl GpuScene {
             bytemuck::cast_slice(&texcoords1),
         )?;
 
-        let (materials, textures, texels) = pack_materials(scene);
         let material_buf = storage(
             ctx,
             "scene.materials",
@@ -220,17 +244,7 @@ impl GpuScene {
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
             instance_count * std::mem::size_of::<GpuInstance>() as u64,
         )?;
-        let max_emitters: usize = scene
-            .instances
-            .iter()
-            .map(|i| {
-                let mesh = &scene.meshes[i.mesh];
-                mesh.triangle_materials
-                    .iter()
-                    .filter(|&&m| scene.material_emission[m as usize].max_element() > 0.0)
-                    .count()
-            })
-            .sum();
+        let max_emitters = emissive_triangles(scene);
         let emitters = host_buffer(
             ctx,
             "scene.emitters",
@@ -457,4 +471,57 @@ impl GpuScene {
         };
         Ok(())
     }
+}
+
+/// What uploading `scene` will take of device memory, from the packed sizes of its geometry and
+/// textures, its environment map, its instances and lights, and the driver's sizes of every
+/// acceleration structure.
+fn memory_need(
+    ctx: &Context,
+    scene: &Scene,
+    env_map: Option<&EnvMap>,
+    geometry: u64,
+    textures: u64,
+) -> MemoryNeed {
+    let environment = match (env_map, &scene.environment) {
+        (Some(map), Environment::Map { .. }) => {
+            (size_of_val(&map.texels[..]) + size_of_val(&map.alias[..])) as u64
+        }
+        _ => 0,
+    };
+    let shapes: Vec<BlasShape> = scene
+        .meshes
+        .iter()
+        .filter(|m| m.triangle_count() > 0)
+        .map(|m| BlasShape {
+            vertex_count: m.positions.len() as u32,
+            triangle_count: m.triangle_count() as u32,
+        })
+        .collect();
+    let tlas = Tlas::sizes(ctx, scene.instances.len().max(1) as u32);
+    let instances = scene.instances.len() * (size_of::<GpuInstance>() + 64)
+        + emissive_triangles(scene) * (size_of::<GpuEmitter>() + size_of::<GpuAlias>())
+        + scene.light_instances.len() * size_of::<GpuLight>();
+    MemoryNeed {
+        geometry,
+        textures,
+        environment,
+        instances: instances as u64,
+        acceleration: MemoryNeed::acceleration(&ctx.blas_sizes(&shapes), tlas),
+    }
+}
+
+/// Emissive triangles over all instances (the emitter buffers' capacity).
+fn emissive_triangles(scene: &Scene) -> usize {
+    scene
+        .instances
+        .iter()
+        .map(|i| {
+            let mesh = &scene.meshes[i.mesh];
+            mesh.triangle_materials
+                .iter()
+                .filter(|&&m| scene.material_emission[m as usize].max_element() > 0.0)
+                .count()
+        })
+        .sum()
 }
