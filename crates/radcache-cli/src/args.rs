@@ -164,7 +164,9 @@ pub struct RenderArgs {
     /// Perfetto or chrome://tracing.
     #[arg(long, value_name = "FILE.json")]
     pub(crate) profile: Option<PathBuf>,
-    /// Write per-frame statistics as JSON.
+    /// Write per-frame statistics as JSON (times, rays, passes, live device memory), with the
+    /// run's configuration, host times and memory (the upload's planned device peak by part, the
+    /// peak resident host memory).
     #[arg(long, value_name = "FILE.json")]
     pub(crate) stats: Option<PathBuf>,
     /// Store half floats in the EXR.

@@ -181,7 +181,8 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
         entry["device_memory_bytes"] = json!(ctx.memory_by_category());
         entries.push(entry);
         if let Some(path) = &args.stats {
-            write_stats(path, &setup, &entries, [load_s, upload_s, write_s])?;
+            let memory = memory_entry(&gpu.stats().memory_need);
+            write_stats(path, &setup, &entries, [load_s, upload_s, write_s], memory)?;
         }
         if !args.quiet && sequence.frames.len() == 1 {
             let out = &rendered.out;
@@ -247,12 +248,38 @@ fn interrupt_flag(sequence: bool) -> Arc<AtomicBool> {
     flag
 }
 
+/// The stats file's `memory`: the device memory the scene's upload was planned for at its peak,
+/// by part, and the process's peak resident host memory so far (`VmHWM`, Linux; null elsewhere).
+/// Each frame's live device allocations are in its own entry (`device_memory_bytes`).
+fn memory_entry(need: &radcache_render::scene::budget::MemoryNeed) -> serde_json::Value {
+    let peak_host = std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix("VmHWM:"))
+                .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+                .map(|kb| kb * 1024)
+        });
+    json!({
+        "upload_peak_device_bytes": need.total(),
+        "upload_peak_by_part": {
+            "geometry": need.geometry,
+            "textures": need.textures,
+            "environment": need.environment,
+            "instances": need.instances,
+            "acceleration_structures": need.acceleration,
+        },
+        "peak_host_bytes": peak_host,
+    })
+}
+
 /// Writes the stats file (atomically, after every frame, so an interrupted run keeps it).
 fn write_stats(
     path: &Path,
     setup: &FrameSetup<'_>,
     frames: &[serde_json::Value],
     cpu_s: [f64; 3],
+    memory: serde_json::Value,
 ) -> Result<()> {
     let [load_s, upload_s, write_s] = cpu_s;
     let value = json!({
@@ -266,6 +293,7 @@ fn write_stats(
         // Host seconds outside the frames; "write" sums the frames' `write_s`.
         "cpu_s": {"scene_load": load_s, "upload": upload_s, "write": write_s},
         "pipelines": frame::pipelines_entry(setup),
+        "memory": memory,
         "frames": frames,
     });
     crate::output::write_text(path, &serde_json::to_string_pretty(&value)?, "stats")

@@ -78,6 +78,17 @@ fn render_writes_exr_with_metadata_aovs_png_and_stats() {
     // Device memory by category: at least the scene's buffers (vertices, BVH inputs, ...).
     let memory = frame["device_memory_bytes"].as_object().unwrap();
     assert!(memory["scene"].as_u64().unwrap() > 0, "{memory:?}");
+    // The upload's planned peak, its parts adding up to it, and the host's peak.
+    let run = &json["memory"];
+    let peak = run["upload_peak_device_bytes"].as_u64().unwrap();
+    let parts: u64 = run["upload_peak_by_part"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_u64().unwrap())
+        .sum();
+    assert!(peak > 0 && parts == peak, "{run}");
+    assert!(run["peak_host_bytes"].as_u64().unwrap() > 0, "{run}");
 }
 
 #[test]
