@@ -449,6 +449,18 @@ fn raw_json(bytes: &[u8]) -> serde_json::Value {
         .unwrap_or_default()
 }
 
+/// Element `i` of the top-level list `list` of `root`, with its extension object `name`, where it
+/// has one.
+fn extension_of<'a>(
+    root: &'a serde_json::Value,
+    list: &str,
+    i: usize,
+    name: &str,
+) -> Option<(&'a serde_json::Value, &'a serde_json::Value)> {
+    let element = root.get(list)?.get(i)?;
+    Some((element, element.get("extensions")?.get(name)?))
+}
+
 /// A buffer view's `EXT_meshopt_compression` object: where its compressed bytes are and how
 /// they are coded.
 #[derive(Debug, Clone, Copy)]
@@ -472,14 +484,11 @@ fn compressed_views(
 ) -> Result<Vec<Option<CompressedView>>> {
     (0..count)
         .map(|i| {
-            let view = root.get("bufferViews").and_then(|list| list.get(i));
-            let Some(ext) = view
-                .and_then(|v| v.get("extensions"))
-                .and_then(|e| e.get("EXT_meshopt_compression"))
+            let Some((view, ext)) = extension_of(root, "bufferViews", i, "EXT_meshopt_compression")
             else {
                 return Ok(None);
             };
-            let name = view.and_then(|v| v.get("name")).and_then(|n| n.as_str());
+            let name = view.get("name").and_then(|n| n.as_str());
             let err = |reason: String| Error::Invalid {
                 path: path.to_path_buf(),
                 element: label("buffer view", i, name),
@@ -526,7 +535,7 @@ fn compressed_views(
                 filter,
             };
             meshopt::check_layout(mode, filter, c.count, c.stride).map_err(err)?;
-            if let Some(parent) = view.and_then(|v| v.get("byteStride")) {
+            if let Some(parent) = view.get("byteStride") {
                 if parent.as_u64() != Some(c.stride as u64) {
                     return Err(err(format!(
                         "byteStride {} differs from the view's {parent}",
@@ -535,7 +544,7 @@ fn compressed_views(
                 }
             }
             let decoded = c.count.checked_mul(c.stride);
-            let parent = int(view, "byteLength")?;
+            let parent = int(Some(view), "byteLength")?;
             if decoded != Some(parent) {
                 return Err(err(format!(
                     "count {} × byteStride {} is not the view's byteLength {parent}",
@@ -572,12 +581,8 @@ fn placeholder_buffers(
     let mut blob = has_blob;
     doc.buffers()
         .map(|b| {
-            let tagged = root
-                .get("buffers")
-                .and_then(|list| list.get(b.index()))
-                .and_then(|b| b.get("extensions"))
-                .and_then(|e| e.get("EXT_meshopt_compression"))
-                .and_then(|e| e.get("fallback"))
+            let tagged = extension_of(root, "buffers", b.index(), "EXT_meshopt_compression")
+                .and_then(|(_, e)| e.get("fallback"))
                 .and_then(|f| f.as_bool())
                 .unwrap_or(false);
             let uri_less = matches!(b.source(), gltf::buffer::Source::Bin);
@@ -596,14 +601,11 @@ fn raw_instancing(
 ) -> Result<Vec<Option<RawInstancing>>> {
     (0..count)
         .map(|i| {
-            let node = root.get("nodes").and_then(|list| list.get(i));
-            let Some(ext) = node
-                .and_then(|n| n.get("extensions"))
-                .and_then(|e| e.get("EXT_mesh_gpu_instancing"))
+            let Some((node, ext)) = extension_of(root, "nodes", i, "EXT_mesh_gpu_instancing")
             else {
                 return Ok(None);
             };
-            let name = node.and_then(|n| n.get("name")).and_then(|n| n.as_str());
+            let name = node.get("name").and_then(|n| n.as_str());
             let attributes = ext.get("attributes");
             let index = |key: &str| -> Result<Option<usize>> {
                 match attributes.and_then(|a| a.get(key)) {

@@ -32,6 +32,7 @@ use anyhow::{bail, Context as _, Result};
 use glam::Vec3;
 use radcache_cache::Preset;
 use radcache_render::{render_ic, GpuScene, IcSettings};
+use radcache_scene::assets::look;
 use radcache_scene::light::LightKind;
 use radcache_scene::writer::{
     write_files, GltfBuilder, LightDesc, MaterialDesc, NodeDesc, PrimitiveDesc,
@@ -278,13 +279,6 @@ fn write_case(case: &Case, dir: &Path) -> Result<PathBuf> {
     let path = dir.join(format!("{}.gltf", case.name));
     write_files(&path, &root, Some((&bin_name, &bin)))?;
     Ok(path)
-}
-
-/// A rotation whose −Z axis points along `dir` (as a camera or a directional light looks).
-fn look(dir: Vec3) -> [f32; 4] {
-    let yaw = (-dir.x).atan2(-dir.z);
-    let pitch = dir.y.atan2(dir.x.hypot(dir.z));
-    (glam::Quat::from_rotation_y(yaw) * glam::Quat::from_rotation_x(pitch)).to_array()
 }
 
 /// Gives `node` an `EXT_mesh_gpu_instancing` TRANSLATION accessor of `translations` (appended to

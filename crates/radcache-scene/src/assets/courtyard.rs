@@ -16,10 +16,10 @@
 use std::f32::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
 
-use glam::{Quat, Vec3};
+use glam::Vec3;
 use serde_json::json;
 
-use super::{write_named, QuadSoup};
+use super::{look, write_named, QuadSoup};
 use crate::animation::{Interpolation, Property};
 use crate::error::Result;
 use crate::light::LightKind;
@@ -397,13 +397,6 @@ fn add_court(b: &mut GltfBuilder, m: &Materials, nodes: &mut Vec<usize>) {
             ..NodeDesc::default()
         }));
     }
-}
-
-/// A rotation that turns the camera's −Z toward `dir`, keeping +Y up.
-fn look(dir: Vec3) -> [f32; 4] {
-    let yaw = (-dir.x).atan2(-dir.z);
-    let pitch = dir.y.atan2(dir.x.hypot(dir.z));
-    (Quat::from_rotation_y(yaw) * Quat::from_rotation_x(pitch)).to_array()
 }
 
 /// The courtyard document.

@@ -97,6 +97,14 @@ impl QuadSoup {
 
 /// A unit quaternion (x, y, z, w) for a rotation of `degrees` about +Y.
 /// Components below 1e-7 in magnitude are snapped to zero (keeps the JSON tidy).
+/// A node rotation that turns its −Z (where a camera looks and a directional light shines)
+/// toward `dir`, keeping +Y up.
+pub fn look(dir: Vec3) -> [f32; 4] {
+    let yaw = (-dir.x).atan2(-dir.z);
+    let pitch = dir.y.atan2(dir.x.hypot(dir.z));
+    (Quat::from_rotation_y(yaw) * Quat::from_rotation_x(pitch)).to_array()
+}
+
 pub(crate) fn yaw(degrees: f32) -> [f32; 4] {
     Quat::from_rotation_y(degrees.to_radians())
         .to_array()
