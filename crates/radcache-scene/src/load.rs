@@ -101,7 +101,9 @@ impl Scene {
                 dynamic: dynamic[node],
             };
             match src.raw_instancing.get(node).copied().flatten() {
-                Some(raw) => instances.extend(gpu_instances(&src, node, &raw)?.map(instance)),
+                Some(raw) => {
+                    instances.extend(gpu_instances(&src, node, &raw)?.into_iter().map(instance))
+                }
                 None => instances.push(instance(Mat4::IDENTITY)),
             }
         }
@@ -284,11 +286,7 @@ fn warn_if_unlit(scene: &Scene, w: &mut Warnings) {
 /// (`T · R · S` of each one's TRANSLATION, ROTATION and SCALE, an absent attribute the identity):
 /// the attributes must have one element per instance, the same number each; a rotation is
 /// normalized, and a non-finite or zero one is an error naming the node.
-fn gpu_instances(
-    src: &Source,
-    node: usize,
-    raw: &RawInstancing,
-) -> Result<impl Iterator<Item = Mat4>> {
+fn gpu_instances(src: &Source, node: usize, raw: &RawInstancing) -> Result<Vec<Mat4>> {
     let gltf_node = src.doc.nodes().nth(node);
     let user = label("node", node, gltf_node.as_ref().and_then(|n| n.name()));
     let invalid = |reason: String| Error::Invalid {
@@ -330,25 +328,20 @@ fn gpu_instances(
             counts[0].0
         )));
     }
-    let mut rotations = Vec::with_capacity(count);
-    for i in 0..count {
-        let q = r.as_ref().map_or(Quat::IDENTITY, |r| Quat::from_vec4(r[i]));
-        if q.length_squared() < 1e-12 {
-            return Err(invalid(format!("ROTATION of instance {i} is zero")));
-        }
-        rotations.push(q.normalize());
-    }
     let at = |v: &Option<Vec<Vec4>>, i: usize, default: Vec3| {
         v.as_ref().map_or(default, |v| v[i].truncate())
     };
-    let transforms: Vec<Mat4> = (0..count)
+    (0..count)
         .map(|i| {
-            Mat4::from_scale_rotation_translation(
+            let q = r.as_ref().map_or(Quat::IDENTITY, |r| Quat::from_vec4(r[i]));
+            if q.length_squared() < 1e-12 {
+                return Err(invalid(format!("ROTATION of instance {i} is zero")));
+            }
+            Ok(Mat4::from_scale_rotation_translation(
                 at(&s, i, Vec3::ONE),
-                rotations[i],
+                q.normalize(),
                 at(&t, i, Vec3::ZERO),
-            )
+            ))
         })
-        .collect();
-    Ok(transforms.into_iter())
+        .collect()
 }

@@ -115,10 +115,12 @@ impl GpuScene {
         } = pack_geometry(scene, plan.normal_maps, plan.texcoord1);
         let (materials, textures, texels) = pack_materials(scene);
         let bytes = |n: usize| n as u64;
+        let max_emitters = emissive_triangles(scene);
         let need = memory_need(
             ctx,
             scene,
             env_map,
+            max_emitters,
             bytes(
                 size_of_val(&vertices[..])
                     + size_of_val(&tangents[..])
@@ -244,7 +246,6 @@ impl GpuScene {
             vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
             instance_count * std::mem::size_of::<GpuInstance>() as u64,
         )?;
-        let max_emitters = emissive_triangles(scene);
         let emitters = host_buffer(
             ctx,
             "scene.emitters",
@@ -474,12 +475,13 @@ impl GpuScene {
 }
 
 /// What uploading `scene` will take of device memory, from the packed sizes of its geometry and
-/// textures, its environment map, its instances and lights, and the driver's sizes of every
-/// acceleration structure.
+/// textures, its environment map, its instances, `emitters` emissive triangles and lights, and the
+/// driver's sizes of every acceleration structure.
 fn memory_need(
     ctx: &Context,
     scene: &Scene,
     env_map: Option<&EnvMap>,
+    emitters: usize,
     geometry: u64,
     textures: u64,
 ) -> MemoryNeed {
@@ -500,7 +502,7 @@ fn memory_need(
         .collect();
     let tlas = Tlas::sizes(ctx, scene.instances.len().max(1) as u32);
     let instances = scene.instances.len() * (size_of::<GpuInstance>() + 64)
-        + emissive_triangles(scene) * (size_of::<GpuEmitter>() + size_of::<GpuAlias>())
+        + emitters * (size_of::<GpuEmitter>() + size_of::<GpuAlias>())
         + scene.light_instances.len() * size_of::<GpuLight>();
     MemoryNeed {
         geometry,
@@ -511,17 +513,18 @@ fn memory_need(
     }
 }
 
-/// Emissive triangles over all instances (the emitter buffers' capacity).
+/// Emissive triangles over all instances (the emitter buffers' capacity): each mesh counted once,
+/// then summed over the instances that place it.
 fn emissive_triangles(scene: &Scene) -> usize {
-    scene
-        .instances
+    let per_mesh: Vec<usize> = scene
+        .meshes
         .iter()
-        .map(|i| {
-            let mesh = &scene.meshes[i.mesh];
+        .map(|mesh| {
             mesh.triangle_materials
                 .iter()
                 .filter(|&&m| scene.material_emission[m as usize].max_element() > 0.0)
                 .count()
         })
-        .sum()
+        .collect();
+    scene.instances.iter().map(|i| per_mesh[i.mesh]).sum()
 }
